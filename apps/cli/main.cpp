@@ -1,0 +1,99 @@
+// pointhaptics: the command line. `pointhaptics <command> [scene.toml] [options]`, --help on every command.
+#include "progress_bar.hpp"
+
+#include <pointhaptics/pointhaptics.hpp>
+
+#include "bench_suite.hpp"
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cstdio>
+
+namespace ph = pointhaptics;
+
+namespace {
+
+struct RunOptions {
+  std::string scene;
+  std::string json;
+  bool quiet = false;
+  int threads = 0;
+};
+
+void print_summary(const ph::Simulation& sim, const ph::RunSummary& s, double setup_s) {
+  const ph::Model& m = sim.model();
+  const ph::State& st = sim.state();
+  Eigen::Index worst = 0;
+  const double max_u = m.n_points ? st.u.colwise().norm().maxCoeff(&worst) : 0.0;
+  fmt::print("points          {} ({} held), h = {:.4g} m, {:.1f} neighbours per point (min {}), kernel {}\n", m.n_points,
+             std::count(m.fixed.begin(), m.fixed.end(), 1), m.h, m.diagnostics.mean_neighbours,
+             m.diagnostics.min_neighbours, ph::to_string(m.kernel.type));
+  if (m.diagnostics.regularised_neighbourhoods)
+    fmt::print("warning         {} neighbourhoods were ill-conditioned and regularised\n", m.diagnostics.regularised_neighbourhoods);
+  fmt::print("material        E = {:.4g} Pa, nu = {:.3g}, rho = {:.4g} kg/m^3, total mass {:.4g} kg\n", m.material.young,
+             m.material.poisson, m.material.density, m.mass.sum());
+  fmt::print("solver          {}: {} steps of {:.3g} s, {} sub-steps (stable sub-step {:.3g} s), t = {:.4g} s\n",
+             s.solver_kind, s.steps, sim.solver().dt, s.substeps, s.stable_dt, st.time);
+  fmt::print("displacement    max {:.4g} m at point {} ({:.4g}, {:.4g}, {:.4g})\n", max_u, worst, m.X(0, worst), m.X(1, worst),
+             m.X(2, worst));
+  fmt::print("energy          strain {:.4g} J, kinetic {:.4g} J, out-of-balance {:.3g}\n", s.strain_energy, s.kinetic_energy,
+             s.residual);
+  for (size_t g = 0; g < s.reactions.size(); ++g)
+    fmt::print("reaction        {}: ({:.4g}, {:.4g}, {:.4g}) N on {} points\n", m.fixed_groups[g].name, s.reactions[g][0],
+               s.reactions[g][1], s.reactions[g][2], m.fixed_groups[g].points.size());
+  fmt::print("timing          set-up {:.3f} s, stepping {:.3f} s, {:.3f} ms per step, {:.0f} steps/s\n", setup_s, s.wall_s,
+             s.step_ms_mean, s.steps_per_s);
+}
+
+int run_command(const RunOptions& opt) {
+  const auto start = std::chrono::steady_clock::now();
+  const ph::Scene scene = ph::read_scene_file(opt.scene);
+  ph::Simulation sim(ph::build_scene_model(scene), scene.solver, opt.threads);
+  const double setup_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  {
+    ph::cli::ProgressBar bar(!opt.quiet);
+    sim.run(scene.solver.duration, [&](double f) { bar.update(f); });
+  }
+  const ph::RunSummary summary = sim.summary();
+  if (!opt.json.empty()) ph::write_result_json(opt.json, sim.model(), sim.state(), summary);
+  if (!opt.quiet) print_summary(sim, summary, setup_s);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"PointHaptics: point-based deformable objects with haptic rendering", "pointhaptics"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "pointhaptics 0.1.0");
+
+  RunOptions run;
+  CLI::App* run_cmd = app.add_subcommand("run", "Simulate a scene file as it says (headless)");
+  run_cmd->add_option("scene", run.scene, "Scene file (TOML)")->required();
+  run_cmd->add_option("--json", run.json, "Write the result JSON to FILE");
+  run_cmd->add_flag("--quiet,-q", run.quiet, "Print nothing but errors");
+  run_cmd->add_option("--threads", run.threads, "Threads for the force evaluation (0: all)")->check(CLI::NonNegativeNumber);
+
+  ph::bench::BenchOptions bench;
+  CLI::App* bench_cmd = app.add_subcommand("bench", "Run the performance suite (forces and explicit steps) and print a table");
+  bench_cmd->add_option("--json", bench.json_path, "Write the results as JSON to FILE");
+  bench_cmd->add_option("--filter", bench.filter, "Only benchmarks whose name matches this regex, e.g. 'forces/points:10000'");
+  bench_cmd->add_option("--min-time", bench.min_time, "Seconds per benchmark")->check(CLI::PositiveNumber);
+  bench_cmd->add_option("--sizes", bench.sizes, "Approximate point counts")->check(CLI::PositiveNumber);
+  bench_cmd->add_option("--threads", bench.threads, "Thread counts")->check(CLI::PositiveNumber);
+
+  CLI11_PARSE(app, argc, argv);
+  try {
+    if (*run_cmd) return run_command(run);
+    if (*bench_cmd) return ph::bench::run_bench_suite(bench);
+  } catch (const ph::Error& e) {
+    std::fprintf(stderr, "pointhaptics: error: %s\n", e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "pointhaptics: internal error: %s\n", e.what());
+    return 2;
+  }
+  return 0;
+}

@@ -1,0 +1,5 @@
+# project options, prefixed PH_, defaulting to whether this is the top-level project
+option(PH_BUILD_TESTS "Build the GoogleTest suite" ${PROJECT_IS_TOP_LEVEL})
+option(PH_BUILD_APPS "Build the pointhaptics command line and the benchmark suite" ${PROJECT_IS_TOP_LEVEL})
+option(PH_NATIVE "Optimise for the building machine's CPU (-march=native)" OFF)
+set(PH_SANITIZE "" CACHE STRING "Sanitizers to build with: address,undefined | thread | empty")

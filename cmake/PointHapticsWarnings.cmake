@@ -1,0 +1,20 @@
+# warnings and code-generation flags shared by every target, as one interface target;
+# they apply when building this project only, never to consumers of the installed package
+add_library(pointhaptics_build_flags INTERFACE)
+add_library(pointhaptics::build_flags ALIAS pointhaptics_build_flags)
+target_compile_options(pointhaptics_build_flags INTERFACE
+  $<BUILD_INTERFACE:$<$<CXX_COMPILER_ID:GNU,Clang>:-Wall -Wextra -Wpedantic>>)
+if(PH_NATIVE)
+  target_compile_options(pointhaptics_build_flags INTERFACE $<BUILD_INTERFACE:-march=native>)
+endif()
+if(PH_SANITIZE)
+  target_compile_options(pointhaptics_build_flags INTERFACE
+    $<BUILD_INTERFACE:-fsanitize=${PH_SANITIZE} -fno-omit-frame-pointer -fno-sanitize-recover=all>)
+  target_link_options(pointhaptics_build_flags INTERFACE $<BUILD_INTERFACE:-fsanitize=${PH_SANITIZE}>)
+endif()
+install(TARGETS pointhaptics_build_flags EXPORT PointHapticsTargets)
+# GCC 12 reports -Wmaybe-uninitialized inside its own AVX-512 intrinsics when Eigen vectorises for
+# -march=native (a known false positive in avx512fintrin.h, not in our code)
+if(PH_NATIVE AND CMAKE_CXX_COMPILER_ID STREQUAL "GNU" AND CMAKE_CXX_COMPILER_VERSION VERSION_LESS 13)
+  target_compile_options(pointhaptics_build_flags INTERFACE $<BUILD_INTERFACE:-Wno-maybe-uninitialized>)
+endif()

@@ -1,0 +1,52 @@
+#pragma once
+/// @file The static model: everything precomputed once and never written during a run.
+#include <pointhaptics/core/csr.hpp>
+#include <pointhaptics/core/diagnostics.hpp>
+#include <pointhaptics/core/parameters.hpp>
+#include <pointhaptics/core/types.hpp>
+
+#include <string>
+#include <vector>
+
+namespace pointhaptics {
+
+/// A set of held points (one `[[fixed]]` table): at zero or at a prescribed displacement.
+struct FixedGroup {
+  std::string name;                       ///< for messages, e.g. "fixed #1"
+  Vec3 displacement = Vec3::Zero();       ///< prescribed displacement, m
+  double ramp = 0.0;                      ///< ramp-in time of the prescribed displacement, s
+  std::vector<index_t> points;            ///< held points
+};
+
+/// Static, precomputed data of a point-based object (MuJoCo's mjModel). Built by build_model()
+/// and then only read: the solvers take it by const reference.
+struct Model {
+  index_t n_points = 0;
+  Points X;                         ///< reference positions, m  (3 x n)
+  Eigen::VectorXd volume;           ///< v_i, m^3  (n)
+  Eigen::VectorXd mass;             ///< m_i, kg  (n)
+  double spacing = 0;               ///< nominal sample spacing, m
+  double h = 0;                     ///< kernel support radius, m
+  KernelParams kernel;
+  MaterialParams material;
+  double lambda = 0, mu = 0;        ///< Lame parameters, Pa
+
+  /// stencils: the neighbours j != i with |X_j - X_i| < h of each point i, as CSR (pairs e = (i, j))
+  Csr neighbours;
+  // per-pair data, aligned with neighbours.index
+  Points d;                         ///< d_ij = M_i^-1 X_ij w_ij, 1/m  (3 x n_pairs), seed Eq. 10-11
+  Eigen::VectorXd hg_coef;          ///< c_ij = alpha E v_i w^_ij / |X_ij|^2 of the hourglass energy, N/m  (n_pairs)
+  // per-point data
+  Points d_self;                    ///< d_ii = -sum_j d_ij, 1/m  (3 x n)
+
+  // boundary conditions and constant external loads
+  std::vector<unsigned char> fixed; ///< 1 where the point is held  (n)
+  std::vector<FixedGroup> fixed_groups;
+  Points f_ext;                     ///< constant external force per point (gravity, tractions, point loads), N  (3 x n)
+
+  ModelDiagnostics diagnostics;
+
+  index_t n_pairs() const { return neighbours.n_entries(); }
+};
+
+}  // namespace pointhaptics

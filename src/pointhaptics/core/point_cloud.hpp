@@ -1,0 +1,18 @@
+#pragma once
+/// @file A sampled body: positions, the volume each point stands for, and flags.
+#include <pointhaptics/core/types.hpp>
+
+#include <vector>
+
+namespace pointhaptics {
+
+struct PointCloud {
+  Points X;                           ///< positions, m  (3 x n)
+  Eigen::VectorXd volume;             ///< volume each point represents, m^3  (n); sums to the body's volume
+  std::vector<unsigned char> surface; ///< 1 where the point lies on the body's surface  (n)
+  double spacing = 0;                 ///< nominal sample spacing, m
+
+  index_t size() const { return static_cast<index_t>(X.cols()); }
+};
+
+}  // namespace pointhaptics

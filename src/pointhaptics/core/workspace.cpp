@@ -1,0 +1,55 @@
+#include <pointhaptics/core/workspace.hpp>
+
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/task_arena.h>
+
+#include <algorithm>
+#include <thread>
+
+namespace pointhaptics {
+
+struct Workspace::ThreadPool {
+  explicit ThreadPool(int n) : arena(n) {}
+  tbb::task_arena arena;
+};
+
+Workspace::Workspace(const Model& model, int n_threads) {
+  if (n_threads <= 0) n_threads = std::max(1u, std::thread::hardware_concurrency());
+  // a chunk per thread, but never a chunk without points
+  n_threads_ = std::max(1, std::min<int>(n_threads, std::max<index_t>(1, model.n_points)));
+  chunk_offset_.resize(n_threads_ + 1);
+  for (int c = 0; c <= n_threads_; ++c)
+    chunk_offset_[c] = static_cast<index_t>(static_cast<std::int64_t>(model.n_points) * c / n_threads_);
+  // the columns each chunk scatters into: its own points and their neighbours
+  scatter_range_.resize(2 * n_threads_);
+  const Csr& nbr = model.neighbours;
+  const bool has_neighbours = nbr.n_rows() == model.n_points;
+  for (int c = 0; c < n_threads_; ++c) {
+    index_t lo = chunk_offset_[c], hi = chunk_offset_[c + 1];
+    for (index_t i = chunk_offset_[c]; has_neighbours && i < chunk_offset_[c + 1]; ++i)
+      for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
+        lo = std::min(lo, nbr.index[e]);
+        hi = std::max(hi, nbr.index[e] + 1);
+      }
+    scatter_range_[2 * c] = lo;
+    scatter_range_[2 * c + 1] = hi;
+  }
+  f_int = Points::Zero(3, model.n_points);
+  acceleration = Points::Zero(3, model.n_points);
+  if (n_threads_ > 1) {
+    chunk_forces.assign(n_threads_, Points::Zero(3, model.n_points));
+    pool_ = std::make_unique<ThreadPool>(n_threads_);
+  }
+}
+
+Workspace::~Workspace() = default;
+Workspace::Workspace(Workspace&&) noexcept = default;
+Workspace& Workspace::operator=(Workspace&&) noexcept = default;
+
+void Workspace::run_chunks(void (*call)(void*, int), void* context) {
+  pool_->arena.execute([&] {
+    tbb::parallel_for(0, n_threads_, [&](int c) { call(context, c); }, tbb::static_partitioner());
+  });
+}
+
+}  // namespace pointhaptics

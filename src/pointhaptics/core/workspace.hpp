@@ -1,0 +1,53 @@
+#pragma once
+/// @file Solver-owned scratch memory, sized once per model so that a step never allocates.
+#include <pointhaptics/core/model.hpp>
+
+#include <memory>
+#include <vector>
+
+namespace pointhaptics {
+
+/// Scratch buffers and the thread pool of the force evaluation and the solvers.
+/// Not shared between threads that step different simulations.
+class Workspace {
+ public:
+  /// Size every buffer for `model`; n_threads = 0 means all hardware threads.
+  Workspace(const Model& model, int n_threads = 0);
+  ~Workspace();
+  Workspace(Workspace&&) noexcept;
+  Workspace& operator=(Workspace&&) noexcept;
+
+  int n_threads() const { return n_threads_; }
+  /// Contiguous point range [first, last) handled by chunk c (one chunk per thread).
+  index_t chunk_begin(int c) const { return chunk_offset_[c]; }
+  index_t chunk_end(int c) const { return chunk_offset_[c + 1]; }
+  /// Columns [first, last) that chunk c's stencils write to (its points and their neighbours).
+  index_t scatter_begin(int c) const { return scatter_range_[2 * c]; }
+  index_t scatter_end(int c) const { return scatter_range_[2 * c + 1]; }
+  /// Run fn(c) for every chunk c in [0, n_threads), in parallel on this workspace's threads.
+  template <class Fn>
+  void for_each_chunk(Fn&& fn);
+
+  Points f_int;                     ///< internal elastic forces, N  (3 x n)
+  std::vector<Points> chunk_forces; ///< per-chunk scatter targets, summed into f_int  (n_threads x (3 x n))
+  Points acceleration;              ///< scratch of the explicit solver, m/s^2  (3 x n)
+
+ private:
+  void run_chunks(void (*call)(void*, int), void* context);
+  int n_threads_ = 1;
+  std::vector<index_t> chunk_offset_;
+  std::vector<index_t> scatter_range_;
+  struct ThreadPool;                ///< a TBB arena of n_threads, kept out of this header
+  std::unique_ptr<ThreadPool> pool_;
+};
+
+template <class Fn>
+void Workspace::for_each_chunk(Fn&& fn) {
+  if (n_threads_ == 1) {
+    fn(0);
+    return;
+  }
+  run_chunks([](void* ctx, int c) { (*static_cast<Fn*>(ctx))(c); }, &fn);
+}
+
+}  // namespace pointhaptics

@@ -1,0 +1,72 @@
+#include <pointhaptics/geometry/neighbour_search.hpp>
+
+#include <pointhaptics/geometry/kd_tree.hpp>
+#include <oneapi/tbb/parallel_for.h>
+
+#include <algorithm>
+#include <utility>
+
+namespace pointhaptics {
+namespace {
+
+Csr rows_to_csr(const std::vector<std::vector<index_t>>& rows) {
+  std::vector<index_t> offset(rows.size() + 1, 0);
+  for (size_t i = 0; i < rows.size(); ++i) offset[i + 1] = offset[i] + static_cast<index_t>(rows[i].size());
+  std::vector<index_t> index;
+  index.reserve(offset.back());
+  for (const auto& row : rows) index.insert(index.end(), row.begin(), row.end());
+  return Csr{std::move(offset), std::move(index)};
+}
+
+}  // namespace
+
+Csr radius_neighbours(const Points& X, double h) {
+  const index_t n = static_cast<index_t>(X.cols());
+  const KdTree tree(X);
+  std::vector<std::vector<index_t>> rows(n);
+  tbb::parallel_for(tbb::blocked_range<index_t>(0, n, 256), [&](const tbb::blocked_range<index_t>& range) {
+    std::vector<std::pair<index_t, double>> found;
+    nanoflann::SearchParams params;
+    params.sorted = false;
+    for (index_t i = range.begin(); i != range.end(); ++i) {
+      found.clear();
+      const Vec3 q = X.col(i);
+      // search slightly wider than h, then apply the one support predicate
+      tree.index().radiusSearch(q.data(), h * h * (1.0 + 1e-6), found, params);
+      auto& row = rows[i];
+      for (const auto& [j, r2] : found)
+        if (j != i && within_support((X.col(j) - q).squaredNorm(), h)) row.push_back(j);
+      std::sort(row.begin(), row.end());
+    }
+  });
+  return rows_to_csr(rows);
+}
+
+Csr radius_neighbours_brute_force(const Points& X, double h) {
+  const index_t n = static_cast<index_t>(X.cols());
+  std::vector<std::vector<index_t>> rows(n);
+  for (index_t i = 0; i < n; ++i)
+    for (index_t j = 0; j < n; ++j)
+      if (j != i && within_support((X.col(j) - X.col(i)).squaredNorm(), h)) rows[i].push_back(j);
+  return rows_to_csr(rows);
+}
+
+std::vector<index_t> nearest_neighbour(const Points& X) {
+  const index_t n = static_cast<index_t>(X.cols());
+  std::vector<index_t> nearest(n, -1);
+  if (n < 2) return nearest;
+  const KdTree tree(X);
+  tbb::parallel_for(tbb::blocked_range<index_t>(0, n, 256), [&](const tbb::blocked_range<index_t>& range) {
+    for (index_t i = range.begin(); i != range.end(); ++i) {
+      index_t idx[2];
+      double d2[2];
+      const Vec3 q = X.col(i);
+      const size_t found = tree.index().knnSearch(q.data(), 2, idx, d2);
+      for (size_t k = 0; k < found; ++k)
+        if (idx[k] != i) { nearest[i] = idx[k]; break; }
+    }
+  });
+  return nearest;
+}
+
+}  // namespace pointhaptics

@@ -1,0 +1,68 @@
+#include <pointhaptics/io/result_json.hpp>
+
+#include <pointhaptics/core/error.hpp>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <fstream>
+
+namespace pointhaptics {
+namespace {
+
+using nlohmann::json;
+
+json vec(const Eigen::Ref<const Vec3>& v) { return json::array({v[0], v[1], v[2]}); }
+
+json columns(const Points& P) {
+  json out = json::array();
+  for (Eigen::Index i = 0; i < P.cols(); ++i) out.push_back(vec(P.col(i)));
+  return out;
+}
+
+}  // namespace
+
+std::string result_json(const Model& model, const State& state, const RunSummary& s) {
+  json doc;
+  json fixed = json::array(), active = json::array();
+  for (index_t i = 0; i < model.n_points; ++i) {
+    fixed.push_back(model.fixed[i] != 0);
+    active.push_back(true);
+  }
+  doc["points"] = {{"reference", columns(model.X)}, {"displacement", columns(state.u)}, {"fixed", fixed}, {"active", active}};
+  doc["solver"] = {{"kind", s.solver_kind},     {"converged", s.converged}, {"iterations", s.iterations},
+                   {"residual", s.residual},    {"steps", s.steps},         {"substeps", s.substeps},
+                   {"stable_dt", s.stable_dt}};
+  doc["energy"] = {{"strain", s.strain_energy}, {"kinetic", s.kinetic_energy}};
+  doc["timing"] = {{"wall_s", s.wall_s}, {"step_ms_mean", s.step_ms_mean}, {"steps_per_s", s.steps_per_s}};
+  json constraints = json::array();
+  for (size_t g = 0; g < model.fixed_groups.size(); ++g)
+    constraints.push_back({{"points", model.fixed_groups[g].points.size()},
+                           {"reaction", g < s.reactions.size() ? vec(s.reactions[g]) : vec(Vec3::Zero())}});
+  doc["constraints"] = constraints;
+  // no probe and no levels of detail in this run: the blocks are there, empty
+  doc["haptic"] = {{"ticks", 0}, {"rate_hz", 0.0}, {"period_p99_us", 0.0}, {"max_force_n", 0.0}};
+  doc["lod"] = {{"selected", model.n_points}, {"selection_ms", 0.0}};
+  const ModelDiagnostics& d = model.diagnostics;
+  doc["model"] = {{"points", model.n_points},
+                  {"h", model.h},
+                  {"kernel", std::string(to_string(model.kernel.type))},
+                  {"volume", std::string(to_string(model.material.volume))},
+                  {"total_volume", model.volume.sum()},
+                  {"total_mass", model.mass.sum()},
+                  {"mean_neighbours", d.mean_neighbours},
+                  {"min_neighbours", d.min_neighbours},
+                  {"regularised_neighbourhoods", d.regularised_neighbourhoods},
+                  {"isolated_points", d.isolated_points}};
+  return doc.dump(1);
+}
+
+void write_result_json(const std::string& path, const Model& model, const State& state, const RunSummary& summary) {
+  std::ofstream out(path);
+  if (!out) throw Error(fmt::format("{}: cannot write the result file", path));
+  out << result_json(model, state, summary) << '\n';
+  if (!out) throw Error(fmt::format("{}: writing the result failed", path));
+}
+
+}  // namespace pointhaptics

@@ -1,0 +1,30 @@
+#pragma once
+/// @file The result JSON of `pointhaptics run --json` (design.md's contract).
+#include <pointhaptics/core/state.hpp>
+
+#include <string>
+#include <vector>
+
+namespace pointhaptics {
+
+/// What a run reports besides the points: solver outcome, energies, timing, support reactions.
+struct RunSummary {
+  std::string solver_kind;
+  bool converged = false;
+  long long iterations = 0;     ///< Newton iterations (static, implicit) or force evaluations (explicit)
+  double residual = 0;          ///< relative out-of-balance force of the free points at the end
+  long long steps = 0;          ///< solver steps of dt
+  double strain_energy = 0, kinetic_energy = 0;  ///< J
+  double wall_s = 0, step_ms_mean = 0, steps_per_s = 0;
+  double stable_dt = 0;         ///< explicit: the stable sub-step, s
+  long long substeps = 0;       ///< explicit: sub-steps taken in all
+  std::vector<Vec3> reactions;  ///< per fixed group, N
+};
+
+/// The result document as a string (indented JSON).
+std::string result_json(const Model& model, const State& state, const RunSummary& summary);
+
+/// Write result_json() to `path`; throws Error naming the path when it cannot be written.
+void write_result_json(const std::string& path, const Model& model, const State& state, const RunSummary& summary);
+
+}  // namespace pointhaptics

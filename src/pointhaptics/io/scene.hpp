@@ -1,0 +1,66 @@
+#pragma once
+/// @file The scene: a plain description of an experiment, as read from a scene file (design.md's TOML schema).
+#include <pointhaptics/core/parameters.hpp>
+#include <pointhaptics/core/types.hpp>
+
+#include <string>
+#include <vector>
+
+namespace pointhaptics {
+
+struct Aabb {
+  Vec3 min = Vec3::Zero(), max = Vec3::Zero();
+  bool contains(const Vec3& p) const { return (p.array() >= min.array()).all() && (p.array() <= max.array()).all(); }
+};
+
+enum class ShapeKind { BOX, SPHERE, HALF_SPHERE, FILE };
+
+struct ObjectSpec {
+  ShapeKind shape = ShapeKind::BOX;
+  Vec3 size = Vec3(0.15, 0.03, 0.03);  ///< box edge lengths, m
+  Vec3 origin = Vec3::Zero();          ///< box: min corner; sphere, half_sphere: centre, m
+  double radius = 0.05;                ///< sphere, half_sphere, m
+  double spacing = 0.0075;             ///< sample spacing, m
+  std::string file;                    ///< shape = file: path, resolved against the scene file's folder
+};
+
+struct FixedSpec {
+  Aabb box;                                ///< points inside (faces included) are held
+  Vec3 displacement = Vec3::Zero();        ///< prescribed displacement, m
+  double ramp = 0;                         ///< ramp-in time, s
+  int line = 0;                            ///< line of the [[fixed]] table, for messages
+};
+
+enum class LoadKind { TRACTION, GRAVITY, POINT };
+
+struct LoadSpec {
+  LoadKind kind = LoadKind::TRACTION;
+  Aabb box;                     ///< traction: the loaded points
+  Vec3 total = Vec3::Zero();    ///< traction: total force, N
+  Vec3 g = Vec3(0, -9.81, 0);   ///< gravity, m/s^2
+  long long point = 0;          ///< point load: point index
+  Vec3 force = Vec3::Zero();    ///< point load: force, N
+  int line = 0;
+};
+
+enum class SolverKind { STATIC, EXPLICIT, IMPLICIT };
+
+struct SolverSpec {
+  SolverKind kind = SolverKind::EXPLICIT;
+  double dt = 1e-3;       ///< s
+  double duration = 1.0;  ///< s
+};
+
+struct Scene {
+  std::string path;  ///< the scene file ("<string>" when parsed from text), for messages
+  ObjectSpec object;
+  MaterialParams material;
+  KernelParams kernel;
+  std::vector<FixedSpec> fixed;
+  std::vector<LoadSpec> loads;
+  SolverSpec solver;
+};
+
+std::string_view to_string(SolverKind kind);
+
+}  // namespace pointhaptics

@@ -1,0 +1,299 @@
+#include <pointhaptics/io/scene_toml.hpp>
+
+#include <pointhaptics/core/error.hpp>
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+namespace pointhaptics {
+
+std::string_view to_string(SolverKind kind) {
+  switch (kind) {
+    case SolverKind::STATIC: return "static";
+    case SolverKind::EXPLICIT: return "explicit";
+    case SolverKind::IMPLICIT: return "implicit";
+  }
+  return "?";
+}
+
+namespace {
+
+struct Context {
+  std::string file;
+  std::string base_dir;
+};
+
+[[noreturn]] void fail(const Context& ctx, const toml::source_region& where, std::string_view key, std::string_view what) {
+  throw Error(fmt::format("{}:{}: {}: {}", ctx.file, where.begin.line, key, what));
+}
+
+// Reads the keys of one table, remembering which it read, so that the rest can be reported as unknown.
+class TableReader {
+ public:
+  TableReader(const Context& ctx, const toml::table& table, std::string section)
+      : ctx_(ctx), table_(table), section_(std::move(section)) {}
+
+  std::string name(std::string_view key) const { return section_.empty() ? std::string(key) : section_ + "." + std::string(key); }
+  const toml::node* find(std::string_view key) {
+    seen_.insert(std::string(key));
+    return table_.get(key);
+  }
+  [[noreturn]] void fail_at(const toml::node& node, std::string_view key, std::string_view what) const {
+    fail(ctx_, node.source(), name(key), what);
+  }
+  [[noreturn]] void fail_table(std::string_view key, std::string_view what) const { fail(ctx_, table_.source(), name(key), what); }
+
+  double number(std::string_view key, double fallback) {
+    const toml::node* node = find(key);
+    return node ? as_number(*node, key) : fallback;
+  }
+  double as_number(const toml::node& node, std::string_view key) const {
+    double value;
+    if (auto f = node.as_floating_point()) value = f->get();
+    else if (auto i = node.as_integer()) value = static_cast<double>(i->get());
+    else fail_at(node, key, fmt::format("expected a number, got {}", type_name(node)));
+    if (!std::isfinite(value)) fail_at(node, key, fmt::format("{} is not a finite number", value));
+    return value;
+  }
+  // number with a range rule: ok(value) must hold
+  template <class Ok>
+  double number(std::string_view key, double fallback, Ok ok, std::string_view rule) {
+    const toml::node* node = find(key);
+    if (!node) return fallback;
+    const double value = as_number(*node, key);
+    if (!ok(value)) fail_at(*node, key, fmt::format("{} is out of range: {}", value, rule));
+    return value;
+  }
+  long long integer(std::string_view key, long long fallback) {
+    const toml::node* node = find(key);
+    if (!node) return fallback;
+    if (auto i = node->as_integer()) return i->get();
+    fail_at(*node, key, fmt::format("expected an integer, got {}", type_name(*node)));
+  }
+  Vec3 vec3(std::string_view key, const Vec3& fallback) {
+    const toml::node* node = find(key);
+    return node ? as_vec3(*node, key) : fallback;
+  }
+  Vec3 as_vec3(const toml::node& node, std::string_view key) const {
+    const toml::array* array = node.as_array();
+    if (!array || array->size() != 3) fail_at(node, key, "expected an array of 3 numbers [x, y, z]");
+    Vec3 v;
+    for (int a = 0; a < 3; ++a) v[a] = as_number(*array->get(a), key);
+    return v;
+  }
+  std::string string(std::string_view key, std::string fallback) {
+    const toml::node* node = find(key);
+    if (!node) return fallback;
+    if (auto s = node->as_string()) return s->get();
+    fail_at(*node, key, fmt::format("expected a string, got {}", type_name(*node)));
+  }
+  // a string that must be one of `choices`
+  std::string choice(std::string_view key, std::string fallback, std::initializer_list<std::string_view> choices) {
+    const toml::node* node = table_.get(key);
+    std::string value = string(key, std::move(fallback));
+    for (auto c : choices)
+      if (value == c) return value;
+    std::string list;
+    for (auto c : choices) list += (list.empty() ? "" : " | ") + std::string(c);
+    fail_at(*node, key, fmt::format("unknown value \"{}\" (expected {})", value, list));
+  }
+  const toml::table* subtable(std::string_view key) {
+    const toml::node* node = find(key);
+    if (!node) return nullptr;
+    if (auto t = node->as_table()) return t;
+    fail_at(*node, key, fmt::format("expected a table, got {}", type_name(*node)));
+  }
+  Aabb box(std::string_view key, bool required) {
+    const toml::table* t = subtable(key);
+    if (!t) {
+      if (required) fail_table(key, "missing (expected box = { min = [x, y, z], max = [x, y, z] })");
+      return {};
+    }
+    TableReader r(ctx_, *t, name(key));
+    Aabb b;
+    if (!t->get("min") || !t->get("max")) r.fail_table("min", "a box needs both min and max");
+    b.min = r.vec3("min", Vec3::Zero());
+    b.max = r.vec3("max", Vec3::Zero());
+    r.finish();
+    if (!(b.min.array() <= b.max.array()).all()) fail(ctx_, t->source(), name(key), "min must not exceed max in any component");
+    return b;
+  }
+  // every key not read is unknown
+  void finish() const {
+    for (auto&& [key, node] : table_)
+      if (!seen_.count(std::string(key.str())))
+        fail(ctx_, key.source().begin.line ? key.source() : node.source(), name(key.str()), "unknown key");
+  }
+  int line() const { return static_cast<int>(table_.source().begin.line); }
+  const Context& context() const { return ctx_; }
+
+  static std::string_view type_name(const toml::node& node) {
+    switch (node.type()) {
+      case toml::node_type::string: return "a string";
+      case toml::node_type::integer: return "an integer";
+      case toml::node_type::floating_point: return "a float";
+      case toml::node_type::boolean: return "a boolean";
+      case toml::node_type::array: return "an array";
+      case toml::node_type::table: return "a table";
+      default: return "a date or time";
+    }
+  }
+
+ private:
+  const Context& ctx_;
+  const toml::table& table_;
+  std::string section_;
+  std::set<std::string> seen_;
+};
+
+auto positive = [](double x) { return x > 0; };
+auto non_negative = [](double x) { return x >= 0; };
+
+void read_object(TableReader& r, ObjectSpec& o, const Context& ctx) {
+  const std::string shape = r.choice("shape", "box", {"box", "sphere", "half_sphere", "file"});
+  o.shape = shape == "box" ? ShapeKind::BOX : shape == "sphere" ? ShapeKind::SPHERE : shape == "half_sphere" ? ShapeKind::HALF_SPHERE : ShapeKind::FILE;
+  o.spacing = r.number("spacing", o.spacing, positive, "must be > 0 (m)");
+  if (o.shape == ShapeKind::BOX) {
+    if (!r.find("size")) r.fail_table("size", "a box needs size = [lx, ly, lz] (m)");
+    o.size = r.vec3("size", o.size);
+    if (!(o.size.array() > 0).all()) r.fail_at(*r.find("size"), "size", "every edge length must be > 0 (m)");
+  }
+  o.origin = r.vec3("origin", o.origin);
+  if (o.shape == ShapeKind::SPHERE || o.shape == ShapeKind::HALF_SPHERE) {
+    if (!r.find("radius")) r.fail_table("radius", "a sphere needs radius = <m>");
+  }
+  if (o.shape == ShapeKind::SPHERE || o.shape == ShapeKind::HALF_SPHERE)
+    o.radius = r.number("radius", o.radius, positive, "must be > 0 (m)");
+  if (o.shape == ShapeKind::FILE) {
+    if (!r.find("file")) r.fail_table("file", "shape = \"file\" needs file = \"path\"");
+    o.file = r.string("file", "");
+    std::filesystem::path p(o.file);
+    if (p.is_relative()) p = std::filesystem::path(ctx.base_dir) / p;
+    o.file = p.lexically_normal().string();
+  }
+}
+
+void read_material(TableReader& r, MaterialParams& m) {
+  m.young = r.number("young", m.young, positive, "must be > 0 (Pa)");
+  m.poisson = r.number("poisson", m.poisson, [](double x) { return x > -1 && x < 0.5; }, "must lie in (-1, 0.5)");
+  m.density = r.number("density", m.density, positive, "must be > 0 (kg/m^3)");
+  m.volume_stiffness = r.number("volume_stiffness", m.volume_stiffness, non_negative, "must be >= 0 (Pa)");
+  m.damping = r.number("damping", m.damping, non_negative, "must be >= 0 (1/s)");
+  m.hourglass = r.number("hourglass", m.hourglass, [](double x) { return x >= 0 && x <= 10; }, "must lie in [0, 10]");
+  m.volume = r.choice("volume", "cell", {"cell", "kernel"}) == "cell" ? VolumeMode::CELL : VolumeMode::KERNEL;
+}
+
+void read_kernel(TableReader& r, KernelParams& k) {
+  const std::string type = r.choice("type", "poly6", {"poly6", "spiky", "viscosity", "quadratic"});
+  k.type = type == "poly6" ? KernelType::POLY6 : type == "spiky" ? KernelType::SPIKY : type == "viscosity" ? KernelType::VISCOSITY : KernelType::QUADRATIC;
+  if (r.find("support_factor") && r.find("support"))
+    r.fail_at(*r.find("support"), "support", "give either support (m) or support_factor, not both");
+  k.support_factor = r.number("support_factor", k.support_factor, [](double x) { return x > 1 && x <= 20; }, "must lie in (1, 20]");
+  k.support = r.number("support", 0.0, positive, "must be > 0 (m)");
+}
+
+void read_solver(TableReader& r, SolverSpec& s) {
+  const std::string kind = r.choice("kind", "explicit", {"static", "explicit", "implicit"});
+  s.kind = kind == "static" ? SolverKind::STATIC : kind == "explicit" ? SolverKind::EXPLICIT : SolverKind::IMPLICIT;
+  s.dt = r.number("dt", s.dt, [](double x) { return x > 0 && x <= 1; }, "must lie in (0, 1] (s)");
+  s.duration = r.number("duration", s.duration, [](double x) { return x >= 0 && x <= 1e6; }, "must lie in [0, 1e6] (s)");
+}
+
+FixedSpec read_fixed(TableReader& r) {
+  FixedSpec f;
+  f.line = r.line();
+  f.box = r.box("box", true);
+  f.displacement = r.vec3("displacement", f.displacement);
+  f.ramp = r.number("ramp", 0.0, non_negative, "must be >= 0 (s)");
+  return f;
+}
+
+LoadSpec read_load(TableReader& r) {
+  LoadSpec l;
+  l.line = r.line();
+  const std::string kind = r.choice("kind", "traction", {"traction", "gravity", "point"});
+  if (kind == "traction") {
+    l.kind = LoadKind::TRACTION;
+    l.box = r.box("box", true);
+    if (!r.find("total")) r.fail_table("total", "a traction load needs total = [fx, fy, fz] (N)");
+    l.total = r.vec3("total", l.total);
+  } else if (kind == "gravity") {
+    l.kind = LoadKind::GRAVITY;
+    l.g = r.vec3("g", l.g);
+  } else {
+    l.kind = LoadKind::POINT;
+    if (!r.find("point")) r.fail_table("point", "a point load needs point = <index>");
+    l.point = r.integer("point", 0);
+    if (l.point < 0) r.fail_at(*r.find("point"), "point", "must be a point index >= 0");
+    if (!r.find("force")) r.fail_table("force", "a point load needs force = [fx, fy, fz] (N)");
+    l.force = r.vec3("force", l.force);
+  }
+  return l;
+}
+
+// [[name]] arrays of tables
+template <class Read>
+void read_array_of_tables(TableReader& root, std::string_view key, Read read) {
+  const toml::node* node = root.find(key);
+  if (!node) return;
+  const toml::array* array = node->as_array();
+  if (!array || !array->is_array_of_tables())
+    root.fail_at(*node, key, fmt::format("expected one or more [[{}]] tables", key));
+  int k = 0;
+  for (const toml::node& item : *array) {
+    TableReader r(root.context(), *item.as_table(), fmt::format("{}[{}]", key, k++));
+    read(r);
+    r.finish();
+  }
+}
+
+}  // namespace
+
+Scene parse_scene(std::string_view text, const std::string& name, const std::string& base_dir) {
+  Context ctx{name, base_dir};
+  toml::table root;
+  try {
+    root = toml::parse(text, name);
+  } catch (const toml::parse_error& e) {
+    throw Error(fmt::format("{}:{}: TOML syntax error: {}", name, e.source().begin.line, e.description()));
+  }
+  Scene scene;
+  scene.path = name;
+  TableReader top(ctx, root, "");
+  for (std::string_view later : {"lod", "probe", "device"})
+    if (const toml::node* node = top.find(later))
+      top.fail_at(*node, later, fmt::format("[{}] is part of the design but not implemented in this version yet", later));
+  auto section = [&](std::string_view key, auto read) {
+    if (const toml::table* t = top.subtable(key)) {
+      TableReader r(ctx, *t, std::string(key));
+      read(r);
+      r.finish();
+    }
+  };
+  if (!root.get("object")) throw Error(fmt::format("{}:1: object: missing [object] section", name));
+  section("object", [&](TableReader& r) { read_object(r, scene.object, ctx); });
+  section("material", [&](TableReader& r) { read_material(r, scene.material); });
+  section("kernel", [&](TableReader& r) { read_kernel(r, scene.kernel); });
+  section("solver", [&](TableReader& r) { read_solver(r, scene.solver); });
+  read_array_of_tables(top, "fixed", [&](TableReader& r) { scene.fixed.push_back(read_fixed(r)); });
+  read_array_of_tables(top, "load", [&](TableReader& r) { scene.loads.push_back(read_load(r)); });
+  top.finish();
+  return scene;
+}
+
+Scene read_scene_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(fmt::format("{}: cannot open the scene file", path));
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  const std::string dir = std::filesystem::path(path).parent_path().string();
+  return parse_scene(buffer.str(), path, dir.empty() ? "." : dir);
+}
+
+}  // namespace pointhaptics

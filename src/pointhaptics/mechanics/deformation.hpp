@@ -1,0 +1,33 @@
+#pragma once
+/// @file Per-point kinematics and constitutive law: G_i (seed Eq. 10), F_i, Green strain (Eq. 2), SVK stress.
+#include <pointhaptics/core/model.hpp>
+
+namespace pointhaptics {
+
+/// Displacement gradient G_i = sum_j (u_j - u_i) d_ij^T (seed Eq. 10); row a is the gradient of u_a.
+inline Mat3 displacement_gradient(const Model& model, const Points& u, index_t i) {
+  Mat3 G = Mat3::Zero();
+  const Vec3 ui = u.col(i);
+  for (index_t e = model.neighbours.begin(i); e < model.neighbours.end(i); ++e)
+    G.noalias() += (u.col(model.neighbours.index[e]) - ui) * model.d.col(e).transpose();
+  return G;
+}
+
+/// Green strain E = 0.5 (F^T F - I) with F = I + G (seed Eq. 2).
+inline Mat3 green_strain(const Mat3& F) { return 0.5 * (F.transpose() * F - Mat3::Identity()); }
+
+/// St. Venant-Kirchhoff second Piola-Kirchhoff stress S = lambda tr(E) I + 2 mu E.
+inline Mat3 svk_stress(const Mat3& E, double lambda, double mu) {
+  return lambda * E.trace() * Mat3::Identity() + 2.0 * mu * E;
+}
+
+/// Cofactor matrix cof F = det(F) F^-T; its rows are (r1 x r2, r2 x r0, r0 x r1) for rows r_a of F.
+inline Mat3 cofactor(const Mat3& F) {
+  Mat3 C;
+  C.row(0) = F.row(1).cross(F.row(2));
+  C.row(1) = F.row(2).cross(F.row(0));
+  C.row(2) = F.row(0).cross(F.row(1));
+  return C;
+}
+
+}  // namespace pointhaptics

@@ -1,0 +1,20 @@
+#pragma once
+/// @file The total elastic energy of a displacement field, term by term (independent of the force code).
+#include <pointhaptics/core/model.hpp>
+
+namespace pointhaptics {
+
+struct EnergyTerms {
+  double elastic = 0;    ///< sum_i v_i 0.5 S_i : E_i (St. Venant-Kirchhoff), J
+  double volume = 0;     ///< sum_i 0.5 k_v v_i (det F_i - 1)^2, J
+  double hourglass = 0;  ///< zero-energy-mode penalty (physics.md), J
+  double total() const { return elastic + volume + hourglass; }
+};
+
+/// The strain energy W(u) whose exact negative gradient compute_internal_forces() returns.
+EnergyTerms strain_energy(const Model& model, const Points& u);
+
+/// Kinetic energy 0.5 sum_i m_i |v_i|^2, J.
+double kinetic_energy(const Model& model, const Points& velocity);
+
+}  // namespace pointhaptics

@@ -1,0 +1,169 @@
+#include <pointhaptics/mechanics/model_builder.hpp>
+
+#include <pointhaptics/core/error.hpp>
+#include <pointhaptics/geometry/neighbour_search.hpp>
+#include <pointhaptics/mechanics/kernels.hpp>
+
+#include <Eigen/Eigenvalues>
+#include <fmt/format.h>
+#include <oneapi/tbb/parallel_for.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+
+namespace pointhaptics {
+
+void validate_material(const MaterialParams& m) {
+  auto bad = [](const char* key, double value, const char* rule) {
+    throw Error(fmt::format("material: {} = {} is out of range: {}", key, value, rule));
+  };
+  if (!(m.young > 0) || !std::isfinite(m.young)) bad("young", m.young, "must be positive and finite (Pa)");
+  if (!(m.poisson > -1 && m.poisson < 0.5)) bad("poisson", m.poisson, "must lie in (-1, 0.5)");
+  if (!(m.density > 0) || !std::isfinite(m.density)) bad("density", m.density, "must be positive and finite (kg/m^3)");
+  if (!(m.volume_stiffness >= 0) || !std::isfinite(m.volume_stiffness)) bad("volume_stiffness", m.volume_stiffness, "must be >= 0 and finite (Pa)");
+  if (!(m.damping >= 0) || !std::isfinite(m.damping)) bad("damping", m.damping, "must be >= 0 and finite (1/s)");
+  if (!(m.hourglass >= 0) || !std::isfinite(m.hourglass)) bad("hourglass", m.hourglass, "must be >= 0 and finite");
+}
+
+namespace {
+
+double support_radius(const PointCloud& cloud, const KernelParams& kernel) {
+  if (kernel.support > 0) {
+    if (!std::isfinite(kernel.support)) throw Error("kernel: support must be finite");
+    return kernel.support;
+  }
+  if (!(kernel.support_factor > 0) || !std::isfinite(kernel.support_factor))
+    throw Error(fmt::format("kernel: support_factor = {} must be positive", kernel.support_factor));
+  if (!(cloud.spacing > 0)) throw Error("kernel: the point cloud has no spacing; give kernel.support in m");
+  return kernel.support_factor * cloud.spacing;
+}
+
+}  // namespace
+
+Model build_model(const PointCloud& cloud, const MaterialParams& material, const KernelParams& kernel) {
+  validate_material(material);
+  const index_t n = cloud.size();
+  if (n == 0) throw Error("model: the object has no points");
+  if (!cloud.X.allFinite()) throw Error("model: the point positions contain NaN or infinity");
+
+  Model model;
+  model.n_points = n;
+  model.X = cloud.X;
+  model.spacing = cloud.spacing;
+  model.kernel = kernel;
+  model.material = material;
+  model.lambda = material.lambda();
+  model.mu = material.mu();
+  model.h = support_radius(cloud, kernel);
+  const double h = model.h;
+
+  // neighbours in the reference configuration
+  model.neighbours = radius_neighbours(model.X, h);
+  const Csr& nbr = model.neighbours;
+  const index_t n_pairs = nbr.n_entries();
+
+  // kernel weights per pair; coincident points would make w (and M_i) meaningless
+  Eigen::VectorXd w(n_pairs);
+  std::atomic<std::int64_t> coincident{-1};
+  tbb::parallel_for(index_t{0}, n, [&](index_t i) {
+    for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
+      const double r = (model.X.col(nbr.index[e]) - model.X.col(i)).norm();
+      if (r <= 1e-9 * h) coincident = i;
+      w[e] = kernel_value(kernel.type, r, h);
+    }
+  });
+  if (coincident >= 0) {
+    const index_t i = static_cast<index_t>(coincident.load());
+    index_t j = -1;
+    for (index_t e = nbr.begin(i); e < nbr.end(i); ++e)
+      if ((model.X.col(nbr.index[e]) - model.X.col(i)).norm() <= 1e-9 * h) j = nbr.index[e];
+    throw Error(fmt::format("model: points {} and {} coincide at ({}, {}, {}); remove duplicate points", i, j,
+                            model.X(0, i), model.X(1, i), model.X(2, i)));
+  }
+
+  // volumes and masses
+  if (cloud.volume.size() != n || !(cloud.volume.array() > 0).all())
+    throw Error("model: every point needs a positive sampling volume");
+  if (material.volume == VolumeMode::CELL) {
+    model.volume = cloud.volume;
+    model.mass = material.density * model.volume;
+  } else {
+    // seed Eq. 7-8: equal masses, kernel-summed density (self term included; the viscosity
+    // kernel is infinite at r = 0, so it is left out there)
+    const double total_mass = material.density * cloud.volume.sum();
+    model.mass = Eigen::VectorXd::Constant(n, total_mass / n);
+    const double w0 = kernel.type == KernelType::VISCOSITY ? 0.0 : kernel_value(kernel.type, 0.0, h);
+    model.volume.resize(n);
+    for (index_t i = 0; i < n; ++i) {
+      double rho = model.mass[i] * w0;  // seed Eq. 7
+      for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) rho += model.mass[nbr.index[e]] * w[e];
+      model.volume[i] = rho > 0 ? model.mass[i] / rho : cloud.volume[i];  // seed Eq. 8
+    }
+  }
+
+  // moment matrices (seed Eq. 11), their conditioning, d_ij and d_ii (seed Eq. 10)
+  model.d.resize(3, n_pairs);
+  model.d_self.resize(3, n);
+  model.hg_coef.resize(n_pairs);
+  std::vector<double> condition(n, 0.0);
+  std::vector<unsigned char> regularised(n, 0);
+  const double hg_scale = material.hourglass * material.young;
+  tbb::parallel_for(index_t{0}, n, [&](index_t i) {
+    Mat3 M = Mat3::Zero();
+    double w_sum = 0;
+    for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
+      const Vec3 xij = model.X.col(nbr.index[e]) - model.X.col(i);
+      M.noalias() += w[e] * xij * xij.transpose();
+      w_sum += w[e];
+    }
+    Mat3 M_inv = Mat3::Zero();
+    const double trace = M.trace();
+    if (trace > 0) {
+      Eigen::SelfAdjointEigenSolver<Mat3> eig;
+      eig.computeDirect(M, Eigen::EigenvaluesOnly);
+      const double lo = std::max(eig.eigenvalues()[0], 0.0), hi = eig.eigenvalues()[2];
+      condition[i] = lo > 0 ? hi / lo : std::numeric_limits<double>::infinity();
+      if (condition[i] > max_moment_condition) {
+        // too few or coplanar neighbours: regularise so that cond(M) stays near 1e3
+        M += 1e-3 * trace * Mat3::Identity();
+        regularised[i] = 1;
+      }
+      M_inv = M.inverse();
+    } else {
+      regularised[i] = 1;  // isolated: G_i = 0, the point feels no elastic force
+      condition[i] = std::numeric_limits<double>::infinity();
+    }
+    Vec3 d_sum = Vec3::Zero();
+    for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
+      const Vec3 xij = model.X.col(nbr.index[e]) - model.X.col(i);
+      const Vec3 dij = M_inv * xij * w[e];
+      model.d.col(e) = dij;
+      d_sum += dij;
+      // hourglass energy (physics.md): (alpha E / 2) v_i w^_ij |u_j - u_i - G_i X_ij|^2 / |X_ij|^2
+      model.hg_coef[e] = w_sum > 0 ? hg_scale * model.volume[i] * (w[e] / w_sum) / xij.squaredNorm() : 0.0;
+    }
+    model.d_self.col(i) = -d_sum;
+  });
+
+  // diagnostics
+  ModelDiagnostics& diag = model.diagnostics;
+  index_t min_nbr = std::numeric_limits<index_t>::max();
+  for (index_t i = 0; i < n; ++i) {
+    min_nbr = std::min(min_nbr, nbr.row_size(i));
+    diag.regularised_neighbourhoods += regularised[i];
+    diag.isolated_points += nbr.row_size(i) == 0;
+    if (std::isfinite(condition[i])) diag.worst_condition = std::max(diag.worst_condition, condition[i]);
+    else diag.worst_condition = std::numeric_limits<double>::infinity();
+  }
+  diag.min_neighbours = min_nbr;
+  diag.mean_neighbours = static_cast<double>(n_pairs) / n;
+
+  // no boundary conditions or loads yet
+  model.fixed.assign(n, 0);
+  model.f_ext = Points::Zero(3, n);
+  return model;
+}
+
+}  // namespace pointhaptics

@@ -1,0 +1,10 @@
+#pragma once
+/// @file The public API in one include: scenes, models, the simulation and its results.
+#include <pointhaptics/core/error.hpp>
+#include <pointhaptics/core/model.hpp>
+#include <pointhaptics/core/state.hpp>
+#include <pointhaptics/io/result_json.hpp>
+#include <pointhaptics/io/scene_toml.hpp>
+#include <pointhaptics/mechanics/energy.hpp>
+#include <pointhaptics/scene_builder.hpp>
+#include <pointhaptics/simulation.hpp>

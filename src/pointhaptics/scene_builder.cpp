@@ -1,0 +1,82 @@
+#include <pointhaptics/scene_builder.hpp>
+
+#include <pointhaptics/core/error.hpp>
+#include <pointhaptics/geometry/sampling.hpp>
+#include <pointhaptics/io/point_cloud_file.hpp>
+#include <pointhaptics/mechanics/model_builder.hpp>
+
+#include <fmt/format.h>
+
+namespace pointhaptics {
+
+PointCloud sample_object(const Scene& scene) {
+  const ObjectSpec& o = scene.object;
+  switch (o.shape) {
+    case ShapeKind::BOX: return sample_box(o.origin, o.size, o.spacing);
+    case ShapeKind::SPHERE: return sample_sphere(o.origin, o.radius, o.spacing);
+    case ShapeKind::HALF_SPHERE: return sample_half_sphere(o.origin, o.radius, o.spacing);
+    case ShapeKind::FILE: return read_point_cloud(o.file, o.spacing);
+  }
+  throw Error("object: unknown shape");
+}
+
+namespace {
+
+std::vector<index_t> points_in(const Model& model, const Aabb& box) {
+  // a relative tolerance so that a box drawn on a face catches the points on it
+  const double tol = 1e-9 * std::max(model.h, 1e-12);
+  Aabb grown{box.min.array() - tol, box.max.array() + tol};
+  std::vector<index_t> inside;
+  for (index_t i = 0; i < model.n_points; ++i)
+    if (grown.contains(model.X.col(i))) inside.push_back(i);
+  return inside;
+}
+
+}  // namespace
+
+Model build_scene_model(const Scene& scene) {
+  const PointCloud cloud = sample_object(scene);
+  Model model = build_model(cloud, scene.material, scene.kernel);
+
+  // held points, one group per [[fixed]] table
+  for (size_t k = 0; k < scene.fixed.size(); ++k) {
+    const FixedSpec& spec = scene.fixed[k];
+    FixedGroup group;
+    group.name = fmt::format("fixed[{}]", k);
+    group.displacement = spec.displacement;
+    group.ramp = spec.ramp;
+    group.points = points_in(model, spec.box);
+    if (group.points.empty())
+      throw Error(fmt::format("{}:{}: fixed[{}].box: holds no point of the object", scene.path, spec.line, k));
+    for (index_t i : group.points) model.fixed[i] = 1;
+    model.fixed_groups.push_back(std::move(group));
+  }
+
+  // constant external loads
+  for (size_t k = 0; k < scene.loads.size(); ++k) {
+    const LoadSpec& load = scene.loads[k];
+    switch (load.kind) {
+      case LoadKind::GRAVITY:
+        for (index_t i = 0; i < model.n_points; ++i) model.f_ext.col(i) += model.mass[i] * load.g;
+        break;
+      case LoadKind::TRACTION: {
+        const std::vector<index_t> loaded = points_in(model, load.box);
+        if (loaded.empty())
+          throw Error(fmt::format("{}:{}: load[{}].box: holds no point of the object", scene.path, load.line, k));
+        double total_volume = 0;
+        for (index_t i : loaded) total_volume += model.volume[i];
+        for (index_t i : loaded) model.f_ext.col(i) += load.total * (model.volume[i] / total_volume);
+        break;
+      }
+      case LoadKind::POINT:
+        if (load.point >= model.n_points)
+          throw Error(fmt::format("{}:{}: load[{}].point: {} is out of range (the object has {} points)", scene.path,
+                                  load.line, k, load.point, model.n_points));
+        model.f_ext.col(static_cast<index_t>(load.point)) += load.force;
+        break;
+    }
+  }
+  return model;
+}
+
+}  // namespace pointhaptics

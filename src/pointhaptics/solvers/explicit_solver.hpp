@@ -1,0 +1,27 @@
+#pragma once
+/// @file Explicit dynamics: symplectic Euler with automatic sub-steps below the stable step.
+#include <pointhaptics/core/state.hpp>
+#include <pointhaptics/core/workspace.hpp>
+
+namespace pointhaptics {
+
+/// Largest stable explicit step, s: safety * a / c_p with a the smallest distance between two points
+/// and c_p the p-wave speed sqrt((lambda + 2 mu + k_v + alpha E) / rho) of the densest point
+/// (physics.md measures stability up to ~0.97 a / c_p at h = 2 spacing; 0.7 leaves room for
+/// other kernels, supports and large strain).
+double stable_time_step(const Model& model, double safety = 0.7);
+
+/// Prescribed displacement of a fixed group at time t (ramped in linearly over group.ramp).
+Vec3 prescribed_displacement(const FixedGroup& group, double t);
+
+struct ExplicitStepStats {
+  int substeps = 0;  ///< sub-steps taken for this step
+};
+
+/// Advance the state by dt with ceil(dt / stable step) equal symplectic Euler sub-steps:
+///   v <- (v + h M^-1 (f_int + f_ext)) / (1 + h c),   u <- u + h v   (c: mass-proportional damping)
+/// Held points follow their prescribed displacement. Throws Error naming the step and point if a
+/// displacement becomes non-finite or grows beyond 100 times the object's size (divergence).
+ExplicitStepStats explicit_step(const Model& model, State& state, Workspace& ws, double dt, double stable_dt);
+
+}  // namespace pointhaptics
