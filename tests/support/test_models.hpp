@@ -1,0 +1,37 @@
+#pragma once
+// Small models and random fields shared by the tests.
+#include <pointhaptics/geometry/sampling.hpp>
+#include <pointhaptics/mechanics/model_builder.hpp>
+
+#include <random>
+
+namespace pointhaptics::test {
+
+/// A box grid of nx x ny x nz points at `spacing`, optionally jittered by `jitter` x spacing
+/// (uniform per coordinate), with volumes from the unjittered grid.
+inline PointCloud jittered_box(int nx, int ny, int nz, double spacing, double jitter, unsigned seed = 1) {
+  PointCloud cloud = sample_box(Vec3::Zero(), spacing * Vec3(nx - 1, ny - 1, nz - 1), spacing);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> uni(-jitter * spacing, jitter * spacing);
+  for (Eigen::Index k = 0; k < cloud.X.size(); ++k) cloud.X.data()[k] += uni(rng);
+  return cloud;
+}
+
+/// Gaussian random field with standard deviation `scale` per component.
+inline Points random_field(index_t n, double scale, unsigned seed = 2) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, scale);
+  Points u(3, n);
+  for (Eigen::Index k = 0; k < u.size(); ++k) u.data()[k] = noise(rng);
+  return u;
+}
+
+/// A random rotation matrix.
+inline Mat3 random_rotation(unsigned seed = 3) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise;
+  Eigen::Quaterniond q(noise(rng), noise(rng), noise(rng), noise(rng));
+  return q.normalized().toRotationMatrix();
+}
+
+}  // namespace pointhaptics::test
