@@ -1,0 +1,170 @@
+// Tests for io/scene_toml: the schema of design.md and one-line errors naming file, line and key.
+#include <pointhaptics/core/error.hpp>
+#include <pointhaptics/io/scene_toml.hpp>
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+namespace pointhaptics {
+namespace {
+
+const char* full_scene = R"(
+[object]
+shape   = "box"
+size    = [0.15, 0.03, 0.03]
+origin  = [0.0, 0.0, 0.0]
+spacing = 0.0075
+[material]
+young = 1e5
+poisson = 0.4
+density = 1000.0
+volume_stiffness = 0.0
+damping = 2
+hourglass = 0.05
+volume = "kernel"
+[kernel]
+type = "quadratic"
+support_factor = 2.5
+[[fixed]]
+box = { min = [-1.0, -1.0, -1.0], max = [0.0, 1.0, 1.0] }
+[[fixed]]
+box = { min = [0.15, -1.0, -1.0], max = [1.0, 1.0, 1.0] }
+displacement = [0.0, -0.005, 0.0]
+ramp = 0.5
+[[load]]
+kind  = "traction"
+box   = { min = [0.15, -1.0, -1.0], max = [1.0, 1.0, 1.0] }
+total = [0.0, -0.01, 0.0]
+[[load]]
+kind = "gravity"
+g = [0, -9.81, 0]
+[[load]]
+kind = "point"
+point = 111
+force = [1, 2, 3]
+[solver]
+kind = "explicit"
+dt = 2e-3
+duration = 0.5
+)";
+
+TEST(SceneToml, ReadsEveryKeyOfTheSchema) {
+  const Scene s = parse_scene(full_scene, "full.toml");
+  EXPECT_EQ(s.object.shape, ShapeKind::BOX);
+  EXPECT_DOUBLE_EQ(s.object.size.x(), 0.15);
+  EXPECT_DOUBLE_EQ(s.object.spacing, 0.0075);
+  EXPECT_DOUBLE_EQ(s.material.damping, 2.0);  // an integer where a float is expected is fine
+  EXPECT_EQ(s.material.volume, VolumeMode::KERNEL);
+  EXPECT_EQ(s.kernel.type, KernelType::QUADRATIC);
+  EXPECT_DOUBLE_EQ(s.kernel.support_factor, 2.5);
+  ASSERT_EQ(s.fixed.size(), 2u);
+  EXPECT_DOUBLE_EQ(s.fixed[1].displacement.y(), -0.005);
+  EXPECT_DOUBLE_EQ(s.fixed[1].ramp, 0.5);
+  ASSERT_EQ(s.loads.size(), 3u);
+  EXPECT_EQ(s.loads[0].kind, LoadKind::TRACTION);
+  EXPECT_DOUBLE_EQ(s.loads[0].total.y(), -0.01);
+  EXPECT_EQ(s.loads[1].kind, LoadKind::GRAVITY);
+  EXPECT_EQ(s.loads[2].kind, LoadKind::POINT);
+  EXPECT_EQ(s.loads[2].point, 111);
+  EXPECT_EQ(s.solver.kind, SolverKind::EXPLICIT);
+  EXPECT_DOUBLE_EQ(s.solver.dt, 2e-3);
+  EXPECT_DOUBLE_EQ(s.solver.duration, 0.5);
+}
+
+// the error message of parsing `text` with one line replaced
+std::string error_of(const std::string& find, const std::string& replace) {
+  std::string text = full_scene;
+  const size_t at = text.find(find);
+  EXPECT_NE(at, std::string::npos) << find;
+  text.replace(at, find.size(), replace);
+  try {
+    parse_scene(text, "bad.toml");
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.find('\n'), std::string::npos) << "one line: " << what;
+    return what;
+  }
+  ADD_FAILURE() << "accepted: " << replace;
+  return {};
+}
+
+int line_of(const std::string& needle) {
+  std::string text = full_scene;
+  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(text.find(needle)), '\n'));
+}
+
+TEST(SceneToml, UnknownKeyNamesFileLineAndKey) {
+  const std::string e = error_of("damping = 2", "dampnig = 2");
+  EXPECT_EQ(e, "bad.toml:" + std::to_string(line_of("damping = 2")) + ": material.dampnig: unknown key");
+}
+
+TEST(SceneToml, UnknownSectionAndNestedKeys) {
+  EXPECT_NE(error_of("[solver]", "[solvr]").find("solvr: unknown key"), std::string::npos);
+  EXPECT_NE(error_of("max = [0.0, 1.0, 1.0] }", "max = [0.0, 1.0, 1.0], mid = 1 }").find("fixed[0].box.mid: unknown key"),
+            std::string::npos);
+  EXPECT_NE(error_of("g = [0, -9.81, 0]", "gg = [0, -9.81, 0]").find("load[1].gg: unknown key"), std::string::npos);
+}
+
+TEST(SceneToml, WrongTypesAreNamed) {
+  EXPECT_NE(error_of("young = 1e5", "young = \"stiff\"").find("material.young: expected a number, got a string"),
+            std::string::npos);
+  EXPECT_NE(error_of("size    = [0.15, 0.03, 0.03]", "size = [0.15, 0.03]").find("object.size: expected an array of 3"),
+            std::string::npos);
+  EXPECT_NE(error_of("point = 111", "point = 1.5").find("load[2].point: expected an integer"), std::string::npos);
+  EXPECT_NE(error_of("type = \"quadratic\"", "type = 3").find("kernel.type: expected a string"), std::string::npos);
+}
+
+TEST(SceneToml, OutOfRangeValuesAreNamed) {
+  const std::string poisson = error_of("poisson = 0.4", "poisson = 0.5");
+  EXPECT_EQ(poisson, "bad.toml:" + std::to_string(line_of("poisson = 0.4")) +
+                         ": material.poisson: 0.5 is out of range: must lie in (-1, 0.5)");
+  EXPECT_NE(error_of("young = 1e5", "young = -5e4").find("material.young: -50000 is out of range"), std::string::npos);
+  EXPECT_NE(error_of("density = 1000.0", "density = nan").find("material.density: nan is not a finite number"),
+            std::string::npos);
+  EXPECT_NE(error_of("spacing = 0.0075", "spacing = 0").find("object.spacing"), std::string::npos);
+  EXPECT_NE(error_of("dt = 2e-3", "dt = -1").find("solver.dt"), std::string::npos);
+  EXPECT_NE(error_of("point = 111", "point = -3").find("load[2].point"), std::string::npos);
+  EXPECT_NE(error_of("max = [0.0, 1.0, 1.0] }", "max = [-2.0, 1.0, 1.0] }").find("fixed[0].box"), std::string::npos);
+}
+
+TEST(SceneToml, UnknownChoicesListTheAllowedOnes) {
+  EXPECT_NE(error_of("type = \"quadratic\"", "type = \"gauss\"").find("unknown value \"gauss\" (expected poly6 | spiky | viscosity | quadratic)"),
+            std::string::npos);
+  EXPECT_NE(error_of("shape   = \"box\"", "shape = \"cube\"").find("object.shape"), std::string::npos);
+  EXPECT_NE(error_of("kind = \"explicit\"", "kind = \"rk4\"").find("solver.kind"), std::string::npos);
+}
+
+TEST(SceneToml, MissingRequiredKeys) {
+  EXPECT_NE(error_of("total = [0.0, -0.01, 0.0]", "").find("load[0].total"), std::string::npos);
+  EXPECT_NE(error_of("size    = [0.15, 0.03, 0.03]", "").find("object.size"), std::string::npos);
+  EXPECT_THROW(parse_scene("[material]\nyoung = 1e5\n"), Error);  // no [object]
+}
+
+TEST(SceneToml, SyntaxErrorNamesTheLine) {
+  const std::string e = error_of("density = 1000.0", "density = = 1000.0");
+  EXPECT_NE(e.find("bad.toml:" + std::to_string(line_of("density = 1000.0")) + ": TOML syntax error"), std::string::npos) << e;
+}
+
+TEST(SceneToml, SectionsOfLaterVersionsAreRefusedClearly) {
+  EXPECT_NE(error_of("[solver]", "[lod]\nk1 = 1.0\n[solver]").find("lod"), std::string::npos);
+}
+
+TEST(SceneToml, FilesAreReadAndRelativePathsResolved) {
+  const auto dir = std::filesystem::temp_directory_path() / "ph_scene_test";
+  std::filesystem::create_directories(dir);
+  const auto path = dir / "cloud_scene.toml";
+  std::ofstream(path) << "[object]\nshape = \"file\"\nfile = \"cloud.xyz\"\nspacing = 0.01\n";
+  const Scene s = read_scene_file(path.string());
+  EXPECT_EQ(s.object.file, (dir / "cloud.xyz").string());
+  try {
+    read_scene_file((dir / "missing.toml").string());
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("missing.toml"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace pointhaptics
