@@ -38,6 +38,8 @@ struct Model {
   Eigen::VectorXd hg_coef;          ///< c_ij = alpha E v_i w^_ij / |X_ij|^2 of the hourglass energy, N/m  (n_pairs)
   // per-point data
   Points d_self;                    ///< d_ii = -sum_j d_ij, 1/m  (3 x n)
+  Eigen::Matrix<double, 9, Eigen::Dynamic> hg_H;  ///< H_i = sum_j c_ij X_ij X_ij^T, column-major 3x3, N m  (9 x n)
+  Points hg_t;                      ///< t_i = sum_j c_ij X_ij, N  (3 x n)
 
   // boundary conditions and constant external loads
   std::vector<unsigned char> fixed; ///< 1 where the point is held  (n)

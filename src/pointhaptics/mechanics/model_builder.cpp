@@ -107,6 +107,8 @@ Model build_model(const PointCloud& cloud, const MaterialParams& material, const
   model.d.resize(3, n_pairs);
   model.d_self.resize(3, n);
   model.hg_coef.resize(n_pairs);
+  model.hg_H.resize(9, n);
+  model.hg_t.resize(3, n);
   std::vector<double> condition(n, 0.0);
   std::vector<unsigned char> regularised(n, 0);
   const double hg_scale = material.hourglass * material.young;
@@ -135,7 +137,8 @@ Model build_model(const PointCloud& cloud, const MaterialParams& material, const
       regularised[i] = 1;  // isolated: G_i = 0, the point feels no elastic force
       condition[i] = std::numeric_limits<double>::infinity();
     }
-    Vec3 d_sum = Vec3::Zero();
+    Vec3 d_sum = Vec3::Zero(), t = Vec3::Zero();
+    Mat3 H = Mat3::Zero();
     for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
       const Vec3 xij = model.X.col(nbr.index[e]) - model.X.col(i);
       const Vec3 dij = M_inv * xij * w[e];
@@ -143,8 +146,13 @@ Model build_model(const PointCloud& cloud, const MaterialParams& material, const
       d_sum += dij;
       // hourglass energy (physics.md): (alpha E / 2) v_i w^_ij |u_j - u_i - G_i X_ij|^2 / |X_ij|^2
       model.hg_coef[e] = w_sum > 0 ? hg_scale * model.volume[i] * (w[e] / w_sum) / xij.squaredNorm() : 0.0;
+      const Vec3 g = model.hg_coef[e] * xij;
+      t += g;
+      H.noalias() += g * xij.transpose();
     }
     model.d_self.col(i) = -d_sum;
+    model.hg_t.col(i) = t;
+    model.hg_H.col(i) = H.reshaped();
   });
 
   // diagnostics
