@@ -1,11 +1,13 @@
-# warnings and code-generation flags shared by every target, as one interface target;
-# they apply when building this project only, never to consumers of the installed package
+# warnings and code-generation flags shared by every target, as one interface target; only
+# -march=native (PH_NATIVE) reaches consumers of the installed package
 add_library(pointhaptics_build_flags INTERFACE)
 add_library(pointhaptics::build_flags ALIAS pointhaptics_build_flags)
 target_compile_options(pointhaptics_build_flags INTERFACE
   $<BUILD_INTERFACE:$<$<CXX_COMPILER_ID:GNU,Clang>:-Wall -Wextra -Wpedantic>>)
 if(PH_NATIVE)
-  target_compile_options(pointhaptics_build_flags INTERFACE $<BUILD_INTERFACE:-march=native>)
+  # exported too: Eigen's allocation alignment depends on the instruction set, so code that shares
+  # Eigen objects with a -march=native build must be compiled with the same flag
+  target_compile_options(pointhaptics_build_flags INTERFACE -march=native)
 endif()
 if(PH_SANITIZE)
   target_compile_options(pointhaptics_build_flags INTERFACE
