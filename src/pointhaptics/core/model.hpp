@@ -27,6 +27,7 @@ struct Model {
   Eigen::VectorXd mass;             ///< m_i, kg  (n)
   double spacing = 0;               ///< nominal sample spacing, m
   double h = 0;                     ///< kernel support radius, m
+  double extent = 0;                ///< diagonal of the reference bounding box plus h, m (scale for divergence checks)
   KernelParams kernel;
   MaterialParams material;
   double lambda = 0, mu = 0;        ///< Lame parameters, Pa

@@ -58,6 +58,7 @@ Model build_model(const PointCloud& cloud, const MaterialParams& material, const
   model.mu = material.mu();
   model.h = support_radius(cloud, kernel);
   const double h = model.h;
+  model.extent = (model.X.rowwise().maxCoeff() - model.X.rowwise().minCoeff()).norm() + h;
 
   // neighbours in the reference configuration
   model.neighbours = radius_neighbours(model.X, h);

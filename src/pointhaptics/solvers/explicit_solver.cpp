@@ -36,8 +36,7 @@ ExplicitStepStats explicit_step(const Model& model, State& state, Workspace& ws,
   const int n_sub = std::max(1, static_cast<int>(std::ceil(dt / stable_dt * (1 - 1e-12))));
   const double h = dt / n_sub;
   const double c = model.material.damping;
-  const double size = (model.X.rowwise().maxCoeff() - model.X.rowwise().minCoeff()).norm() + model.h;
-  const double limit2 = (100 * size) * (100 * size);
+  const double limit2 = (100 * model.extent) * (100 * model.extent);
   for (int sub = 0; sub < n_sub; ++sub) {
     compute_internal_forces(model, state.u, ws);
     std::atomic<index_t> bad_point{-1};
