@@ -1,0 +1,32 @@
+#pragma once
+/// @file The tangent stiffness K = d^2 W / du^2 (Hessian of the elastic, volume and hourglass energy),
+/// applied matrix-free (physics.md, "Tangent"), and its 3x3 diagonal blocks for block-Jacobi.
+#include <pointhaptics/core/workspace.hpp>
+
+namespace pointhaptics {
+
+enum class TangentMode {
+  EXACT,      ///< the exact Hessian; indefinite under compression (the geometric term dF S)
+  PROJECTED,  ///< positive semi-definite: the geometric term uses the positive part of S and the
+              ///< volume term drops its (J - 1) d(cof F) part (a per-point Gauss-Newton)
+};
+
+/// The linearisation of the internal forces at one configuration u: K du = -(d f_int / du) du.
+/// linearise() records F_i and S_i per point; apply() then costs about one force evaluation.
+class Tangent {
+ public:
+  /// Linearise at displacement u (parallel, allocates only the first time for a model size).
+  void linearise(const Model& model, const Points& u, TangentMode mode);
+  /// out = K du, on ws's threads (uses ws.chunk_forces as scratch), no allocation.
+  void apply(const Model& model, const Points& du, Workspace& ws, Points& out) const;
+  /// The 3x3 diagonal blocks K_jj (column-major, 9 x n), for a block-Jacobi preconditioner.
+  void diagonal_blocks(const Model& model, Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks) const;
+  TangentMode mode() const { return mode_; }
+
+ private:
+  TangentMode mode_ = TangentMode::EXACT;
+  Eigen::Matrix<double, 9, Eigen::Dynamic> F_;  ///< F_i at the linearisation point (column-major 3x3)
+  Eigen::Matrix<double, 9, Eigen::Dynamic> S_;  ///< S_i, or its positive part (PROJECTED)
+};
+
+}  // namespace pointhaptics
