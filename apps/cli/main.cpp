@@ -34,8 +34,15 @@ void print_summary(const ph::Simulation& sim, const ph::RunSummary& s, double se
     fmt::print("warning         {} neighbourhoods were ill-conditioned and regularised\n", m.diagnostics.regularised_neighbourhoods);
   fmt::print("material        E = {:.4g} Pa, nu = {:.3g}, rho = {:.4g} kg/m^3, total mass {:.4g} kg\n", m.material.young,
              m.material.poisson, m.material.density, m.mass.sum());
-  fmt::print("solver          {}: {} steps of {:.3g} s, {} sub-steps (stable sub-step {:.3g} s), t = {:.4g} s\n",
-             s.solver_kind, s.steps, sim.solver().dt, s.substeps, s.stable_dt, st.time);
+  if (s.solver_kind == "static")
+    fmt::print("solver          static: {} in {} load increments, {} Newton and {} CG iterations, residual {:.3g}\n",
+               s.converged ? "converged" : "NOT converged", s.substeps, s.iterations, s.cg_iterations, s.residual);
+  else if (s.solver_kind == "implicit")
+    fmt::print("solver          implicit: {} steps of {:.3g} s, {} Newton and {} CG iterations, t = {:.4g} s\n", s.steps,
+               sim.solver().dt, s.iterations, s.cg_iterations, st.time);
+  else
+    fmt::print("solver          {}: {} steps of {:.3g} s, {} sub-steps (stable sub-step {:.3g} s), t = {:.4g} s\n",
+               s.solver_kind, s.steps, sim.solver().dt, s.substeps, s.stable_dt, st.time);
   fmt::print("displacement    max {:.4g} m at point {} ({:.4g}, {:.4g}, {:.4g})\n", max_u, worst, m.X(0, worst), m.X(1, worst),
              m.X(2, worst));
   fmt::print("energy          strain {:.4g} J, kinetic {:.4g} J, out-of-balance {:.3g}\n", s.strain_energy, s.kinetic_energy,
@@ -59,6 +66,11 @@ int run_command(const RunOptions& opt) {
   const ph::RunSummary summary = sim.summary();
   if (!opt.json.empty()) ph::write_result_json(opt.json, sim.model(), sim.state(), summary);
   if (!opt.quiet) print_summary(sim, summary, setup_s);
+  if (!summary.converged) {
+    fmt::print(stderr, "pointhaptics: {}: {}\n", opt.scene,
+               summary.failure.empty() ? "the solver did not converge" : summary.failure);
+    return 1;
+  }
   return 0;
 }
 

@@ -4,20 +4,26 @@
 #include <pointhaptics/core/workspace.hpp>
 #include <pointhaptics/io/result_json.hpp>
 #include <pointhaptics/io/scene.hpp>
+#include <pointhaptics/solvers/implicit_solver.hpp>
+#include <pointhaptics/solvers/newton.hpp>
 
 #include <functional>
+#include <memory>
 
 namespace pointhaptics {
 
 class Simulation {
  public:
   /// Take the model (never written again) and prepare the solver; n_threads = 0: all hardware threads.
-  /// Throws Error for a solver kind this version does not provide.
   Simulation(Model model, const SolverSpec& solver, int n_threads = 0);
+  ~Simulation();
+  Simulation(Simulation&&) noexcept;
 
-  /// Advance by one solver step (dt).
+  /// Advance by one solver step (dt): explicit (sub-stepped) or implicit dynamics; for a static solver,
+  /// solve for the equilibrium under the full load (once; later calls start from the last solution).
   void step();
-  /// Step until state().time reaches `duration`; progress(fraction) is called after each step.
+  /// Dynamics: step until state().time reaches `duration`; static: one solve. progress(fraction) is
+  /// called after each step.
   void run(double duration, const std::function<void(double)>& progress = {});
 
   const Model& model() const { return model_; }
@@ -31,12 +37,19 @@ class Simulation {
   RunSummary summary();
 
  private:
+  NewtonSettings newton_settings() const;
+
   Model model_;
   SolverSpec solver_;
   State state_;
   Workspace ws_;
+  std::unique_ptr<NewtonSolver> newton_;      ///< static
+  std::unique_ptr<ImplicitSolver> implicit_;  ///< implicit
   double stable_dt_ = 0;
-  long long steps_ = 0, substeps_ = 0;
+  long long steps_ = 0, substeps_ = 0, iterations_ = 0, cg_iterations_ = 0;
+  bool converged_ = true;
+  double residual_ = 0;
+  std::string failure_;
   double step_seconds_ = 0;
 };
 

@@ -80,7 +80,7 @@ TEST_P(ForcesTest, RigidMotionsGiveZeroStrainEnergyAndForce) {
   const double reference = forces(model, test::random_field(model.n_points, 0.01 * spacing, 4)).norm();
   for (const Points* u : {&translation, &rotation}) {
     for (index_t i = 0; i < model.n_points; ++i)
-      EXPECT_LT(green_strain(Mat3::Identity() + displacement_gradient(model, *u, i)).norm(), 1e-12);
+      EXPECT_LT(green_strain(displacement_gradient(model, *u, i)).norm(), 1e-12);
     EXPECT_LT(std::abs(strain_energy(model, *u).total()), 1e-16 * model.material.young * model.volume.sum());
     EXPECT_LT(forces(model, *u).norm(), 1e-9 * reference);
   }
@@ -153,7 +153,7 @@ TEST(ZeroEnergyModes, OddEvenFieldIsOnlyResistedWithThePenalty) {
     for (index_t i = 0; i < model.n_points; ++i) {
       if (model.neighbours.row_size(i) != 26) continue;
       const Mat3 G = displacement_gradient(model, u, i);
-      const Mat3 E = green_strain(Mat3::Identity() + G);
+      const Mat3 E = green_strain(G);
       elastic += model.volume[i] * 0.5 * (svk_stress(E, model.lambda, model.mu).array() * E.array()).sum();
       for (index_t k = model.neighbours.begin(i); k < model.neighbours.end(i); ++k) {
         const index_t j = model.neighbours.index[k];

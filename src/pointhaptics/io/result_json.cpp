@@ -33,7 +33,8 @@ std::string result_json(const Model& model, const State& state, const RunSummary
   doc["points"] = {{"reference", columns(model.X)}, {"displacement", columns(state.u)}, {"fixed", fixed}, {"active", active}};
   doc["solver"] = {{"kind", s.solver_kind},     {"converged", s.converged}, {"iterations", s.iterations},
                    {"residual", s.residual},    {"steps", s.steps},         {"substeps", s.substeps},
-                   {"stable_dt", s.stable_dt}};
+                   {"stable_dt", s.stable_dt}, {"cg_iterations", s.cg_iterations}};
+  if (!s.failure.empty()) doc["solver"]["failure"] = s.failure;
   doc["energy"] = {{"strain", s.strain_energy}, {"kinetic", s.kinetic_energy}};
   doc["timing"] = {{"wall_s", s.wall_s}, {"step_ms_mean", s.step_ms_mean}, {"steps_per_s", s.steps_per_s}};
   json constraints = json::array();

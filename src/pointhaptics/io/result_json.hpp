@@ -17,7 +17,9 @@ struct RunSummary {
   double strain_energy = 0, kinetic_energy = 0;  ///< J
   double wall_s = 0, step_ms_mean = 0, steps_per_s = 0;
   double stable_dt = 0;         ///< explicit: the stable sub-step, s
-  long long substeps = 0;       ///< explicit: sub-steps taken in all
+  long long substeps = 0;       ///< explicit: sub-steps taken in all; static: load increments
+  long long cg_iterations = 0;  ///< static, implicit: conjugate-gradient iterations in all
+  std::string failure;          ///< static: why it did not converge (empty when it did)
   std::vector<Vec3> reactions;  ///< per fixed group, N
 };
 

@@ -203,6 +203,16 @@ void read_solver(TableReader& r, SolverSpec& s) {
   s.kind = kind == "static" ? SolverKind::STATIC : kind == "explicit" ? SolverKind::EXPLICIT : SolverKind::IMPLICIT;
   s.dt = r.number("dt", s.dt, [](double x) { return x > 0 && x <= 1; }, "must lie in (0, 1] (s)");
   s.duration = r.number("duration", s.duration, [](double x) { return x >= 0 && x <= 1e6; }, "must lie in [0, 1e6] (s)");
+  s.tolerance = r.number("tolerance", s.tolerance, [](double x) { return x > 0 && x < 1; }, "must lie in (0, 1)");
+  auto count = [&](std::string_view key, int fallback, int lo, int hi) {
+    const auto node = r.find(key);
+    const long long v = r.integer(key, fallback);
+    if (v < lo || v > hi) r.fail_at(*node, key, fmt::format("must lie in [{}, {}]", lo, hi));
+    return static_cast<int>(v);
+  };
+  s.max_iterations = count("max_iterations", s.max_iterations, 1, 100000);
+  s.max_cg_iterations = count("max_cg_iterations", s.max_cg_iterations, 1, 10000000);
+  s.iteration_budget = count("iteration_budget", s.iteration_budget, 0, 1000);
 }
 
 FixedSpec read_fixed(TableReader& r) {

@@ -13,8 +13,10 @@ inline Mat3 displacement_gradient(const Model& model, const Points& u, index_t i
   return G;
 }
 
-/// Green strain E = 0.5 (F^T F - I) with F = I + G (seed Eq. 2).
-inline Mat3 green_strain(const Mat3& F) { return 0.5 * (F.transpose() * F - Mat3::Identity()); }
+/// Green strain E = 0.5 (F^T F - I) = 0.5 (G + G^T + G^T G) from the displacement gradient G (seed Eq. 2).
+/// Written in G: forming F^T F - I cancels catastrophically at small strain (at |G| ~ 1e-9 only 7 digits
+/// survive, which puts a floor under Newton's residual).
+inline Mat3 green_strain(const Mat3& G) { return 0.5 * (G + G.transpose() + G.transpose() * G); }
 
 /// St. Venant-Kirchhoff second Piola-Kirchhoff stress S = lambda tr(E) I + 2 mu E.
 inline Mat3 svk_stress(const Mat3& E, double lambda, double mu) {

@@ -16,7 +16,7 @@ EnergyTerms strain_energy(const Model& model, const Points& u) {
         for (index_t i = range.begin(); i != range.end(); ++i) {
           const Mat3 G = displacement_gradient(model, u, i);  // seed Eq. 10
           const Mat3 F = Mat3::Identity() + G;
-          const Mat3 E = green_strain(F);  // seed Eq. 2
+          const Mat3 E = green_strain(G);  // seed Eq. 2
           const Mat3 S = svk_stress(E, model.lambda, model.mu);
           const double v = model.volume[i];
           acc.elastic += v * 0.5 * (S.array() * E.array()).sum();

@@ -47,8 +47,9 @@ void Tangent::linearise(const Model& model, const Points& u, TangentMode mode) {
   S_.resize(9, model.n_points);
   tbb::parallel_for(tbb::blocked_range<index_t>(0, model.n_points, 256), [&](const tbb::blocked_range<index_t>& r) {
     for (index_t i = r.begin(); i != r.end(); ++i) {
-      const Mat3 F = Mat3::Identity() + displacement_gradient(model, u, i);  // seed Eq. 10
-      const Mat3 S = svk_stress(green_strain(F), model.lambda, model.mu);     // seed Eq. 2
+      const Mat3 G = displacement_gradient(model, u, i);                   // seed Eq. 10
+      const Mat3 F = Mat3::Identity() + G;
+      const Mat3 S = svk_stress(green_strain(G), model.lambda, model.mu);  // seed Eq. 2
       F_.col(i) = F.reshaped();
       S_.col(i) = (mode == TangentMode::PROJECTED ? positive_part(S) : S).reshaped();
     }

@@ -1,0 +1,26 @@
+#pragma once
+/// @file Implicit dynamics: backward Euler solved by Newton-CG, warm-started, with an optional
+/// iteration budget for real time.
+#include <pointhaptics/core/state.hpp>
+#include <pointhaptics/solvers/newton.hpp>
+
+namespace pointhaptics {
+
+/// One backward Euler step of dt with mass-proportional damping c:
+///   M (v' - v) / dt = f_int(u') + f_ext - c M v',   u' = u + dt v'.
+/// As a minimisation (so Newton can line-search): u' minimises
+///   W(u') - f_ext . u' + (1/(2 dt^2)) |u' - u - dt v|_M^2 + (c/(2 dt)) |u' - u|_M^2,
+/// whose Hessian is K + (1/dt^2 + c/dt) M. The initial guess is u + dt v (warm start). Held points
+/// follow their prescribed displacement. With settings.accept_at_budget the step keeps the iterate
+/// reached within settings.max_iterations (real time); otherwise a step that fails throws Error.
+class ImplicitSolver {
+ public:
+  explicit ImplicitSolver(const Model& model);
+  NewtonStats step(const Model& model, State& state, Workspace& ws, double dt, const NewtonSettings& settings);
+
+ private:
+  NewtonSolver newton_;
+  Points anchor_, u_next_;
+};
+
+}  // namespace pointhaptics

@@ -1,0 +1,187 @@
+#include <pointhaptics/solvers/newton.hpp>
+
+#include <pointhaptics/mechanics/energy.hpp>
+#include <pointhaptics/mechanics/forces.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+namespace pointhaptics {
+namespace {
+
+double dot(const Points& a, const Points& b) { return (a.array() * b.array()).sum(); }
+
+}  // namespace
+
+NewtonSolver::NewtonSolver(const Model& model) {
+  const index_t n = model.n_points;
+  for (Points* p : {&r_, &dx_, &trial_, &cg_r_, &cg_z_, &cg_p_, &cg_q_}) p->setZero(3, n);
+  blocks_.setZero(9, n);
+}
+
+void NewtonSolver::mask_held(const Model& model, Points& x) const {
+  for (index_t i = 0; i < model.n_points; ++i)
+    if (model.fixed[i]) x.col(i).setZero();
+}
+
+double NewtonSolver::energy(const Model& model, const NewtonProblem& problem, const Points& u) const {
+  double pi = strain_energy(model, u).total();
+  for (index_t i = 0; i < model.n_points; ++i) {
+    if (model.fixed[i]) continue;
+    pi -= problem.load->col(i).dot(u.col(i));
+    if (problem.inertia > 0) pi += 0.5 * problem.inertia * model.mass[i] * (u.col(i) - problem.anchor->col(i)).squaredNorm();
+  }
+  return pi;
+}
+
+double NewtonSolver::residual(const Model& model, const NewtonProblem& problem, const Points& u, Workspace& ws,
+                              Points& r) const {
+  compute_internal_forces(model, u, ws);
+  r = ws.f_int + *problem.load;
+  double inertial = 0;
+  if (problem.inertia > 0) {
+    for (index_t i = 0; i < model.n_points; ++i) {
+      const Vec3 f = problem.inertia * model.mass[i] * (u.col(i) - problem.anchor->col(i));
+      if (!model.fixed[i]) inertial += f.squaredNorm();
+      r.col(i) -= f;
+    }
+  }
+  mask_held(model, r);
+  const double scale = std::max({problem.load->norm(), ws.f_int.norm(), std::sqrt(inertial), 1e-300});
+  return r.norm() / scale;
+}
+
+void NewtonSolver::build_preconditioner(const Model& model, double inertia) {
+  tangent_.diagonal_blocks(model, blocks_);
+  for (index_t i = 0; i < model.n_points; ++i) {
+    Eigen::Map<Mat3> B(blocks_.col(i).data());
+    if (model.fixed[i]) {
+      B.setZero();
+      continue;
+    }
+    B.diagonal().array() += inertia * model.mass[i];
+    Mat3 sym = 0.5 * (B + B.transpose());
+    Eigen::LLT<Mat3> llt(sym);
+    if (llt.info() == Eigen::Success && std::isfinite(sym.trace())) {
+      B = llt.solve(Mat3::Identity());
+    } else {
+      // an indefinite block (exact tangent under compression): a scaled identity keeps PCG well posed
+      const double t = std::max(std::abs(sym.trace()) / 3.0, inertia * model.mass[i]);
+      B = t > 0 && std::isfinite(t) ? Mat3(Mat3::Identity() / t) : Mat3(Mat3::Identity());
+    }
+  }
+}
+
+void NewtonSolver::precondition(const Points& r, Points& z) const {
+  for (Eigen::Index i = 0; i < r.cols(); ++i) z.col(i) = Eigen::Map<const Mat3>(blocks_.col(i).data()) * r.col(i);
+}
+
+bool NewtonSolver::conjugate_gradients(const Model& model, double inertia, const Points& r, double eta,
+                                       int max_iterations, Workspace& ws, Points& x, long long& iterations) {
+  x.setZero();
+  cg_r_ = r;
+  precondition(cg_r_, cg_z_);
+  cg_p_ = cg_z_;
+  double rz = dot(cg_r_, cg_z_);
+  const double target = eta * r.norm();
+  for (int k = 0; k < max_iterations; ++k) {
+    tangent_.apply(model, cg_p_, ws, cg_q_);
+    if (inertia > 0) cg_q_ += inertia * (cg_p_.array().rowwise() * model.mass.transpose().array()).matrix();
+    mask_held(model, cg_q_);
+    const double curvature = dot(cg_p_, cg_q_);
+    ++iterations;
+    if (!(curvature > 0)) return false;  // negative curvature: the caller switches to the projected tangent
+    const double alpha = rz / curvature;
+    x += alpha * cg_p_;
+    cg_r_ -= alpha * cg_q_;
+    if (cg_r_.norm() <= target) break;
+    precondition(cg_r_, cg_z_);
+    const double rz_next = dot(cg_r_, cg_z_);
+    cg_p_ = cg_z_ + (rz_next / rz) * cg_p_;
+    rz = rz_next;
+  }
+  return true;
+}
+
+NewtonStats NewtonSolver::solve(const Model& model, const NewtonProblem& problem, Points& u, Workspace& ws,
+                                const NewtonSettings& settings) {
+  NewtonStats stats;
+  const double inertia = problem.inertia;
+  double rel = residual(model, problem, u, ws, r_);
+  double pi = energy(model, problem, u);
+  for (;;) {
+    stats.residual = rel;
+    if (!std::isfinite(rel) || !std::isfinite(pi)) {
+      stats.failure = "non-finite residual or energy";
+      return stats;
+    }
+    if (rel <= settings.tolerance) {
+      stats.converged = true;
+      return stats;
+    }
+    if (stats.iterations >= settings.max_iterations) {
+      stats.converged = settings.accept_at_budget;
+      stats.failure = "iteration limit reached";
+      return stats;
+    }
+    ++stats.iterations;
+    // inexact Newton: the linear solve is as accurate as the residual (quadratic convergence), at most
+    // 1e-2, and never much more accurate than the tolerance needs
+    const double eta = std::max(std::min(0.01, rel), 0.5 * settings.tolerance / rel);
+    bool descent = false;
+    for (TangentMode mode : {TangentMode::EXACT, TangentMode::PROJECTED}) {
+      tangent_.linearise(model, u, mode);
+      build_preconditioner(model, inertia);
+      const bool positive =
+          conjugate_gradients(model, inertia, r_, eta, settings.max_cg_iterations, ws, dx_, stats.cg_iterations);
+      if (positive && dot(dx_, r_) > 0) {
+        descent = true;
+        break;
+      }
+      ++stats.projected;
+    }
+    if (!descent) {
+      precondition(r_, dx_);  // preconditioned steepest descent, a descent direction for SPD blocks
+      if (!(dot(dx_, r_) > 0)) dx_ = r_;
+    }
+    // backtracking line search: a step is taken when it lowers Pi (Armijo) or the residual. Near
+    // convergence Pi's change is below its round-off (~1e-11 relative here, sums of cancelling
+    // terms) while the residual still falls quadratically, so both are needed.
+    const double slope = dot(dx_, r_);  // -dPi/dalpha at alpha = 0
+    double alpha = 1.0;
+    bool accepted = false;
+    for (int k = 0; k < 30 && !accepted; ++k, alpha *= 0.5) {
+      trial_ = u + alpha * dx_;
+      const double pi_trial = energy(model, problem, trial_);
+      if (!std::isfinite(pi_trial)) continue;
+      Points& r_trial = cg_r_;  // scratch: CG is done for this iteration
+      const double rel_trial = residual(model, problem, trial_, ws, r_trial);
+      const bool armijo = pi_trial <= pi - 1e-4 * alpha * slope &&
+                          std::abs(pi_trial - pi) > 1e-9 * std::max(std::abs(pi), 1e-300);
+      if (armijo || rel_trial <= (1.0 - 1e-4 * alpha) * rel) {
+        u.swap(trial_);
+        r_.swap(r_trial);
+        rel = rel_trial;
+        pi = pi_trial;
+        accepted = true;
+      }
+    }
+    if (!accepted && slope <= 1e-12 * std::abs(pi)) {
+      // the Newton step promises less than the round-off of Pi: the residual is at its floor (forces are
+      // sums of large cancelling stencil terms), so this is as converged as double precision allows
+      stats.residual = rel;
+      stats.converged = true;
+      stats.stalled = true;
+      return stats;
+    }
+    if (!accepted) {
+      stats.residual = rel;
+      stats.failure = "line search found no decrease";
+      return stats;
+    }
+  }
+}
+
+}  // namespace pointhaptics

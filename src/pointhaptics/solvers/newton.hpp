@@ -1,0 +1,62 @@
+#pragma once
+/// @file Newton's method with a line search and preconditioned conjugate gradients on the matrix-free
+/// tangent: the core of the static solver and of implicit dynamics.
+#include <pointhaptics/core/workspace.hpp>
+#include <pointhaptics/mechanics/tangent.hpp>
+
+namespace pointhaptics {
+
+struct NewtonSettings {
+  double tolerance = 1e-8;      ///< converged when |residual| <= tolerance * force scale (see NewtonStats)
+  int max_iterations = 50;      ///< Newton iterations per solve
+  int max_cg_iterations = 2000; ///< CG iterations per Newton iteration
+  /// Accept the last iterate when max_iterations is reached instead of reporting failure
+  /// (the real-time budget of implicit dynamics).
+  bool accept_at_budget = false;
+};
+
+/// The energy Pi(u) = W(u) - b . u + 0.5 k sum_free m_i |u_i - a_i|^2 minimised over the free points
+/// (held points keep the values they have in u). Static: k = 0; backward Euler: k = 1/dt^2 + c/dt.
+struct NewtonProblem {
+  const Points* load = nullptr;    ///< b, N  (3 x n)
+  double inertia = 0;              ///< k, 1/s^2
+  const Points* anchor = nullptr;  ///< a, m  (3 x n); needed when inertia > 0
+};
+
+struct NewtonStats {
+  bool converged = false;
+  int iterations = 0;            ///< Newton iterations
+  long long cg_iterations = 0;   ///< CG iterations, summed
+  int projected = 0;             ///< iterations that fell back to the positive semi-definite tangent
+  double residual = 0;           ///< |r|_free / max(|b|, |f_int|, |k M (u - a)|) at the end
+  bool stalled = false;          ///< converged at the round-off floor above the tolerance
+  const char* failure = "";      ///< why it stopped without converging
+};
+
+/// Owns the solver's buffers (sized once per model) and the tangent.
+class NewtonSolver {
+ public:
+  explicit NewtonSolver(const Model& model);
+  /// Minimise the problem's energy from the initial guess u (updated in place). Never throws for a
+  /// hard problem: it reports failure in the stats and leaves u at the last accepted iterate.
+  NewtonStats solve(const Model& model, const NewtonProblem& problem, Points& u, Workspace& ws,
+                    const NewtonSettings& settings);
+
+ private:
+  double energy(const Model& model, const NewtonProblem& problem, const Points& u) const;
+  /// r = -grad Pi at u, zero at held points; returns the relative residual
+  double residual(const Model& model, const NewtonProblem& problem, const Points& u, Workspace& ws, Points& r) const;
+  void build_preconditioner(const Model& model, double inertia);
+  /// PCG on (K + k M) x = r over the free points to relative tolerance eta; returns false when it meets
+  /// a direction of non-positive curvature (an indefinite tangent).
+  bool conjugate_gradients(const Model& model, double inertia, const Points& r, double eta, int max_iterations,
+                           Workspace& ws, Points& x, long long& iterations);
+  void precondition(const Points& r, Points& z) const;
+  void mask_held(const Model& model, Points& x) const;
+
+  Tangent tangent_;
+  Eigen::Matrix<double, 9, Eigen::Dynamic> blocks_;  ///< inverted diagonal blocks of K + k M
+  Points r_, dx_, trial_, cg_r_, cg_z_, cg_p_, cg_q_;
+};
+
+}  // namespace pointhaptics

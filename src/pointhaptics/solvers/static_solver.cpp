@@ -1,0 +1,49 @@
+#include <pointhaptics/solvers/static_solver.hpp>
+
+#include <fmt/format.h>
+
+#include <algorithm>
+
+namespace pointhaptics {
+
+StaticStats solve_static(const Model& model, State& state, Workspace& ws, NewtonSolver& newton,
+                         const NewtonSettings& settings) {
+  StaticStats stats;
+  Points load(3, model.n_points), trial(3, model.n_points);
+  double reached = 0.0, increment = 1.0;
+  const double min_increment = 1e-4;
+  NewtonProblem problem;
+  problem.load = &load;
+  while (reached < 1.0) {
+    const double factor = std::min(1.0, reached + increment);
+    load = factor * model.f_ext;
+    // predictor: the last equilibrium, scaled to the new load factor (exact for a linear response)
+    trial = reached > 0 ? Points(state.u * (factor / reached)) : state.u;
+    for (const FixedGroup& group : model.fixed_groups)
+      for (index_t i : group.points) trial.col(i) = factor * group.displacement;
+    const NewtonStats ns = newton.solve(model, problem, trial, ws, settings);
+    stats.iterations += ns.iterations;
+    stats.cg_iterations += ns.cg_iterations;
+    stats.projected += ns.projected;
+    stats.residual = ns.residual;
+    if (ns.converged) {
+      state.u = trial;
+      reached = factor;
+      ++stats.load_steps;
+      increment = std::min(2.0 * increment, 1.0);
+      continue;
+    }
+    ++stats.cutbacks;
+    increment *= 0.5;
+    if (increment < min_increment) {
+      stats.failure = fmt::format("static solver: no equilibrium beyond {:.4g} of the load ({}; residual {:.3g})",
+                                  reached, ns.failure, ns.residual);
+      break;
+    }
+  }
+  stats.converged = reached >= 1.0;
+  state.velocity.setZero();
+  return stats;
+}
+
+}  // namespace pointhaptics

@@ -1,0 +1,28 @@
+#pragma once
+/// @file Static equilibrium: Newton with line search on the total potential energy, with automatic
+/// load stepping when a full step fails.
+#include <pointhaptics/core/state.hpp>
+#include <pointhaptics/solvers/newton.hpp>
+
+namespace pointhaptics {
+
+struct StaticStats {
+  bool converged = false;
+  int iterations = 0;            ///< Newton iterations over all load steps
+  long long cg_iterations = 0;
+  int projected = 0;             ///< Newton iterations that used the positive semi-definite tangent
+  int load_steps = 0;            ///< converged load increments
+  int cutbacks = 0;              ///< failed increments that were retried with a smaller one
+  double residual = 0;           ///< relative residual at the end
+  std::string failure;           ///< why it did not converge
+};
+
+/// Solve f_int(u) + f_ext = 0 on the free points, with held points at their prescribed displacement.
+/// Starts from state.u (e.g. the rest state) and takes the whole load at once; when Newton fails it
+/// halves the load increment (down to 1e-4 of the load) and grows it again after successes. The load
+/// factor scales f_ext and the prescribed displacements together. state.u holds the last converged
+/// equilibrium (the full load when converged); velocity is set to zero.
+StaticStats solve_static(const Model& model, State& state, Workspace& ws, NewtonSolver& newton,
+                         const NewtonSettings& settings);
+
+}  // namespace pointhaptics
