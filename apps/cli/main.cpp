@@ -1,4 +1,5 @@
 // pointhaptics: the command line. `pointhaptics <command> [scene.toml] [options]`, --help on every command.
+#include "experiment_cantilever.hpp"
 #include "progress_bar.hpp"
 
 #include <pointhaptics/pointhaptics.hpp>
@@ -96,10 +97,22 @@ int main(int argc, char** argv) {
   bench_cmd->add_option("--sizes", bench.sizes, "Approximate point counts")->check(CLI::PositiveNumber);
   bench_cmd->add_option("--threads", bench.threads, "Thread counts")->check(CLI::PositiveNumber);
 
+  ph::experiments::CantileverOptions cantilever;
+  CLI::App* experiment_cmd = app.add_subcommand("experiment", "Reproduce a seed experiment: CSV, markdown summary, PNG plots");
+  experiment_cmd->require_subcommand(1);
+  CLI::App* cantilever_cmd = experiment_cmd->add_subcommand(
+      "cantilever", "Seed Fig. 3-4: the cantilever against CalculiX (ccx) and Timoshenko beam theory");
+  cantilever_cmd->add_option("--out", cantilever.out, "Output folder")->required();
+  cantilever_cmd->add_flag("--quick", cantilever.quick, "Two spacings, two loads and coarse FEM meshes (seconds)");
+  cantilever_cmd->add_option("--threads", cantilever.threads, "Threads for the point model and ccx (0: all)")
+      ->check(CLI::NonNegativeNumber);
+  cantilever_cmd->add_option("--plot-script", cantilever.plot_script, "plot_cantilever.py to use");
+
   CLI11_PARSE(app, argc, argv);
   try {
     if (*run_cmd) return run_command(run);
     if (*bench_cmd) return ph::bench::run_bench_suite(bench);
+    if (*cantilever_cmd) return ph::experiments::run_cantilever_experiment(cantilever);
   } catch (const ph::Error& e) {
     std::fprintf(stderr, "pointhaptics: error: %s\n", e.what());
     return 1;
