@@ -12,7 +12,7 @@ namespace {
 /// v dP for a gradient increment dG at (F, S) (physics.md, "Tangent"):
 ///   dP = dG S + F (lambda tr(dE) I + 2 mu dE) + k_v [(cof F : dG) cof F + (J - 1) d(cof F)],
 ///   dE = sym(F^T dG). PROJECTED passes S's positive part and drops the (J - 1) term.
-inline Mat3 stress_increment(const Mat3& F, const Mat3& S, const Mat3& dG, double v, double lambda, double mu,
+PH_ALWAYS_INLINE inline Mat3 stress_increment(const Mat3& F, const Mat3& S, const Mat3& dG, double v, double lambda, double mu,
                              double kv, bool exact) {
   const Mat3 FtdG = F.transpose() * dG;
   const Mat3 dE = 0.5 * (FtdG + FtdG.transpose());

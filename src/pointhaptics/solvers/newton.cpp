@@ -110,11 +110,16 @@ NewtonStats NewtonSolver::solve(const Model& model, const NewtonProblem& problem
   NewtonStats stats;
   const double inertia = problem.inertia;
   double rel = residual(model, problem, u, ws, r_);
-  double pi = energy(model, problem, u);
+  // Pi at the current iterate, evaluated only when a line search needs it (NaN: not yet)
+  double pi = NAN;
+  auto current_pi = [&] {
+    if (std::isnan(pi)) pi = energy(model, problem, u);
+    return pi;
+  };
   for (;;) {
     stats.residual = rel;
-    if (!std::isfinite(rel) || !std::isfinite(pi)) {
-      stats.failure = "non-finite residual or energy";
+    if (!std::isfinite(rel)) {
+      stats.failure = "non-finite residual";
       return stats;
     }
     if (rel <= settings.tolerance) {
@@ -133,7 +138,10 @@ NewtonStats NewtonSolver::solve(const Model& model, const NewtonProblem& problem
     bool descent = false;
     for (TangentMode mode : {TangentMode::EXACT, TangentMode::PROJECTED}) {
       tangent_.linearise(model, u, mode);
-      build_preconditioner(model, inertia);
+      // the block-Jacobi preconditioner is rebuilt at the first iteration of a solve and when the tangent's
+      // mode changes; in between it lags (it changes slowly and costs about two tangent products)
+      if (stats.iterations == 1 || mode != preconditioner_mode_) build_preconditioner(model, inertia);
+      preconditioner_mode_ = mode;
       const bool positive =
           conjugate_gradients(model, inertia, r_, eta, settings.max_cg_iterations, ws, dx_, stats.cg_iterations);
       if (positive && dot(dx_, r_) > 0) {
@@ -154,21 +162,24 @@ NewtonStats NewtonSolver::solve(const Model& model, const NewtonProblem& problem
     bool accepted = false;
     for (int k = 0; k < 30 && !accepted; ++k, alpha *= 0.5) {
       trial_ = u + alpha * dx_;
-      const double pi_trial = energy(model, problem, trial_);
-      if (!std::isfinite(pi_trial)) continue;
       Points& r_trial = cg_r_;  // scratch: CG is done for this iteration
       const double rel_trial = residual(model, problem, trial_, ws, r_trial);
-      const bool armijo = pi_trial <= pi - 1e-4 * alpha * slope &&
-                          std::abs(pi_trial - pi) > 1e-9 * std::max(std::abs(pi), 1e-300);
-      if (armijo || rel_trial <= (1.0 - 1e-4 * alpha) * rel) {
+      if (!std::isfinite(rel_trial)) continue;
+      // the residual test first: it costs nothing more, and Pi is only needed when it fails
+      const bool lowers_residual = rel_trial <= (1.0 - 1e-4 * alpha) * rel;
+      const double pi_trial = lowers_residual ? NAN : energy(model, problem, trial_);
+      const double pi_now = lowers_residual ? NAN : current_pi();
+      const bool armijo = !lowers_residual && std::isfinite(pi_trial) && pi_trial <= pi_now - 1e-4 * alpha * slope &&
+                          std::abs(pi_trial - pi_now) > 1e-9 * std::max(std::abs(pi_now), 1e-300);
+      if (armijo || lowers_residual) {
         u.swap(trial_);
         r_.swap(r_trial);
         rel = rel_trial;
-        pi = pi_trial;
+        pi = pi_trial;  // NaN when not computed: current_pi() evaluates it if it is ever needed
         accepted = true;
       }
     }
-    if (!accepted && slope <= 1e-12 * std::abs(pi)) {
+    if (!accepted && slope <= 1e-12 * std::abs(current_pi())) {
       // the Newton step promises less than the round-off of Pi: the residual is at its floor (forces are
       // sums of large cancelling stencil terms), so this is as converged as double precision allows
       stats.residual = rel;

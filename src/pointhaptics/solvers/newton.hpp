@@ -55,6 +55,7 @@ class NewtonSolver {
   void mask_held(const Model& model, Points& x) const;
 
   Tangent tangent_;
+  TangentMode preconditioner_mode_ = TangentMode::EXACT;
   Eigen::Matrix<double, 9, Eigen::Dynamic> blocks_;  ///< inverted diagonal blocks of K + k M
   Points r_, dx_, trial_, cg_r_, cg_z_, cg_p_, cg_q_;
 };
