@@ -4,6 +4,8 @@
 #include <pointhaptics/geometry/sampling.hpp>
 #include <pointhaptics/mechanics/forces.hpp>
 #include <pointhaptics/mechanics/model_builder.hpp>
+#include <pointhaptics/scene_builder.hpp>
+#include <pointhaptics/simulation.hpp>
 #include <pointhaptics/solvers/explicit_solver.hpp>
 
 #include <benchmark/benchmark.h>
@@ -77,14 +79,64 @@ void step_benchmark(benchmark::State& state) {
   set_counters(state, model, threads);
 }
 
+// scenes/beam-4x1x1.toml: a 4 x 1 x 1 m beam, E = 5e6 Pa, nu = 0.33, clamped at x = 0, sagging under
+// gravity, spacing 1/13 m (10388 points), damping 10 1/s
+Scene beam_4x1x1(SolverKind kind) {
+  Scene s;
+  s.path = "beam-4x1x1";
+  s.object.size = Vec3(4, 1, 1);
+  s.object.spacing = 1.0 / 13.0;
+  s.material.young = 5e6;
+  s.material.poisson = 0.33;
+  s.material.density = 1000;
+  s.material.damping = 10;
+  FixedSpec clamp;
+  clamp.box = {Vec3(-1, -1, -1), Vec3(0, 2, 2)};
+  s.fixed.push_back(clamp);
+  LoadSpec gravity;
+  gravity.kind = LoadKind::GRAVITY;
+  gravity.g = Vec3(0, -9.81, 0);
+  s.loads.push_back(gravity);
+  s.solver.kind = kind;
+  s.solver.dt = 2e-3;
+  return s;
+}
+
+// compute seconds per simulated second: each iteration simulates 0.05 s from rest (the first, hardest
+// part of the sag) with the scene's solver; range(0): 0 explicit, 1 implicit; range(1): threads
+void beam_benchmark(benchmark::State& state) {
+  const Scene scene = beam_4x1x1(state.range(0) == 0 ? SolverKind::EXPLICIT : SolverKind::IMPLICIT);
+  const int threads = static_cast<int>(state.range(1));
+  const Model model = build_scene_model(scene);
+  const double simulated = 0.05;
+  for (auto _ : state) {
+    state.PauseTiming();
+    Simulation sim(model, scene.solver, threads);
+    state.ResumeTiming();
+    sim.run(simulated);
+    benchmark::DoNotOptimize(sim.state().u.data());
+  }
+  state.counters["points"] = model.n_points;
+  state.counters["threads"] = threads;
+  state.counters["compute_s_per_simulated_s"] =
+      benchmark::Counter(static_cast<double>(state.iterations()) * simulated, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
 // collects each run's counters for the JSON while the console reporter prints the table
 class CollectingReporter : public benchmark::ConsoleReporter {
  public:
-  nlohmann::json force = nlohmann::json::array(), step = nlohmann::json::array();
+  nlohmann::json force = nlohmann::json::array(), step = nlohmann::json::array(), beam = nlohmann::json::array();
   void ReportRuns(const std::vector<Run>& runs) override {
     ConsoleReporter::ReportRuns(runs);
     for (const Run& run : runs) {
       if (run.error_occurred) continue;
+      if (run.benchmark_name().rfind("beam4x1x1", 0) == 0) {
+        beam.push_back({{"solver", run.benchmark_name().find("implicit") != std::string::npos ? "implicit" : "explicit"},
+                        {"threads", static_cast<int>(run.counters.at("threads").value)},
+                        {"points", static_cast<long long>(run.counters.at("points").value)},
+                        {"compute_s_per_simulated_s", static_cast<double>(run.counters.at("compute_s_per_simulated_s").value)}});
+        continue;
+      }
       nlohmann::json row;
       for (const char* key : {"points", "threads", "neighbours_per_point", "ns_per_pair", "point_steps_per_s"}) {
         auto it = run.counters.find(key);
@@ -107,6 +159,11 @@ int run_bench_suite(const BenchOptions& options) {
       benchmark::RegisterBenchmark(fmt::format("step/points:{}/threads:{}", n, t).c_str(), step_benchmark)
           ->Args({n, t})->Unit(benchmark::kMicrosecond)->MinTime(options.min_time)->UseRealTime();
     }
+  for (int t : options.threads)
+    for (int solver : {0, 1})
+      benchmark::RegisterBenchmark(fmt::format("beam4x1x1/{}/threads:{}", solver ? "implicit" : "explicit", t).c_str(),
+                                   beam_benchmark)
+          ->Args({solver, t})->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
   std::string filter_flag = "--benchmark_filter=" + options.filter;
   std::string name = "pointhaptics-bench";
   char* argv[] = {name.data(), filter_flag.data(), nullptr};
@@ -121,7 +178,7 @@ int run_bench_suite(const BenchOptions& options) {
       fmt::print(stderr, "pointhaptics bench: cannot write {}\n", options.json_path);
       return 1;
     }
-    out << nlohmann::json{{"force", reporter.force}, {"step", reporter.step}}.dump(1) << '\n';
+    out << nlohmann::json{{"force", reporter.force}, {"step", reporter.step}, {"beam_4x1x1", reporter.beam}}.dump(1) << '\n';
   }
   return 0;
 }

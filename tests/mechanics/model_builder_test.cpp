@@ -14,13 +14,13 @@ TEST(BuildModel, DefaultsFollowPhysicsNotes) {
   const MaterialParams m;
   const KernelParams k;
   EXPECT_EQ(m.volume, VolumeMode::CELL);
-  EXPECT_DOUBLE_EQ(m.hourglass, 0.05);
+  EXPECT_DOUBLE_EQ(m.hourglass, 0.3);
   EXPECT_DOUBLE_EQ(k.support_factor, 2.0);
   EXPECT_EQ(k.type, KernelType::POLY6);
   // the scene parser has the same defaults
   const Scene scene = parse_scene("[object]\nshape = \"box\"\nsize = [0.1, 0.02, 0.02]\nspacing = 0.01\n");
   EXPECT_EQ(scene.material.volume, VolumeMode::CELL);
-  EXPECT_DOUBLE_EQ(scene.material.hourglass, 0.05);
+  EXPECT_DOUBLE_EQ(scene.material.hourglass, 0.3);
   EXPECT_DOUBLE_EQ(scene.kernel.support_factor, 2.0);
   const Model model = build_model(sample_box(Vec3::Zero(), Vec3(0.1, 0.02, 0.02), 0.01), scene.material, scene.kernel);
   EXPECT_DOUBLE_EQ(model.h, 0.02);

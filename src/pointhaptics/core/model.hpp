@@ -36,11 +36,10 @@ struct Model {
   Csr neighbours;
   // per-pair data, aligned with neighbours.index
   Points d;                         ///< d_ij = M_i^-1 X_ij w_ij, 1/m  (3 x n_pairs), seed Eq. 10-11
-  Eigen::VectorXd hg_coef;          ///< c_ij = alpha E v_i w^_ij / |X_ij|^2 of the hourglass energy, N/m  (n_pairs)
+  Eigen::VectorXd hg_coef;          ///< k_ij = (alpha E / 2) (v_i w^_ij + v_j w^_ji) / |X_ij|^2, symmetric, N/m  (n_pairs)
   // per-point data
   Points d_self;                    ///< d_ii = -sum_j d_ij, 1/m  (3 x n)
-  Eigen::Matrix<double, 9, Eigen::Dynamic> hg_H;  ///< H_i = sum_j c_ij X_ij X_ij^T, column-major 3x3, N m  (9 x n)
-  Points hg_t;                      ///< t_i = sum_j c_ij X_ij, N  (3 x n)
+  Eigen::VectorXd hg_diagonal;      ///< diagonal of the (constant) hourglass Hessian per point, N/m  (n)
 
   // boundary conditions and constant external loads
   std::vector<unsigned char> fixed; ///< 1 where the point is held  (n)

@@ -24,7 +24,7 @@ struct MaterialParams {
   double density = 1000.0;         ///< rho, kg/m^3
   double volume_stiffness = 0.0;   ///< k_v of the volume term 0.5 k_v v (det F - 1)^2, Pa
   double damping = 0.0;            ///< mass-proportional damping, 1/s
-  double hourglass = 0.05;         ///< alpha of the zero-energy-mode penalty (physics.md); 0 turns it off
+  double hourglass = 0.3;          ///< alpha of the zero-energy-mode penalty (averaged-gradient form, docs/mechanics.md); 0: off
   VolumeMode volume = VolumeMode::CELL;
 
   /// Lame's first parameter lambda = E nu / ((1 + nu)(1 - 2 nu)), Pa.

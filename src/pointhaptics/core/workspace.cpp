@@ -36,6 +36,7 @@ Workspace::Workspace(const Model& model, int n_threads) {
   }
   f_int = Points::Zero(3, model.n_points);
   acceleration = Points::Zero(3, model.n_points);
+  gradients = Eigen::Matrix<double, 9, Eigen::Dynamic>::Zero(9, model.n_points);
   if (n_threads_ > 1) {
     chunk_forces.assign(n_threads_, Points::Zero(3, model.n_points));
     pool_ = std::make_unique<ThreadPool>(n_threads_);

@@ -31,6 +31,7 @@ class Workspace {
   Points f_int;                     ///< internal elastic forces, N  (3 x n)
   std::vector<Points> chunk_forces; ///< per-chunk scatter targets, summed into f_int  (n_threads x (3 x n))
   Points acceleration;              ///< scratch of the explicit solver, m/s^2  (3 x n)
+  Eigen::Matrix<double, 9, Eigen::Dynamic> gradients;  ///< G_i of the last stencil pass (row-major 3x3)  (9 x n)
 
  private:
   void run_chunks(void (*call)(void*, int), void* context);

@@ -40,6 +40,48 @@ double support_radius(const PointCloud& cloud, const KernelParams& kernel) {
   return kernel.support_factor * cloud.spacing;
 }
 
+// The hourglass energy (physics.md, averaged-gradient form): W = sum_i sum_j (k_ij / 2) |r_ij|^2 with
+// r_ij = u_j - u_i - (G_i + G_j) X_ij / 2 and k_ij = (alpha E / 2) (v_i w^_ij + v_j w^_ji) / |X_ij|^2,
+// w^_ij = w_ij / sum_k w_ik. k must be symmetric for the one-pass force (stencil_loop.hpp). Also the exact
+// diagonal of its (constant) Hessian: the weight of u_m in r_ij is
+//   [m = j] - [m = i] - (a_im + a_jm) / 2,  a_im = d_im . X_ij (m in N(i)), a_ii = d_ii . X_ij,
+// so diag_m = sum over pairs of k_ij (weight)^2, over the two stencils of each pair (serial; O(pairs x stencil)).
+void compute_hourglass(Model& model, const Eigen::VectorXd& w, const std::vector<double>& weight_sum) {
+  const Csr& nbr = model.neighbours;
+  const index_t n = model.n_points;
+  const double scale = 0.5 * model.material.hourglass * model.material.young;
+  auto share = [&](index_t i) { return weight_sum[i] > 0 ? model.volume[i] / weight_sum[i] : 0.0; };
+  for (index_t i = 0; i < n; ++i)
+    for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
+      const index_t j = nbr.index[e];
+      model.hg_coef[e] = scale * w[e] * (share(i) + share(j)) / (model.X.col(j) - model.X.col(i)).squaredNorm();
+    }
+  model.hg_diagonal = Eigen::VectorXd::Zero(n);
+  if (!(model.material.hourglass > 0)) return;
+  std::vector<double> weight(n, 0.0);
+  std::vector<index_t> touched;
+  for (index_t i = 0; i < n; ++i)
+    for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
+      const index_t j = nbr.index[e];
+      const Vec3 xij = model.X.col(j) - model.X.col(i);
+      auto add = [&](index_t m, double value) {
+        if (weight[m] == 0.0) touched.push_back(m);
+        weight[m] += value;
+      };
+      add(j, 1.0);
+      add(i, -1.0);
+      for (index_t s : {i, j}) {  // the two gradients G_i and G_j
+        add(s, -0.5 * model.d_self.col(s).dot(xij));
+        for (index_t f = nbr.begin(s); f < nbr.end(s); ++f) add(nbr.index[f], -0.5 * model.d.col(f).dot(xij));
+      }
+      for (index_t m : touched) {
+        model.hg_diagonal[m] += model.hg_coef[e] * weight[m] * weight[m];
+        weight[m] = 0.0;
+      }
+      touched.clear();
+    }
+}
+
 }  // namespace
 
 Model build_model(const PointCloud& cloud, const MaterialParams& material, const KernelParams& kernel) {
@@ -108,11 +150,8 @@ Model build_model(const PointCloud& cloud, const MaterialParams& material, const
   model.d.resize(3, n_pairs);
   model.d_self.resize(3, n);
   model.hg_coef.resize(n_pairs);
-  model.hg_H.resize(9, n);
-  model.hg_t.resize(3, n);
-  std::vector<double> condition(n, 0.0);
+  std::vector<double> condition(n, 0.0), weight_sum(n, 0.0);
   std::vector<unsigned char> regularised(n, 0);
-  const double hg_scale = material.hourglass * material.young;
   tbb::parallel_for(index_t{0}, n, [&](index_t i) {
     Mat3 M = Mat3::Zero();
     double w_sum = 0;
@@ -138,23 +177,17 @@ Model build_model(const PointCloud& cloud, const MaterialParams& material, const
       regularised[i] = 1;  // isolated: G_i = 0, the point feels no elastic force
       condition[i] = std::numeric_limits<double>::infinity();
     }
-    Vec3 d_sum = Vec3::Zero(), t = Vec3::Zero();
-    Mat3 H = Mat3::Zero();
+    Vec3 d_sum = Vec3::Zero();
     for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
       const Vec3 xij = model.X.col(nbr.index[e]) - model.X.col(i);
       const Vec3 dij = M_inv * xij * w[e];
       model.d.col(e) = dij;
       d_sum += dij;
-      // hourglass energy (physics.md): (alpha E / 2) v_i w^_ij |u_j - u_i - G_i X_ij|^2 / |X_ij|^2
-      model.hg_coef[e] = w_sum > 0 ? hg_scale * model.volume[i] * (w[e] / w_sum) / xij.squaredNorm() : 0.0;
-      const Vec3 g = model.hg_coef[e] * xij;
-      t += g;
-      H.noalias() += g * xij.transpose();
     }
     model.d_self.col(i) = -d_sum;
-    model.hg_t.col(i) = t;
-    model.hg_H.col(i) = H.reshaped();
+    weight_sum[i] = w_sum;
   });
+  compute_hourglass(model, w, weight_sum);
 
   // diagnostics
   ModelDiagnostics& diag = model.diagnostics;

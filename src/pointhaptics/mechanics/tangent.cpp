@@ -92,20 +92,9 @@ void Tangent::diagonal_blocks(const Model& model, Eigen::Matrix<double, 9, Eigen
       unit.data()[col] = 1.0;
       C.col(col) = stress_increment(F, S, unit, model.volume[i], lambda, mu, kv, exact).reshaped();
     }
-    // hourglass (constant, physics.md): W_i = sum_j c_j |r_j|^2 / 2, r_j = u_j - u_i - G_i X_ij; the weight
-    // of u_m in r_j is delta_jm - d_im . X_ij, so the diagonal is c_m (1 - 2 d_im . X_im) + d_im^T H_i d_im,
-    // and for u_i: sum_j c_j + 2 d_ii . t_i + d_ii^T H_i d_ii.
-    const Eigen::Map<const Mat3> H(model.hg_H.data() + 9 * i);
-    double c_sum = 0;
-    for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
-      const index_t j = nbr.index[e];
-      const Vec3 d = model.d.col(e);
-      const double c = model.hg_coef[e];
-      c_sum += c;
-      add_block(j, C, d, c * (1.0 - 2.0 * d.dot(model.X.col(j) - model.X.col(i))) + d.dot(H * d));
-    }
-    const Vec3 d_ii = model.d_self.col(i);
-    add_block(i, C, d_ii, c_sum + 2.0 * d_ii.dot(model.hg_t.col(i)) + d_ii.dot(H * d_ii));
+    // the hourglass part is constant and precomputed in the model (model_builder.cpp)
+    for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) add_block(nbr.index[e], C, model.d.col(e), 0.0);
+    add_block(i, C, model.d_self.col(i), model.hg_diagonal.size() ? model.hg_diagonal[i] : 0.0);
   }
 }
 
