@@ -1,4 +1,5 @@
 // pointhaptics: the command line. `pointhaptics <command> [scene.toml] [options]`, --help on every command.
+#include "experiment_beam.hpp"
 #include "experiment_cantilever.hpp"
 #include "progress_bar.hpp"
 
@@ -108,11 +109,20 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   cantilever_cmd->add_option("--plot-script", cantilever.plot_script, "plot_cantilever.py to use");
 
+  ph::experiments::BeamOptions beam;
+  CLI::App* beam_cmd = experiment_cmd->add_subcommand(
+      "beam-4x1x1", "The 4 x 1 x 1 m benchmark beam: settled sag vs CalculiX, compute s per simulated s");
+  beam_cmd->add_option("--out", beam.out, "Output folder")->required();
+  beam_cmd->add_option("--scene", beam.scene, "Scene file")->required()->check(CLI::ExistingFile);
+  beam_cmd->add_option("--duration", beam.duration, "Simulated seconds of the dynamic runs")->check(CLI::PositiveNumber);
+  beam_cmd->add_flag("!--no-implicit", beam.implicit, "Skip the (slow) implicit runs");
+
   CLI11_PARSE(app, argc, argv);
   try {
     if (*run_cmd) return run_command(run);
     if (*bench_cmd) return ph::bench::run_bench_suite(bench);
     if (*cantilever_cmd) return ph::experiments::run_cantilever_experiment(cantilever);
+    if (*beam_cmd) return ph::experiments::run_beam_experiment(beam);
   } catch (const ph::Error& e) {
     std::fprintf(stderr, "pointhaptics: error: %s\n", e.what());
     return 1;
