@@ -20,7 +20,7 @@ for r in point:
     err = float(r["error_centre_pct"])
     assert abs(err) < 2.0, f"{r['case']}: {err}% at s = 7.5 mm"
 seed = [r for r in rows if r["method"] == "point_seed_h"]
-assert all(float(r["error_centre_pct"]) > 50 for r in seed), "the seed's h = 0.1 m should be far too soft"
+assert all(float(r["error_centre_pct"]) > 25 for r in seed), "the seed's h = 0.1 m should be far too soft"
 with open(os.path.join(out, "point-load.csv"), newline="") as f:
     profile = list(csv.DictReader(f))
 bottom_point, bottom_fem = float(profile[-1]["point_uy_m"]), float(profile[-1]["calculix_uy_m"])
