@@ -1,0 +1,50 @@
+#pragma once
+/// @file From the force the simulation asks for to the force the device gets: the virtual coupling's
+/// budget, and the safety rules applied every haptic tick.
+#include <pointhaptics/haptics/device.hpp>
+
+namespace pointhaptics {
+
+/// Virtual coupling (Brown & Colgate): a spring-damper between the device and the probe in the scene.
+/// A device displacement d moves the probe by `scale` d, so a scene stiffness k is felt as k scale at
+/// the device; the budget keeps that below `safety` times the device's stable maximum.
+struct CouplingGains {
+  double stiffness = 0;  ///< N per m of scene displacement
+  double damping = 0;    ///< N s per m of scene motion
+};
+/// scale: scene metres per device metre (> 0); safety in (0, 1].
+CouplingGains coupling_budget(const DeviceSpecs& specs, double scale, double safety = 0.5);
+
+struct ForceRules {
+  double engage_below = 0.1;    ///< N: forces engage only once the requested force is below this (CHAI3D's start-up rule)
+  double ramp_time = 0.5;       ///< s: after engaging, forces ramp in linearly over this time
+  double max_change = 0.2;      ///< N per tick: bound on the change of the commanded force
+};
+
+/// Applies the rules to each tick's requested force: engage when small, ramp in, clamp the magnitude
+/// (not each component) to the device's max force, bound the change per tick; and keeps a passivity
+/// observer (Hannaford & Ryu): the energy the virtual environment has absorbed from the hand,
+/// E = -sum F . v dt, which a passive environment keeps >= 0. No allocation; haptic thread only.
+class ForceRenderer {
+ public:
+  ForceRenderer(const DeviceSpecs& specs, const ForceRules& rules = {});
+  /// The force to command this tick (N) for the requested one, the device velocity (m/s) and the tick (s).
+  Vec3 render(const Vec3& requested, const Vec3& device_velocity, double dt);
+  /// Zero force, disengaged (e.g. after a device error or at the end).
+  void reset();
+
+  bool engaged() const { return engaged_; }
+  double observed_energy() const { return energy_; }      ///< J; negative: the environment gave energy
+  double min_observed_energy() const { return min_energy_; }
+  const Vec3& last_force() const { return last_; }
+
+ private:
+  DeviceSpecs specs_;
+  ForceRules rules_;
+  bool engaged_ = false;
+  double since_engaged_ = 0;
+  Vec3 last_ = Vec3::Zero();
+  double energy_ = 0, min_energy_ = 0;
+};
+
+}  // namespace pointhaptics

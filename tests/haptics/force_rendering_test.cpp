@@ -1,0 +1,151 @@
+// Tests for haptics/device (known specs), haptics/exchange (the triple buffer) and haptics/force_rendering
+// (coupling budget, engage rule, ramp, magnitude clamp, rate bound, passivity observer).
+#include <pointhaptics/haptics/device.hpp>
+#include <pointhaptics/haptics/exchange.hpp>
+#include <pointhaptics/haptics/force_rendering.hpp>
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <thread>
+
+namespace pointhaptics {
+namespace {
+
+TEST(DeviceSpecs, KnownDevicesAndANamedErrorForOthers) {
+  EXPECT_DOUBLE_EQ(known_device_specs("touch").max_force, 3.3);
+  EXPECT_DOUBLE_EQ(known_device_specs("touch").max_stiffness, 400.0);
+  EXPECT_DOUBLE_EQ(known_device_specs("omni").max_stiffness, 700.0);
+  EXPECT_DOUBLE_EQ(known_device_specs("falcon").max_force, 8.0);
+  try {
+    known_device_specs("phantom-9000");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown device \"phantom-9000\""), std::string::npos);
+  }
+}
+
+TEST(TripleBuffer, ConsumerSeesTheLatestPublishedValueOnce) {
+  TripleBuffer<int> buffer(-1);
+  EXPECT_FALSE(buffer.update());
+  EXPECT_EQ(buffer.front(), -1);
+  buffer.back() = 1;
+  buffer.publish();
+  buffer.back() = 2;
+  buffer.publish();
+  EXPECT_TRUE(buffer.update());
+  EXPECT_EQ(buffer.front(), 2);  // the latest, 1 was overwritten
+  EXPECT_FALSE(buffer.update());
+  EXPECT_EQ(buffer.front(), 2);
+  buffer.back() = 3;
+  buffer.publish();
+  EXPECT_TRUE(buffer.update());
+  EXPECT_EQ(buffer.front(), 3);
+}
+
+// A value that is torn if it is read while being written.
+struct Frame {
+  long long id = 0;
+  double data[32] = {};
+};
+
+TEST(TripleBuffer, TwoThreadsNeverSeeATornOrOlderValue) {
+  TripleBuffer<Frame> buffer;
+  std::atomic<bool> done{false};
+  const long long frames = 200000;
+  std::thread producer([&] {
+    for (long long id = 1; id <= frames; ++id) {
+      Frame& f = buffer.back();
+      f.id = id;
+      for (double& x : f.data) x = static_cast<double>(id);
+      buffer.publish();
+    }
+    done = true;
+  });
+  long long last = 0, torn = 0, backwards = 0, seen = 0;
+  while (!done || buffer.update()) {
+    if (!buffer.update()) continue;
+    const Frame& f = buffer.front();
+    for (double x : f.data) torn += x != static_cast<double>(f.id);
+    backwards += f.id < last;
+    last = f.id;
+    ++seen;
+  }
+  producer.join();
+  buffer.update();
+  EXPECT_EQ(torn, 0);
+  EXPECT_EQ(backwards, 0);
+  EXPECT_EQ(buffer.front().id, frames);  // the last value always arrives
+  EXPECT_GT(seen, 0);
+}
+
+TEST(CouplingBudget, FeltStiffnessStaysBelowTheDevicesStableMaximum) {
+  const DeviceSpecs touch = known_device_specs("touch");
+  for (double scale : {0.5, 1.0, 4.0}) {
+    const CouplingGains g = coupling_budget(touch, scale, 0.5);
+    EXPECT_NEAR(g.stiffness * scale, 0.5 * touch.max_stiffness, 1e-12);
+    EXPECT_NEAR(g.damping * scale, 0.5 * touch.max_damping, 1e-12);
+  }
+  EXPECT_THROW(coupling_budget(touch, 0.0), Error);
+  EXPECT_THROW(coupling_budget(touch, 1.0, 1.5), Error);
+}
+
+TEST(ForceRenderer, EngagesOnlyOnceTheRequestIsSmallThenRampsIn) {
+  ForceRules rules;
+  rules.ramp_time = 0.1;
+  rules.max_change = 100;  // not under test here
+  ForceRenderer r(known_device_specs("touch"), rules);
+  const double dt = 1e-3;
+  // the device starts inside an object: 2 N requested, nothing rendered
+  for (int k = 0; k < 50; ++k) EXPECT_EQ(r.render(Vec3(0, 2, 0), Vec3::Zero(), dt), Vec3::Zero());
+  EXPECT_FALSE(r.engaged());
+  // the request drops below the threshold: engaged, then ramped
+  r.render(Vec3(0, 0.05, 0), Vec3::Zero(), dt);
+  EXPECT_TRUE(r.engaged());
+  const Vec3 early = r.render(Vec3(0, 2, 0), Vec3::Zero(), dt);
+  EXPECT_NEAR(early.y(), 2.0 * 2e-3 / 0.1, 1e-12);
+  for (int k = 0; k < 200; ++k) r.render(Vec3(0, 2, 0), Vec3::Zero(), dt);
+  EXPECT_NEAR(r.last_force().y(), 2.0, 1e-12);
+}
+
+TEST(ForceRenderer, ClampsTheMagnitudeNotTheComponentsAndBoundsTheChange) {
+  ForceRules rules;
+  rules.ramp_time = 0;
+  rules.max_change = 0.2;
+  const DeviceSpecs touch = known_device_specs("touch");
+  ForceRenderer r(touch, rules);
+  r.render(Vec3::Zero(), Vec3::Zero(), 1e-3);  // engage
+  const Vec3 request(30, -40, 0);              // 50 N along (0.6, -0.8, 0)
+  Vec3 f = Vec3::Zero();
+  for (int k = 0; k < 100; ++k) {
+    const Vec3 next = r.render(request, Vec3::Zero(), 1e-3);
+    EXPECT_LE((next - f).norm(), 0.2 + 1e-12);
+    EXPECT_LE(next.norm(), touch.max_force + 1e-12);
+    f = next;
+  }
+  EXPECT_NEAR(f.norm(), touch.max_force, 1e-12);
+  EXPECT_NEAR(f.x() / f.norm(), 0.6, 1e-12);  // direction kept
+  EXPECT_EQ(r.render(Vec3(NAN, 0, 0), Vec3::Zero(), 1e-3).allFinite(), true);
+}
+
+TEST(ForceRenderer, PassivityObserverSeesASpringAsPassiveAndAnActiveForceAsNot) {
+  ForceRules rules;
+  rules.ramp_time = 0;
+  rules.max_change = 100;
+  const double k = 200, dt = 1e-3;
+  ForceRenderer spring(known_device_specs("touch"), rules), active(known_device_specs("touch"), rules);
+  active.render(Vec3::Zero(), Vec3::Zero(), dt);  // engage
+  // the hand goes into a wall spring and back out along the same path
+  for (int t = 0; t < 2000; ++t) {
+    const double x = 0.005 * std::sin(M_PI * t / 1000.0);  // in and out
+    const double v = 0.005 * M_PI * std::cos(M_PI * t / 1000.0);
+    spring.render(Vec3(-k * std::max(x, 0.0), 0, 0), Vec3(v, 0, 0), dt);
+    active.render(Vec3(0.5, 0, 0), Vec3(v > 0 ? 0.01 : 0.0, 0, 0), dt);  // pushes along the motion
+  }
+  EXPECT_GT(spring.min_observed_energy(), -1e-5);
+  EXPECT_NEAR(spring.observed_energy(), 0.0, 1e-5);
+  EXPECT_LT(active.observed_energy(), -1e-4);
+}
+
+}  // namespace
+}  // namespace pointhaptics
