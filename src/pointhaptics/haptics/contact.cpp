@@ -1,0 +1,75 @@
+#include <pointhaptics/haptics/contact.hpp>
+
+#include <pointhaptics/core/error.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+namespace pointhaptics {
+namespace {
+
+ProbeParams resolved(const Model& model, ProbeParams p) {
+  if (!(p.radius > 0) || !std::isfinite(p.radius)) throw Error("probe.radius must be positive (m)");
+  if (p.point_radius <= 0) p.point_radius = 0.5 * model.spacing;
+  if (p.stiffness <= 0) p.stiffness = model.material.young * model.spacing;
+  return p;
+}
+
+}  // namespace
+
+ProbeContact::ProbeContact(const Model& model, const ProbeParams& params)
+    : params_(resolved(model, params)), grid_(params_.radius + params_.point_radius), x_(model.X) {}
+
+ContactModel ProbeContact::apply(const Model& model, const Points& u, const Vec3& probe, bool button, double time,
+                                 Points& forces) {
+  ContactModel out;
+  out.time = time;
+  out.p0 = probe;
+  if (!probe.allFinite()) return out;
+  const double k = params_.stiffness;
+  if (params_.mode == ProbeMode::GRAB) {
+    if (button && !was_pressed_) {
+      // press: grab the points under the probe, keeping their offsets
+      x_ = model.X + u;
+      grid_.rebuild(x_);
+      grabbed_.clear();
+      offsets_.clear();
+      grid_.for_each_within(x_, probe, params_.radius + params_.point_radius, [&](index_t i) {
+        if (model.fixed[i]) return;
+        grabbed_.push_back(i);
+        offsets_.push_back(x_.col(i) - probe);
+      });
+    }
+    if (!button) grabbed_.clear();
+    was_pressed_ = button;
+    for (size_t g = 0; g < grabbed_.size(); ++g) {
+      const index_t i = grabbed_[g];
+      const Vec3 f = k * (probe + offsets_[g] - (model.X.col(i) + u.col(i)));  // seed: the dragged point
+      forces.col(i) += f;
+      out.f0 -= f;
+    }
+    out.K = -k * static_cast<double>(grabbed_.size()) * Mat3::Identity();
+    out.contacts = static_cast<int>(grabbed_.size());
+    out.grabbing = !grabbed_.empty();
+    return out;
+  }
+  // push: sphere-sphere overlap (seed Fig. 5)
+  x_ = model.X + u;
+  grid_.rebuild(x_);
+  const double reach = params_.radius + params_.point_radius;
+  grid_.for_each_within(x_, probe, reach, [&](index_t i) {
+    const Vec3 r = x_.col(i) - probe;
+    const double d = r.norm();
+    // a point at the probe's centre has no direction: push it up, as good as any
+    const Vec3 n = d > 1e-12 * reach ? Vec3(r / d) : Vec3::UnitY();
+    const Vec3 f = k * (reach - d) * n;
+    if (!model.fixed[i]) forces.col(i) += f;
+    out.f0 -= f;
+    // the normal part of dF/dp; the tangential part (which would make K indefinite) is left out
+    out.K -= k * n * n.transpose();
+    ++out.contacts;
+  });
+  return out;
+}
+
+}  // namespace pointhaptics

@@ -1,0 +1,55 @@
+#pragma once
+/// @file The probe and its contact with the object (seed Fig. 5): sphere-sphere tests between the probe
+/// and the point spheres, push and grab, and the local linear contact model the haptic thread renders.
+#include <pointhaptics/core/model.hpp>
+#include <pointhaptics/geometry/spatial_grid.hpp>
+
+#include <vector>
+
+namespace pointhaptics {
+
+enum class ProbeMode { PUSH, GRAB };
+
+struct ProbeParams {
+  double radius = 0.005;        ///< probe sphere, m
+  ProbeMode mode = ProbeMode::PUSH;
+  double point_radius = 0;      ///< point spheres, m (0: half the model's spacing)
+  double stiffness = 0;         ///< contact / grab spring per point, N/m (0: E x spacing, the object's own scale)
+};
+
+/// The force the object exerts on the probe near p0, linearised: F(p) = f0 + K (p - p0).
+/// K is symmetric negative semi-definite (the object pushes back), so the haptic side's coupling solve
+/// (k I - K) p = ... is always well posed.
+struct ContactModel {
+  double time = 0;              ///< simulation time it was made at, s
+  Vec3 p0 = Vec3::Zero();       ///< probe position it was made at, m
+  Vec3 f0 = Vec3::Zero();       ///< force on the probe at p0, N
+  Mat3 K = Mat3::Zero();        ///< dF/dp, N/m
+  int contacts = 0;             ///< touched or grabbed points
+  bool grabbing = false;
+};
+
+/// Contact between the probe and the object, for the simulation thread. Push: every point sphere that
+/// overlaps the probe is pushed out along the line of centres by a spring (stiffness x overlap), and the
+/// probe feels the opposite. Grab: while the button is held, the points under the probe when it was
+/// pressed follow the probe by springs (the seed's dragged point); on release they are let go.
+class ProbeContact {
+ public:
+  ProbeContact(const Model& model, const ProbeParams& params);
+  /// Adds the contact forces on the points (N) into `forces` (3 x n) for the probe at `probe` (m) and the
+  /// current displacement u, and returns the local contact model. A non-finite probe position is ignored
+  /// (no contact). No allocation after the first calls.
+  ContactModel apply(const Model& model, const Points& u, const Vec3& probe, bool button, double time, Points& forces);
+  const ProbeParams& params() const { return params_; }
+  const std::vector<index_t>& grabbed() const { return grabbed_; }
+
+ private:
+  ProbeParams params_;
+  SpatialGrid grid_;
+  Points x_;                      // current positions
+  std::vector<index_t> grabbed_;
+  std::vector<Vec3> offsets_;     // grabbed point minus probe at the press
+  bool was_pressed_ = false;
+};
+
+}  // namespace pointhaptics
