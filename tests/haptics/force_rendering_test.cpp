@@ -63,16 +63,19 @@ TEST(TripleBuffer, TwoThreadsNeverSeeATornOrOlderValue) {
     done = true;
   });
   long long last = 0, torn = 0, backwards = 0, seen = 0;
-  while (!done || buffer.update()) {
-    if (!buffer.update()) continue;
-    const Frame& f = buffer.front();
-    for (double x : f.data) torn += x != static_cast<double>(f.id);
-    backwards += f.id < last;
-    last = f.id;
-    ++seen;
+  for (;;) {
+    const bool finished = done.load();  // read before update(): every publish is then visible to it
+    if (buffer.update()) {
+      const Frame& f = buffer.front();
+      for (double x : f.data) torn += x != static_cast<double>(f.id);
+      backwards += f.id < last;
+      last = f.id;
+      ++seen;
+    } else if (finished) {
+      break;
+    }
   }
   producer.join();
-  buffer.update();
   EXPECT_EQ(torn, 0);
   EXPECT_EQ(backwards, 0);
   EXPECT_EQ(buffer.front().id, frames);  // the last value always arrives
