@@ -17,6 +17,7 @@ namespace pointhaptics {
 Simulation::Simulation(Model model, const SolverSpec& solver, int n_threads)
     : model_(std::move(model)), solver_(solver), state_(State::at_rest(model_)), ws_(model_, n_threads) {
   stable_dt_ = stable_time_step(model_);
+  extra_forces_ = Points::Zero(3, model_.n_points);
   if (solver_.kind == SolverKind::STATIC) newton_ = std::make_unique<NewtonSolver>(model_);
   if (solver_.kind == SolverKind::IMPLICIT) implicit_ = std::make_unique<ImplicitSolver>(model_);
   // held points start at their prescribed displacement at t = 0
@@ -44,13 +45,19 @@ void Simulation::step() {
   switch (solver_.kind) {
     case SolverKind::EXPLICIT: {
       // internal forces, then symplectic Euler, sub-stepped below the stable step
-      const ExplicitStepStats stats = explicit_step(model_, state_, ws_, solver_.dt, stable_dt_);
+      const ExplicitStepStats stats = explicit_step(model_, state_, ws_, solver_.dt, stable_dt_, dynamic_forces_);
       substeps_ += stats.substeps;
       iterations_ += stats.substeps;
       break;
     }
     case SolverKind::IMPLICIT: {
-      const NewtonStats stats = implicit_->step(model_, state_, ws_, solver_.dt, newton_settings());
+      const Points* extra = nullptr;
+      if (dynamic_forces_) {
+        extra_forces_.setZero();
+        dynamic_forces_->add(model_, state_, extra_forces_);
+        extra = &extra_forces_;
+      }
+      const NewtonStats stats = implicit_->step(model_, state_, ws_, solver_.dt, newton_settings(), extra);
       iterations_ += stats.iterations;
       cg_iterations_ += stats.cg_iterations;
       residual_ = stats.residual;

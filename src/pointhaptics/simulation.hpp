@@ -4,6 +4,7 @@
 #include <pointhaptics/core/workspace.hpp>
 #include <pointhaptics/io/result_json.hpp>
 #include <pointhaptics/io/scene.hpp>
+#include <pointhaptics/solvers/explicit_solver.hpp>
 #include <pointhaptics/solvers/implicit_solver.hpp>
 #include <pointhaptics/solvers/newton.hpp>
 
@@ -31,6 +32,9 @@ class Simulation {
   /// Replace the state (same model); used by tests and by replay.
   void set_state(const State& state) { state_ = state; }
   const SolverSpec& solver() const { return solver_; }
+  /// State-dependent forces added at every dynamic step (probe contact): explicit dynamics evaluates them
+  /// at every sub-step, implicit dynamics once per step (held over it). Not owned; nullptr: none.
+  void set_dynamic_forces(DynamicForces* forces) { dynamic_forces_ = forces; }
   double stable_dt() const { return stable_dt_; }
 
   /// Results at the current state: energies, reactions, residual, timing.
@@ -43,6 +47,8 @@ class Simulation {
   SolverSpec solver_;
   State state_;
   Workspace ws_;
+  Points extra_forces_;
+  DynamicForces* dynamic_forces_ = nullptr;
   std::unique_ptr<NewtonSolver> newton_;      ///< static
   std::unique_ptr<ImplicitSolver> implicit_;  ///< implicit
   double stable_dt_ = 0;

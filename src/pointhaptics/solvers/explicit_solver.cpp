@@ -32,20 +32,27 @@ Vec3 prescribed_displacement(const FixedGroup& group, double t) {
   return s * group.displacement;
 }
 
-ExplicitStepStats explicit_step(const Model& model, State& state, Workspace& ws, double dt, double stable_dt) {
+ExplicitStepStats explicit_step(const Model& model, State& state, Workspace& ws, double dt, double stable_dt,
+                                DynamicForces* extra) {
   const int n_sub = std::max(1, static_cast<int>(std::ceil(dt / stable_dt * (1 - 1e-12))));
   const double h = dt / n_sub;
   const double c = model.material.damping;
   const double limit2 = (100 * model.extent) * (100 * model.extent);
   for (int sub = 0; sub < n_sub; ++sub) {
     compute_internal_forces(model, state.u, ws);
+    if (extra) {
+      ws.acceleration.setZero();  // scratch for the dynamic forces
+      extra->add(model, state, ws.acceleration);
+    }
     std::atomic<index_t> bad_point{-1};
     ws.for_each_chunk([&](int chunk) {
       for (index_t i = ws.chunk_begin(chunk); i < ws.chunk_end(chunk); ++i) {
         if (model.fixed[i]) continue;
         auto v = state.velocity.col(i);
         auto u = state.u.col(i);
-        v = (v + h / model.mass[i] * (ws.f_int.col(i) + model.f_ext.col(i))) / (1 + h * c);
+        Vec3 f = ws.f_int.col(i) + model.f_ext.col(i);
+        if (extra) f += ws.acceleration.col(i);
+        v = (v + h / model.mass[i] * f) / (1 + h * c);
         u += h * v;
         if (!(u.squaredNorm() < limit2)) bad_point = i;  // also catches NaN
       }

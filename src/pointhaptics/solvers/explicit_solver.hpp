@@ -22,6 +22,17 @@ struct ExplicitStepStats {
 ///   v <- (v + h M^-1 (f_int + f_ext)) / (1 + h c),   u <- u + h v   (c: mass-proportional damping)
 /// Held points follow their prescribed displacement. Throws Error naming the step and point if a
 /// displacement becomes non-finite or grows beyond 100 times the object's size (divergence).
-ExplicitStepStats explicit_step(const Model& model, State& state, Workspace& ws, double dt, double stable_dt);
+/// Forces that depend on the state and are evaluated at every sub-step (e.g. probe contact), so that
+/// stiff contact springs are integrated at the stable sub-step, not held over a whole step.
+class DynamicForces {
+ public:
+  virtual ~DynamicForces() = default;
+  /// Add the forces (N) at `state` into f (3 x n).
+  virtual void add(const Model& model, const State& state, Points& f) = 0;
+};
+
+/// extra, if given, is evaluated at every sub-step and added to the constant loads.
+ExplicitStepStats explicit_step(const Model& model, State& state, Workspace& ws, double dt, double stable_dt,
+                                DynamicForces* extra = nullptr);
 
 }  // namespace pointhaptics

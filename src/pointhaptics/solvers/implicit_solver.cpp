@@ -8,10 +8,13 @@
 namespace pointhaptics {
 
 ImplicitSolver::ImplicitSolver(const Model& model)
-    : newton_(model), anchor_(Points::Zero(3, model.n_points)), u_next_(Points::Zero(3, model.n_points)) {}
+    : newton_(model),
+      anchor_(Points::Zero(3, model.n_points)),
+      u_next_(Points::Zero(3, model.n_points)),
+      load_(Points::Zero(3, model.n_points)) {}
 
 NewtonStats ImplicitSolver::step(const Model& model, State& state, Workspace& ws, double dt,
-                                 const NewtonSettings& settings) {
+                                 const NewtonSettings& settings, const Points* extra_forces) {
   const double c = model.material.damping;
   const double k = 1.0 / (dt * dt) + c / dt;
   // the two quadratic terms combine into 0.5 k |u' - a|_M^2 with a = ((u + dt v)/dt^2 + c u/dt) / k
@@ -23,7 +26,12 @@ NewtonStats ImplicitSolver::step(const Model& model, State& state, Workspace& ws
     for (index_t i : group.points) u_next_.col(i) = target;
   }
   NewtonProblem problem;
-  problem.load = &model.f_ext;
+  if (extra_forces) {
+    load_ = model.f_ext + *extra_forces;
+    problem.load = &load_;
+  } else {
+    problem.load = &model.f_ext;
+  }
   problem.inertia = k;
   problem.anchor = &anchor_;
   const NewtonStats stats = newton_.solve(model, problem, u_next_, ws, settings);

@@ -16,11 +16,13 @@ namespace pointhaptics {
 class ImplicitSolver {
  public:
   explicit ImplicitSolver(const Model& model);
-  NewtonStats step(const Model& model, State& state, Workspace& ws, double dt, const NewtonSettings& settings);
+  /// extra_forces (3 x n, N), if given, are added to the constant loads for this step (held constant over it).
+  NewtonStats step(const Model& model, State& state, Workspace& ws, double dt, const NewtonSettings& settings,
+                   const Points* extra_forces = nullptr);
 
  private:
   NewtonSolver newton_;
-  Points anchor_, u_next_;
+  Points anchor_, u_next_, load_;
 };
 
 }  // namespace pointhaptics

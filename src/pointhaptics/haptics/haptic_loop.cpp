@@ -1,0 +1,142 @@
+#include <pointhaptics/haptics/haptic_loop.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <ctime>
+
+namespace pointhaptics {
+
+HapticLoop::HapticLoop(Device& device, const WorkspaceMapping& mapping, const CouplingGains& gains,
+                       const ForceRules& rules, double rate_hz, std::size_t log_capacity)
+    : device_(device), mapping_(mapping), gains_(gains), renderer_(device.specs(), rules), period_(1.0 / rate_hz) {
+  if (!(rate_hz > 0) || !(mapping.scale > 0) || !(gains.stiffness > 0))
+    throw Error("haptic loop: the rate, the workspace scale and the coupling stiffness must be positive");
+  log_.reserve(log_capacity);
+}
+
+HapticLoop::~HapticLoop() { stop(); }
+
+bool HapticLoop::tick(double t, double dt) {
+  if (failed_) return false;
+  try {
+    const DeviceState state = device_.read(t);
+    const Vec3 d = mapping_.origin + mapping_.scale * state.position;  // the device point in the scene
+    const Vec3 vd = mapping_.scale * state.velocity;
+    models_.update();
+    const ContactModel& m = models_.front();
+    // the probe is where the coupling spring balances the local contact model:
+    //   k (d - p) + f0 + K (p - p0) = 0  =>  (k I - K) p = k d + f0 - K p0   (K <= 0, so always solvable)
+    const double k = gains_.stiffness;
+    Vec3 p = d;
+    if (m.contacts > 0 && m.p0.allFinite()) {
+      const Mat3 A = k * Mat3::Identity() - m.K;
+      p = A.ldlt().solve(k * d + m.f0 - m.K * m.p0);
+      if (!p.allFinite()) p = d;
+    }
+    const Vec3 vp = probe_.allFinite() && dt > 0 ? Vec3((p - probe_) / dt) : vd;
+    probe_ = p;
+    // the coupling pulls the device toward the probe (scene forces are rendered unscaled)
+    const Vec3 requested = k * (p - d) + gains_.damping * (vp - vd);
+    const Vec3 f = renderer_.render(requested, state.velocity, dt);
+    device_.command(f);
+    HapticFrame& frame = frames_.back();
+    frame.time = t;
+    frame.probe = p;
+    frame.button = (state.buttons & 1u) != 0;
+    frame.force = f;
+    frames_.publish();
+    if (log_.size() < log_.capacity()) log_.push_back({t, state.position, state.velocity, state.buttons, f});
+    max_force_ = std::max(max_force_, f.norm());
+    ++ticks_;
+    last_t_ = t;
+    return true;
+  } catch (const DeviceError& e) {
+    failed_ = true;
+    error_ = e.what();
+  } catch (const Error& e) {
+    failed_ = true;
+    error_ = e.what();
+  }
+  failed_flag_.store(true, std::memory_order_release);
+  renderer_.reset();
+  try {
+    device_.stop();  // zero force, whatever happened
+  } catch (...) {
+  }
+  return false;
+}
+
+void HapticLoop::record_period(double error_us) {
+  const auto bin = static_cast<std::size_t>(std::min(std::abs(error_us), 2000.0));
+  ++period_histogram_[bin];
+}
+
+void HapticLoop::start() {
+  if (running_.exchange(true)) return;
+  thread_ = std::thread([this] { run(); });
+}
+
+void HapticLoop::stop() {
+  if (!running_.exchange(false)) return;
+  if (thread_.joinable()) thread_.join();
+}
+
+void HapticLoop::run() {
+  using clock = std::chrono::steady_clock;
+  const auto start = clock::now();
+  const auto period = std::chrono::duration_cast<clock::duration>(std::chrono::duration<double>(period_));
+  auto deadline = start;
+  auto previous = start;
+  while (running_.load(std::memory_order_relaxed)) {
+    deadline += period;
+    std::this_thread::sleep_until(deadline);  // absolute deadline: no drift
+    const auto now = clock::now();
+    const double t = std::chrono::duration<double>(now - start).count();
+    const double dt = std::chrono::duration<double>(now - previous).count();
+    if (ticks_ > 0) record_period(1e6 * (dt - period_));
+    previous = now;
+    const bool ok = tick(t, dt);
+    tick_max_us_ = std::max(tick_max_us_, 1e6 * std::chrono::duration<double>(clock::now() - now).count());
+    if (!ok) break;
+    // after a stall, do not try to catch up with a burst of ticks
+    if (clock::now() - deadline > 10 * period) deadline = clock::now();
+  }
+  wall_s_ = std::chrono::duration<double>(clock::now() - start).count();
+  try {
+    device_.stop();
+  } catch (...) {
+  }
+}
+
+HapticStats HapticLoop::stats() const {
+  HapticStats s;
+  s.ticks = ticks_;
+  const double span = wall_s_ > 0 ? wall_s_ : last_t_;
+  s.rate_hz = span > 0 ? static_cast<double>(ticks_) / span : 0.0;
+  long long total = 0;
+  for (long long c : period_histogram_) total += c;
+  auto quantile = [&](double q) {
+    long long seen = 0;
+    for (std::size_t b = 0; b < period_histogram_.size(); ++b) {
+      seen += period_histogram_[b];
+      if (total > 0 && seen >= q * total) return static_cast<double>(b);
+    }
+    return 0.0;
+  };
+  s.period_p50_us = quantile(0.5);
+  s.period_p99_us = quantile(0.99);
+  for (std::size_t b = period_histogram_.size(); b-- > 0;)
+    if (period_histogram_[b]) {
+      s.period_max_us = static_cast<double>(b);
+      break;
+    }
+  s.tick_max_us = tick_max_us_;
+  s.max_force_n = max_force_;
+  s.min_observed_energy = renderer_.min_observed_energy();
+  s.device_failed = failed_;
+  s.device_error = error_;
+  return s;
+}
+
+}  // namespace pointhaptics

@@ -1,0 +1,84 @@
+#include <pointhaptics/interactive.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <thread>
+
+namespace pointhaptics {
+namespace {
+
+// The probe's contact as forces on the points, evaluated at every explicit sub-step with the probe of
+// the step; remembers the last local contact model.
+class ContactForces : public DynamicForces {
+ public:
+  ContactForces(const Model& model, const ProbeParams& params) : contact(model, params) {}
+  void add(const Model& model, const State& state, Points& f) override {
+    last = contact.apply(model, state.u, probe, button, state.time, f);
+  }
+  ProbeContact contact;
+  Vec3 probe = Vec3::Constant(NAN);
+  bool button = false;
+  ContactModel last;
+};
+
+// One simulation step with the latest probe; then the local model is published.
+int simulation_step(Simulation& sim, ContactForces& contact, HapticLoop& loop) {
+  loop.frames().update();
+  const HapticFrame& frame = loop.frames().front();
+  contact.probe = frame.probe;
+  contact.button = frame.button;
+  sim.step();
+  loop.contact_models().back() = contact.last;
+  loop.contact_models().publish();
+  return contact.last.contacts;
+}
+
+}  // namespace
+
+InteractiveResult run_interactive(Simulation& sim, Device& device, const InteractiveOptions& options) {
+  if (!(options.duration >= 0) || !(options.haptic_rate > 0)) throw Error("interactive run: bad duration or haptic rate");
+  if (sim.solver().kind == SolverKind::STATIC) throw Error("interactive run: needs a dynamic solver (explicit or implicit)");
+  ContactForces contact(sim.model(), options.probe);
+  sim.set_dynamic_forces(&contact);
+  struct Detach {  // the simulation must not keep a pointer to `contact` if a step throws
+    Simulation& sim;
+    ~Detach() { sim.set_dynamic_forces(nullptr); }
+  } detach{sim};
+  const CouplingGains gains = coupling_budget(device.specs(), options.mapping.scale, options.coupling_safety);
+  const auto ticks = static_cast<std::size_t>(std::ceil(options.duration * options.haptic_rate)) + 16;
+  HapticLoop loop(device, options.mapping, gains, options.rules, options.haptic_rate, options.log ? ticks : 0);
+  InteractiveResult result;
+  const auto start = std::chrono::steady_clock::now();
+  const double t0 = sim.state().time;
+  if (options.real_time) {
+    loop.start();
+    for (;;) {
+      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      if (wall >= options.duration || loop.device_failed()) break;
+      if (sim.state().time - t0 > wall) {  // ahead of the wall clock: wait for it
+        std::this_thread::sleep_for(std::chrono::duration<double>(sim.state().time - t0 - wall));
+        continue;
+      }
+      result.max_contacts = std::max(result.max_contacts, simulation_step(sim, contact, loop));
+      ++result.simulation_steps;
+    }
+    loop.stop();
+  } else {
+    const double h = 1.0 / options.haptic_rate;
+    const auto n_ticks = static_cast<long long>(std::llround(options.duration * options.haptic_rate));
+    for (long long k = 1; k <= n_ticks; ++k) {
+      const double t = k * h;
+      if (!loop.tick(t, h)) break;
+      while (sim.state().time - t0 < t - 1e-12) {
+        result.max_contacts = std::max(result.max_contacts, simulation_step(sim, contact, loop));
+        ++result.simulation_steps;
+      }
+    }
+  }
+  result.simulation_wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.haptic = loop.stats();
+  result.log = loop.log();
+  return result;
+}
+
+}  // namespace pointhaptics

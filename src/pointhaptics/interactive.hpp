@@ -1,0 +1,35 @@
+#pragma once
+/// @file An interactive run: the simulation and the haptic loop together, a probe driven by a device.
+#include <pointhaptics/haptics/haptic_loop.hpp>
+#include <pointhaptics/simulation.hpp>
+
+namespace pointhaptics {
+
+struct InteractiveOptions {
+  ProbeParams probe;
+  WorkspaceMapping mapping;
+  double duration = 1.0;         ///< s
+  double haptic_rate = 1000.0;   ///< Hz
+  double coupling_safety = 0.5;  ///< fraction of the device's stable stiffness the coupling may use
+  ForceRules rules;
+  bool real_time = true;         ///< threads on the wall clock; false: one thread, deterministic, simulated time
+  bool log = true;               ///< keep the force log (one row per haptic tick)
+};
+
+struct InteractiveResult {
+  HapticStats haptic;
+  std::vector<HapticLogRow> log;
+  long long simulation_steps = 0;
+  double simulation_wall_s = 0;
+  int max_contacts = 0;
+};
+
+/// Run the simulation with a probe driven by `device` for options.duration. Real time: the haptic loop
+/// ticks on its own thread at the haptic rate while this thread steps the simulation as fast as it can
+/// (but never ahead of the wall clock), exchanging the probe and the local contact model through
+/// lock-free buffers. Deterministic (real_time = false): the same exchange, interleaved on one thread in
+/// simulated time (a haptic tick every 1/rate s, a simulation step every dt), for tests and experiments.
+/// A device that fails stops the run with zero force; the result says so. Throws Error on bad options.
+InteractiveResult run_interactive(Simulation& sim, Device& device, const InteractiveOptions& options);
+
+}  // namespace pointhaptics

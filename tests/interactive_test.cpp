@@ -1,0 +1,161 @@
+// Tests for interactive (the simulation with a probe driven by a device through the haptic loop):
+// closed-loop stability, the device force limit, a fast probe through the object, a failing device,
+// and a short threaded run in real time.
+#include <pointhaptics/haptics/devices/virtual_device.hpp>
+#include <pointhaptics/interactive.hpp>
+#include <pointhaptics/io/scene_toml.hpp>
+#include <pointhaptics/scene_builder.hpp>
+
+#include <gtest/gtest.h>
+
+namespace pointhaptics {
+namespace {
+
+// the seed's beam (both ends held), soft enough to be pushed in by a hand
+Simulation seed_beam(double damping = 5.0, double young = 1e4) {
+  const std::string text = R"(
+[object]
+shape = "box"
+size = [0.135, 0.03, 0.03]
+spacing = 0.015
+[material]
+young = )" + std::to_string(young) + R"(
+poisson = 0.4
+density = 1000.0
+damping = )" + std::to_string(damping) + R"(
+[[fixed]]
+box = { min = [-1.0, -1.0, -1.0], max = [0.0, 1.0, 1.0] }
+[[fixed]]
+box = { min = [0.135, -1.0, -1.0], max = [1.0, 1.0, 1.0] }
+[solver]
+kind = "explicit"
+dt = 1e-3
+)";
+  const Scene scene = parse_scene(text);
+  return Simulation(build_scene_model(scene), scene.solver, 1);
+}
+
+InteractiveOptions options(double duration, ProbeMode mode = ProbeMode::PUSH) {
+  InteractiveOptions o;
+  o.duration = duration;
+  o.real_time = false;
+  o.probe.radius = 0.01;
+  o.probe.mode = mode;
+  o.mapping.origin = Vec3(0.0675, 0.05, 0.015);  // device origin above the middle of the top face
+  o.coupling_safety = 1.0;                        // the largest stiffness the coupling allows
+  return o;
+}
+
+TEST(Interactive, ClosedLoopPushDoesNotGainEnergy) {
+  Simulation sim = seed_beam();
+  // the hand presses the probe 1.5 cm into the top face, holds, and withdraws, for 10 s
+  VirtualDevice device(Trajectory({{0.0, Vec3(0, 0, 0), false},
+                                   {2.0, Vec3(0, -0.045, 0), false},
+                                   {7.0, Vec3(0, -0.045, 0), false},
+                                   {9.0, Vec3(0, 0, 0), false},
+                                   {10.0, Vec3(0, 0, 0), false}}),
+                       known_device_specs("touch"));
+  const InteractiveResult r = run_interactive(sim, device, options(10.0));
+  EXPECT_FALSE(r.haptic.device_failed) << r.haptic.device_error;
+  EXPECT_EQ(r.haptic.ticks, 10000);
+  EXPECT_EQ(r.simulation_steps, 10000);
+  EXPECT_GT(r.max_contacts, 0);
+  EXPECT_GT(r.haptic.max_force_n, 0.1);
+  // passivity: the environment never gives back more energy than the hand put in
+  EXPECT_GT(r.haptic.min_observed_energy, -1e-4);
+  EXPECT_TRUE(sim.state().u.allFinite());
+  // and after the hand withdrew, the beam comes back to rest
+  EXPECT_LT(sim.state().u.cwiseAbs().maxCoeff(), 2e-3);
+}
+
+TEST(Interactive, DeviceForceNeverExceedsItsLimit) {
+  Simulation sim = seed_beam(20.0, 1e6);  // stiff: the probe cannot go through
+  // the hand tries to go far through the object: the coupling asks for more than the device can give
+  VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), false}, {1.0, Vec3(0, -0.2, 0), false}, {3.0, Vec3(0, -0.2, 0), false}}),
+                       known_device_specs("touch"));
+  const InteractiveResult r = run_interactive(sim, device, options(3.0));
+  EXPECT_LE(r.haptic.max_force_n, 3.3 + 1e-12);
+  EXPECT_GT(r.haptic.max_force_n, 1.0);
+  for (const HapticLogRow& row : r.log) ASSERT_LE(row.force.norm(), 3.3 + 1e-12);
+  EXPECT_TRUE(sim.state().u.allFinite());
+}
+
+TEST(Interactive, FastProbeThroughTheWholeObjectNeitherCrashesNorMakesNaN) {
+  Simulation sim = seed_beam(20.0);
+  HandDynamics stiff_hand;
+  stiff_hand.stiffness = 5000;  // a hand that goes where it wants, at 1 m/s
+  stiff_hand.damping = 40;
+  VirtualDevice device(Trajectory({{0.0, Vec3(-0.1, -0.035, 0), false}, {0.2, Vec3(0.1, -0.035, 0), false},
+                                   {0.4, Vec3(-0.1, -0.035, 0), false}}),
+                       known_device_specs("touch"), stiff_hand);
+  const InteractiveResult r = run_interactive(sim, device, options(0.5));
+  EXPECT_FALSE(r.haptic.device_failed);
+  EXPECT_GT(r.max_contacts, 0);
+  EXPECT_TRUE(sim.state().u.allFinite());
+  for (const HapticLogRow& row : r.log) ASSERT_TRUE(row.force.allFinite());
+}
+
+TEST(Interactive, GrabPullsThePointUpAndLetsItGo) {
+  Simulation sim = seed_beam();
+  VirtualDevice device(Trajectory({{0.0, Vec3(0, -0.02, 0), false},
+                                   {0.2, Vec3(0, -0.02, 0), true},
+                                   {1.0, Vec3(0, -0.01, 0), true},
+                                   {2.0, Vec3(0, -0.01, 0), false},
+                                   {4.0, Vec3(0, -0.01, 0), false}}),
+                       known_device_specs("touch"));
+  InteractiveOptions o = options(1.5, ProbeMode::GRAB);
+  const InteractiveResult held = run_interactive(sim, device, o);
+  EXPECT_GT(held.max_contacts, 0);
+  double top = -1;
+  for (index_t i = 0; i < sim.model().n_points; ++i)
+    if (std::abs(sim.model().X(0, i) - 0.06) < 0.01 && sim.model().X(1, i) == 0.03) top = std::max(top, sim.state().u(1, i));
+  EXPECT_GT(top, 1e-3);  // pulled up by about a centimetre
+  o.duration = 2.5;      // released at 2 s: it springs back
+  run_interactive(sim, device, o);
+  EXPECT_LT(sim.state().u.cwiseAbs().maxCoeff(), 1e-3);
+}
+
+class FailingDevice : public VirtualDevice {
+ public:
+  using VirtualDevice::VirtualDevice;
+  DeviceState read(double t) override {
+    if (t > 0.1) throw DeviceError("device unplugged");
+    return VirtualDevice::read(t);
+  }
+  void command(const Vec3& f) override {
+    last = f;
+    VirtualDevice::command(f);
+  }
+  void stop() override {
+    last.setZero();
+    stopped = true;
+  }
+  Vec3 last = Vec3::Zero();
+  bool stopped = false;
+};
+
+TEST(Interactive, AFailingDeviceStopsTheRunWithZeroForce) {
+  Simulation sim = seed_beam();
+  FailingDevice device(Trajectory({{0.0, Vec3(0, -0.045, 0), false}}), known_device_specs("touch"));
+  const InteractiveResult r = run_interactive(sim, device, options(1.0));
+  EXPECT_TRUE(r.haptic.device_failed);
+  EXPECT_EQ(r.haptic.device_error, "device unplugged");
+  EXPECT_TRUE(device.stopped);
+  EXPECT_EQ(device.last, Vec3::Zero());
+  EXPECT_LE(r.haptic.ticks, 101);
+}
+
+TEST(Interactive, RealTimeRunTicksAtTheHapticRate) {
+  Simulation sim = seed_beam();
+  VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), false}, {0.3, Vec3(0, -0.04, 0), false}}), known_device_specs("touch"));
+  InteractiveOptions o = options(0.3);
+  o.real_time = true;
+  const InteractiveResult r = run_interactive(sim, device, o);
+  EXPECT_FALSE(r.haptic.device_failed);
+  EXPECT_GT(r.haptic.ticks, 150);  // 300 expected; a loaded CI machine may lose some (not a timing test)
+  EXPECT_GT(r.simulation_steps, 10);
+  EXPECT_TRUE(sim.state().u.allFinite());
+}
+
+}  // namespace
+}  // namespace pointhaptics
