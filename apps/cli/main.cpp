@@ -20,6 +20,8 @@ namespace {
 struct RunOptions {
   std::string scene;
   std::string json;
+  std::string force_log;
+  bool deterministic = false;
   bool quiet = false;
   int threads = 0;
 };
@@ -61,13 +63,42 @@ int run_command(const RunOptions& opt) {
   const ph::Scene scene = ph::read_scene_file(opt.scene);
   ph::Simulation sim(ph::build_scene_model(scene), scene.solver, opt.threads);
   const double setup_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  {
+  ph::InteractiveResult interactive;
+  if (scene.probe.present) {
+    // with a probe: the haptic loop at 1 kHz and the simulation, in real time unless asked otherwise
+    const std::unique_ptr<ph::Device> device = ph::make_scene_device(scene);
+    ph::InteractiveOptions options = ph::scene_interactive_options(scene, sim.model());
+    options.real_time = !opt.deterministic;
+    options.log = !opt.force_log.empty();
+    interactive = ph::run_interactive(sim, *device, options);
+    if (!opt.force_log.empty()) ph::write_haptic_log(opt.force_log, interactive.log);
+  } else {
     ph::cli::ProgressBar bar(!opt.quiet);
     sim.run(scene.solver.duration, [&](double f) { bar.update(f); });
   }
-  const ph::RunSummary summary = sim.summary();
+  ph::RunSummary summary = sim.summary();
+  if (scene.probe.present) {
+    summary.haptic_ticks = interactive.haptic.ticks;
+    summary.haptic_rate_hz = interactive.haptic.rate_hz;
+    summary.haptic_period_p99_us = interactive.haptic.period_p99_us;
+    summary.haptic_max_force_n = interactive.haptic.max_force_n;
+  }
   if (!opt.json.empty()) ph::write_result_json(opt.json, sim.model(), sim.state(), summary);
-  if (!opt.quiet) print_summary(sim, summary, setup_s);
+  if (!opt.quiet) {
+    print_summary(sim, summary, setup_s);
+    if (scene.probe.present) {
+      const ph::HapticStats& h = interactive.haptic;
+      fmt::print("haptics         {} ticks at {:.0f} Hz, period error p50 {:.0f} us, p99 {:.0f} us, max {:.0f} us; "
+                 "longest tick {:.1f} us; max force {:.3g} N; up to {} points in contact; {} simulation steps\n",
+                 h.ticks, h.rate_hz, h.period_p50_us, h.period_p99_us, h.period_max_us, h.tick_max_us, h.max_force_n,
+                 interactive.max_contacts, interactive.simulation_steps);
+    }
+  }
+  if (scene.probe.present && interactive.haptic.device_failed) {
+    fmt::print(stderr, "pointhaptics: {}: the device failed: {} (force set to zero, run stopped)\n", opt.scene,
+               interactive.haptic.device_error);
+    return 1;
+  }
   if (!summary.converged) {
     fmt::print(stderr, "pointhaptics: {}: {}\n", opt.scene,
                summary.failure.empty() ? "the solver did not converge" : summary.failure);
@@ -88,6 +119,9 @@ int main(int argc, char** argv) {
   run_cmd->add_option("scene", run.scene, "Scene file (TOML)")->required();
   run_cmd->add_option("--json", run.json, "Write the result JSON to FILE");
   run_cmd->add_flag("--quiet,-q", run.quiet, "Print nothing but errors");
+  run_cmd->add_option("--force-log", run.force_log, "With a [probe]: write the haptic log (CSV, one row per tick) to FILE");
+  run_cmd->add_flag("--deterministic", run.deterministic,
+                    "With a [probe]: interleave haptic ticks and simulation steps on one thread in simulated time");
   run_cmd->add_option("--threads", run.threads, "Threads for the force evaluation (0: all)")->check(CLI::NonNegativeNumber);
 
   ph::bench::BenchOptions bench;

@@ -168,3 +168,65 @@ TEST(SceneToml, FilesAreReadAndRelativePathsResolved) {
 
 }  // namespace
 }  // namespace pointhaptics
+
+namespace pointhaptics {
+namespace {
+
+const char* probe_section = R"(
+[probe]
+radius = 0.01
+mode = "grab"
+keyframes = [[0.0, 0.0, 0.0, 0.0], [1.0, 0.0, -0.01, 0.0, 1]]
+origin = [0.07, 0.05, 0.015]
+scale = 2.0
+[device]
+kind = "virtual"
+specs = "omni"
+)";
+
+TEST(SceneToml, ReadsProbeAndDevice) {
+  const Scene s = parse_scene(std::string(full_scene) + probe_section, "p.toml");
+  EXPECT_TRUE(s.probe.present);
+  EXPECT_DOUBLE_EQ(s.probe.radius, 0.01);
+  EXPECT_TRUE(s.probe.grab);
+  ASSERT_EQ(s.probe.keyframes.size(), 2u);
+  EXPECT_DOUBLE_EQ(s.probe.keyframes[1][2], -0.01);
+  EXPECT_DOUBLE_EQ(s.probe.keyframes[1][4], 1.0);
+  EXPECT_DOUBLE_EQ(s.probe.origin.x(), 0.07);
+  EXPECT_DOUBLE_EQ(s.probe.scale, 2.0);
+  EXPECT_EQ(s.device.specs, "omni");
+  // a trajectory file is resolved against the scene's folder
+  std::string text = std::string(full_scene) + "[probe]\ntrajectory = \"probe.csv\"\n";
+  EXPECT_EQ(parse_scene(text, "dir/p.toml", "dir").probe.trajectory, "dir/probe.csv");
+}
+
+std::string probe_error(const std::string& find, const std::string& replace) {
+  std::string text = std::string(full_scene) + probe_section;
+  const size_t at = text.find(find);
+  EXPECT_NE(at, std::string::npos) << find;
+  text.replace(at, find.size(), replace);
+  try {
+    parse_scene(text, "bad.toml");
+  } catch (const Error& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "accepted: " << replace;
+  return {};
+}
+
+TEST(SceneToml, BadProbeOrDeviceIsANamedError) {
+  EXPECT_NE(probe_error("radius = 0.01", "radius = -1").find("probe.radius"), std::string::npos);
+  EXPECT_NE(probe_error("mode = \"grab\"", "mode = \"poke\"").find("probe.mode: unknown value \"poke\""), std::string::npos);
+  EXPECT_NE(probe_error("[1.0, 0.0, -0.01, 0.0, 1]", "[0.0, 0.0, -0.01]").find("probe.keyframes"), std::string::npos);
+  EXPECT_NE(probe_error("[1.0, 0.0, -0.01, 0.0, 1]", "[0.0, 0.0, -0.01, 0.0]").find("times must increase"), std::string::npos);
+  EXPECT_NE(probe_error("keyframes = [[0.0, 0.0, 0.0, 0.0], [1.0, 0.0, -0.01, 0.0, 1]]", "").find("needs trajectory"),
+            std::string::npos);
+  EXPECT_NE(probe_error("specs = \"omni\"", "specs = \"custom\"").find("custom specs need"), std::string::npos);
+  EXPECT_NE(probe_error("kind = \"virtual\"", "kind = \"replay\"").find("needs log"), std::string::npos);
+  EXPECT_NE(probe_error("kind = \"virtual\"", "kind = \"openhaptics\"").find("not implemented"), std::string::npos);
+  EXPECT_NE(probe_error("kind = \"explicit\"", "kind = \"static\"").find("needs a dynamic solver"), std::string::npos);
+  EXPECT_NE(probe_error("scale = 2.0", "scael = 2.0").find("probe.scael: unknown key"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace pointhaptics

@@ -42,8 +42,9 @@ std::string result_json(const Model& model, const State& state, const RunSummary
     constraints.push_back({{"points", model.fixed_groups[g].points.size()},
                            {"reaction", g < s.reactions.size() ? vec(s.reactions[g]) : vec(Vec3::Zero())}});
   doc["constraints"] = constraints;
-  // no probe and no levels of detail in this run: the blocks are there, empty
-  doc["haptic"] = {{"ticks", 0}, {"rate_hz", 0.0}, {"period_p99_us", 0.0}, {"max_force_n", 0.0}};
+  // zero without a probe; no levels of detail yet: that block is there, with every point selected
+  doc["haptic"] = {{"ticks", s.haptic_ticks}, {"rate_hz", s.haptic_rate_hz}, {"period_p99_us", s.haptic_period_p99_us},
+                   {"max_force_n", s.haptic_max_force_n}};
   doc["lod"] = {{"selected", model.n_points}, {"selection_ms", 0.0}};
   const ModelDiagnostics& d = model.diagnostics;
   doc["model"] = {{"points", model.n_points},

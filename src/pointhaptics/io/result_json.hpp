@@ -21,6 +21,9 @@ struct RunSummary {
   long long cg_iterations = 0;  ///< static, implicit: conjugate-gradient iterations in all
   std::string failure;          ///< static: why it did not converge (empty when it did)
   std::vector<Vec3> reactions;  ///< per fixed group, N
+  // haptic loop (runs with a probe)
+  long long haptic_ticks = 0;
+  double haptic_rate_hz = 0, haptic_period_p99_us = 0, haptic_max_force_n = 0;
 };
 
 /// The result document as a string (indented JSON).

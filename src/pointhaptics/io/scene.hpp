@@ -3,6 +3,8 @@
 #include <pointhaptics/core/parameters.hpp>
 #include <pointhaptics/core/types.hpp>
 
+#include <array>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -55,6 +57,27 @@ struct SolverSpec {
   int iteration_budget = 0;    ///< implicit: Newton iterations per step in real time, keeping the iterate (0 = off)
 };
 
+/// [probe]: a spherical probe driven by a device (design.md, "Haptics").
+struct ProbeSpec {
+  bool present = false;
+  double radius = 0.005;                   ///< m
+  bool grab = false;                       ///< mode = "grab" (else push)
+  std::string trajectory;                  ///< virtual device: CSV of t, x, y, z[, button] (resolved path)
+  std::vector<std::array<double, 5>> keyframes;  ///< or keyframes t, x, y, z, button
+  Vec3 origin = Vec3::Constant(NAN);       ///< scene position of the device origin, m (NaN: above the object's centre)
+  double scale = 1.0;                      ///< scene metres per device metre
+  double stiffness = 0;                    ///< contact spring per point, N/m (0: E x spacing)
+  int line = 0;
+};
+
+/// [device]: which device drives the probe.
+struct DeviceSpec {
+  std::string kind = "virtual";            ///< virtual | replay
+  std::string specs = "touch";             ///< touch | omni | falcon | custom
+  double max_force = 0, max_stiffness = 0, max_damping = 0, workspace_radius = 0;  ///< custom specs
+  std::string log;                         ///< replay: a recorded session (resolved path)
+};
+
 struct Scene {
   std::string path;  ///< the scene file ("<string>" when parsed from text), for messages
   ObjectSpec object;
@@ -63,6 +86,8 @@ struct Scene {
   std::vector<FixedSpec> fixed;
   std::vector<LoadSpec> loads;
   SolverSpec solver;
+  ProbeSpec probe;
+  DeviceSpec device;
 };
 
 std::string_view to_string(SolverKind kind);

@@ -247,6 +247,57 @@ LoadSpec read_load(TableReader& r) {
   return l;
 }
 
+std::string resolve(const Context& ctx, const std::string& file) {
+  std::filesystem::path p(file);
+  if (p.is_relative()) p = std::filesystem::path(ctx.base_dir) / p;
+  return p.lexically_normal().string();
+}
+
+void read_probe(TableReader& r, ProbeSpec& p, const Context& ctx) {
+  p.present = true;
+  p.line = r.line();
+  p.radius = r.number("radius", p.radius, positive, "must be > 0 (m)");
+  p.grab = r.choice("mode", "push", {"push", "grab"}) == "grab";
+  if (r.find("trajectory") && r.find("keyframes"))
+    r.fail_at(*r.find("keyframes"), "keyframes", "give either trajectory (a CSV file) or keyframes, not both");
+  if (r.find("trajectory")) p.trajectory = resolve(ctx, r.string("trajectory", ""));
+  if (const toml::node* node = r.find("keyframes")) {
+    const toml::array* rows = node->as_array();
+    if (!rows || rows->empty()) r.fail_at(*node, "keyframes", "expected [[t, x, y, z], ...] (a 5th value 1 holds the button)");
+    for (const toml::node& row : *rows) {
+      const toml::array* a = row.as_array();
+      if (!a || (a->size() != 4 && a->size() != 5))
+        r.fail_at(row, "keyframes", "each keyframe is [t, x, y, z] or [t, x, y, z, button]");
+      std::array<double, 5> k{0, 0, 0, 0, 0};
+      for (std::size_t c = 0; c < a->size(); ++c) k[c] = r.as_number(*a->get(c), "keyframes");
+      if (!p.keyframes.empty() && !(k[0] > p.keyframes.back()[0])) r.fail_at(row, "keyframes", "times must increase");
+      p.keyframes.push_back(k);
+    }
+  }
+  if (r.find("origin")) p.origin = r.vec3("origin", p.origin);
+  p.scale = r.number("scale", p.scale, positive, "must be > 0 (scene metres per device metre)");
+  p.stiffness = r.number("stiffness", p.stiffness, non_negative, "must be >= 0 (N/m)");
+}
+
+void read_device(TableReader& r, DeviceSpec& d, const Context& ctx) {
+  d.kind = r.choice("kind", "virtual", {"virtual", "replay", "openhaptics"});
+  if (d.kind == "openhaptics")
+    r.fail_at(*r.find("kind"), "kind", "the OpenHaptics backend is part of the design but not implemented in this version yet");
+  d.specs = r.choice("specs", "touch", {"touch", "omni", "falcon", "custom"});
+  if (d.specs == "custom") {
+    for (const char* key : {"max_force", "max_stiffness", "workspace_radius"})
+      if (!r.find(key)) r.fail_table(key, "custom specs need max_force, max_stiffness and workspace_radius");
+    d.max_force = r.number("max_force", 0.0, positive, "must be > 0 (N)");
+    d.max_stiffness = r.number("max_stiffness", 0.0, positive, "must be > 0 (N/m)");
+    d.max_damping = r.number("max_damping", 0.0, non_negative, "must be >= 0 (N s/m)");
+    d.workspace_radius = r.number("workspace_radius", 0.0, positive, "must be > 0 (m)");
+  }
+  if (d.kind == "replay") {
+    if (!r.find("log")) r.fail_table("log", "a replay device needs log = \"session.csv\" (a recorded force log)");
+    d.log = resolve(ctx, r.string("log", ""));
+  }
+}
+
 // [[name]] arrays of tables
 template <class Read>
 void read_array_of_tables(TableReader& root, std::string_view key, Read read) {
@@ -276,7 +327,7 @@ Scene parse_scene(std::string_view text, const std::string& name, const std::str
   Scene scene;
   scene.path = name;
   TableReader top(ctx, root, "");
-  for (std::string_view later : {"lod", "probe", "device"})
+  for (std::string_view later : {"lod"})
     if (const toml::node* node = top.find(later))
       top.fail_at(*node, later, fmt::format("[{}] is part of the design but not implemented in this version yet", later));
   auto section = [&](std::string_view key, auto read) {
@@ -291,6 +342,16 @@ Scene parse_scene(std::string_view text, const std::string& name, const std::str
   section("material", [&](TableReader& r) { read_material(r, scene.material); });
   section("kernel", [&](TableReader& r) { read_kernel(r, scene.kernel); });
   section("solver", [&](TableReader& r) { read_solver(r, scene.solver); });
+  section("probe", [&](TableReader& r) { read_probe(r, scene.probe, ctx); });
+  section("device", [&](TableReader& r) { read_device(r, scene.device, ctx); });
+  if (scene.probe.present && scene.device.kind == "virtual" && scene.probe.trajectory.empty() && scene.probe.keyframes.empty())
+    throw Error(fmt::format("{}:{}: probe: a virtual device needs trajectory = \"probe.csv\" or keyframes = [[t, x, y, z], ...]",
+                            name, scene.probe.line));
+  if (root.get("device") && !scene.probe.present)
+    throw Error(fmt::format("{}: device: a [device] needs a [probe] to drive", name));
+  if (scene.probe.present && scene.solver.kind == SolverKind::STATIC)
+    throw Error(fmt::format("{}:{}: probe: a probe needs a dynamic solver (solver.kind = \"explicit\" or \"implicit\")",
+                            name, scene.probe.line));
   read_array_of_tables(top, "fixed", [&](TableReader& r) { scene.fixed.push_back(read_fixed(r)); });
   read_array_of_tables(top, "load", [&](TableReader& r) { scene.loads.push_back(read_load(r)); });
   top.finish();

@@ -1,0 +1,57 @@
+#include <pointhaptics/haptics/haptic_log.hpp>
+
+#include <fmt/format.h>
+#include <fmt/os.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+namespace pointhaptics {
+
+void write_haptic_log(const std::string& path, const std::vector<HapticLogRow>& rows) {
+  try {
+    auto out = fmt::output_file(path);
+    out.print("t,x,y,z,vx,vy,vz,buttons,fx,fy,fz\n");
+    for (const HapticLogRow& r : rows)
+      out.print("{:.6f},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{},{:.9g},{:.9g},{:.9g}\n", r.t, r.position.x(),
+                r.position.y(), r.position.z(), r.velocity.x(), r.velocity.y(), r.velocity.z(), r.buttons, r.force.x(),
+                r.force.y(), r.force.z());
+  } catch (const std::exception& e) {
+    throw Error(fmt::format("{}: cannot write the haptic log ({})", path, e.what()));
+  }
+}
+
+std::vector<HapticLogRow> read_haptic_log(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw Error(fmt::format("{}: cannot open the haptic log", path));
+  std::vector<HapticLogRow> rows;
+  std::string line;
+  int line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line_no == 1 && line.rfind("t,", 0) == 0) continue;  // header
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    std::istringstream fields(line);
+    double v[11];
+    int n = 0;
+    for (std::string field; n < 12 && std::getline(fields, field, ',');) {
+      char* end = nullptr;
+      const double x = std::strtod(field.c_str(), &end);
+      if (end == field.c_str() || (*end != '\0' && *end != '\r') || !std::isfinite(x) || n == 11) {
+        n = -1;
+        break;
+      }
+      v[n++] = x;
+    }
+    if (n != 11) throw Error(fmt::format("{}:{}: expected 11 finite numbers (t,x,y,z,vx,vy,vz,buttons,fx,fy,fz)", path, line_no));
+    HapticLogRow r{v[0], Vec3(v[1], v[2], v[3]), Vec3(v[4], v[5], v[6]), static_cast<unsigned>(v[7]), Vec3(v[8], v[9], v[10])};
+    if (!rows.empty() && !(r.t > rows.back().t)) throw Error(fmt::format("{}:{}: time does not increase", path, line_no));
+    rows.push_back(r);
+  }
+  if (rows.empty()) throw Error(fmt::format("{}: the haptic log has no rows", path));
+  return rows;
+}
+
+}  // namespace pointhaptics

@@ -1,0 +1,16 @@
+#pragma once
+/// @file The haptic log: one row per tick (time, device position and velocity, buttons, force), as CSV.
+/// The replay device reads the same format back.
+#include <pointhaptics/haptics/haptic_loop.hpp>
+
+#include <string>
+#include <vector>
+
+namespace pointhaptics {
+
+/// Header: t,x,y,z,vx,vy,vz,buttons,fx,fy,fz (s, m, m/s, bit mask, N; device frame).
+void write_haptic_log(const std::string& path, const std::vector<HapticLogRow>& rows);
+/// Throws Error naming the file and line for a malformed, non-finite or out-of-order row.
+std::vector<HapticLogRow> read_haptic_log(const std::string& path);
+
+}  // namespace pointhaptics

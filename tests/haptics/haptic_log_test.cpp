@@ -1,0 +1,55 @@
+// Tests for haptics/haptic_log and haptics/devices/replay_device: the log round-trips, bad logs are named
+// errors, and a replay follows the recorded positions.
+#include <pointhaptics/haptics/devices/replay_device.hpp>
+#include <pointhaptics/haptics/haptic_log.hpp>
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+namespace pointhaptics {
+namespace {
+
+std::string temp(const std::string& name) { return ::testing::TempDir() + name; }
+
+TEST(HapticLog, RoundTripsAndReplays) {
+  std::vector<HapticLogRow> rows;
+  for (int k = 0; k <= 10; ++k)
+    rows.push_back({k * 1e-3, Vec3(0, -1e-3 * k, 0), Vec3(0, -1.0, 0), k >= 5 ? 1u : 0u, Vec3(0, 0.01 * k, 0)});
+  write_haptic_log(temp("log.csv"), rows);
+  const std::vector<HapticLogRow> back = read_haptic_log(temp("log.csv"));
+  ASSERT_EQ(back.size(), rows.size());
+  for (size_t k = 0; k < rows.size(); ++k) {
+    EXPECT_NEAR(back[k].t, rows[k].t, 1e-9);
+    EXPECT_LE((back[k].position - rows[k].position).norm(), 1e-12);
+    EXPECT_EQ(back[k].buttons, rows[k].buttons);
+    EXPECT_LE((back[k].force - rows[k].force).norm(), 1e-12);
+  }
+  ReplayDevice replay(back, known_device_specs("touch"));
+  EXPECT_NEAR(replay.read(2.5e-3).position.y(), -2.5e-3, 1e-12);
+  EXPECT_EQ(replay.read(6e-3).buttons, 1u);
+  EXPECT_NEAR(replay.read(1.0).position.y(), -1e-2, 1e-12);  // held after the end
+  EXPECT_EQ(replay.read(1.0).velocity, Vec3::Zero());
+}
+
+TEST(HapticLog, BadLogsAreNamedErrors) {
+  auto error_of = [](const std::string& text) {
+    std::ofstream(temp("bad.csv")) << text;
+    try {
+      read_haptic_log(temp("bad.csv"));
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(error_of("t,x,y,z,vx,vy,vz,buttons,fx,fy,fz\n").find("no rows"), std::string::npos);
+  EXPECT_NE(error_of("0,0,0,0,0,0,0,0,0,0\n").find("bad.csv:1:"), std::string::npos);        // 10 fields
+  EXPECT_NE(error_of("0,0,0,0,0,0,0,0,0,0,0,0\n").find("bad.csv:1:"), std::string::npos);    // 12 fields
+  EXPECT_NE(error_of("0,0,nan,0,0,0,0,0,0,0,0\n").find("bad.csv:1:"), std::string::npos);
+  EXPECT_NE(error_of("1,0,0,0,0,0,0,0,0,0,0\n0.5,0,0,0,0,0,0,0,0,0,0\n").find("bad.csv:2: time does not increase"),
+            std::string::npos);
+  EXPECT_THROW(read_haptic_log("/nonexistent/log.csv"), Error);
+}
+
+}  // namespace
+}  // namespace pointhaptics

@@ -1,0 +1,18 @@
+# Replays a recorded force log through the same scene: the scene's [device] becomes a replay of LOG.
+file(MAKE_DIRECTORY ${WORK})
+file(READ ${SCENE} text)
+string(REGEX REPLACE "\\[device\\][^\\[]*" "" text "${text}")
+string(REGEX REPLACE "keyframes = [^\n]*\n" "" text "${text}")
+file(WRITE ${WORK}/replay.toml "${text}\n[device]\nkind = \"replay\"\nlog = \"${LOG}\"\n")
+execute_process(COMMAND ${EXE} run ${WORK}/replay.toml --quiet --deterministic --json ${WORK}/replay.json
+                RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "replay run failed (${rc}): ${err}")
+endif()
+file(READ ${WORK}/replay.json json)
+string(JSON ticks GET "${json}" haptic ticks)
+string(JSON force GET "${json}" haptic max_force_n)
+if(ticks LESS 2900 OR force LESS_EQUAL 0.1)
+  message(FATAL_ERROR "replay: ${ticks} ticks, max force ${force} N")
+endif()
+message(STATUS "replay: ${ticks} ticks, max force ${force} N")
