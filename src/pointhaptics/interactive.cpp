@@ -1,5 +1,6 @@
 #include <pointhaptics/interactive.hpp>
 
+#include <pointhaptics/haptics/devices/openhaptics_device.hpp>
 #include <pointhaptics/haptics/devices/replay_device.hpp>
 #include <pointhaptics/haptics/devices/virtual_device.hpp>
 #include <pointhaptics/haptics/haptic_log.hpp>
@@ -53,6 +54,7 @@ DeviceSpecs scene_device_specs(const DeviceSpec& d) {
 std::unique_ptr<Device> make_scene_device(const Scene& scene) {
   const DeviceSpecs specs = scene_device_specs(scene.device);
   if (scene.device.kind == "replay") return std::make_unique<ReplayDevice>(read_haptic_log(scene.device.log), specs);
+  if (scene.device.kind == "openhaptics") return std::make_unique<OpenHapticsDevice>(scene.device.library);  // its own specs
   if (scene.device.kind != "virtual") throw Error(fmt::format("{}: device.kind = \"{}\" is not available", scene.path, scene.device.kind));
   if (!scene.probe.trajectory.empty()) return std::make_unique<VirtualDevice>(Trajectory::from_csv(scene.probe.trajectory), specs);
   std::vector<Keyframe> frames;

@@ -223,7 +223,8 @@ TEST(SceneToml, BadProbeOrDeviceIsANamedError) {
             std::string::npos);
   EXPECT_NE(probe_error("specs = \"omni\"", "specs = \"custom\"").find("custom specs need"), std::string::npos);
   EXPECT_NE(probe_error("kind = \"virtual\"", "kind = \"replay\"").find("needs log"), std::string::npos);
-  EXPECT_NE(probe_error("kind = \"virtual\"", "kind = \"openhaptics\"").find("not implemented"), std::string::npos);
+  EXPECT_NE(probe_error("kind = \"virtual\"", "kind = \"openhaptics\"\nlibary = \"x.so\"").find("device.libary: unknown key"),
+            std::string::npos);
   EXPECT_NE(probe_error("kind = \"explicit\"", "kind = \"static\"").find("needs a dynamic solver"), std::string::npos);
   EXPECT_NE(probe_error("scale = 2.0", "scael = 2.0").find("probe.scael: unknown key"), std::string::npos);
 }

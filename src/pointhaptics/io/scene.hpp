@@ -72,10 +72,11 @@ struct ProbeSpec {
 
 /// [device]: which device drives the probe.
 struct DeviceSpec {
-  std::string kind = "virtual";            ///< virtual | replay
+  std::string kind = "virtual";            ///< virtual | replay | openhaptics
   std::string specs = "touch";             ///< touch | omni | falcon | custom
   double max_force = 0, max_stiffness = 0, max_damping = 0, workspace_radius = 0;  ///< custom specs
   std::string log;                         ///< replay: a recorded session (resolved path)
+  std::string library = "libHD.so";        ///< openhaptics: the HD library to load
 };
 
 struct Scene {

@@ -281,8 +281,7 @@ void read_probe(TableReader& r, ProbeSpec& p, const Context& ctx) {
 
 void read_device(TableReader& r, DeviceSpec& d, const Context& ctx) {
   d.kind = r.choice("kind", "virtual", {"virtual", "replay", "openhaptics"});
-  if (d.kind == "openhaptics")
-    r.fail_at(*r.find("kind"), "kind", "the OpenHaptics backend is part of the design but not implemented in this version yet");
+  if (d.kind == "openhaptics") d.library = r.string("library", d.library);
   d.specs = r.choice("specs", "touch", {"touch", "omni", "falcon", "custom"});
   if (d.specs == "custom") {
     for (const char* key : {"max_force", "max_stiffness", "workspace_radius"})
