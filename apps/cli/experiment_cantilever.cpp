@@ -1,5 +1,7 @@
 #include "experiment_cantilever.hpp"
 
+#include "plots.hpp"
+
 #include <pointhaptics/core/error.hpp>
 #include <pointhaptics/fem/calculix.hpp>
 #include <pointhaptics/pointhaptics.hpp>
@@ -14,12 +16,6 @@
 #include <optional>
 #include <thread>
 
-#ifndef PH_PLOT_SCRIPT_SOURCE
-#define PH_PLOT_SCRIPT_SOURCE ""
-#endif
-#ifndef PH_PLOT_SCRIPT_INSTALLED
-#define PH_PLOT_SCRIPT_INSTALLED ""
-#endif
 
 namespace pointhaptics::experiments {
 namespace {
@@ -142,12 +138,6 @@ double extrapolate(double d1, double d2, double d3) {
   return d3 + b * b / (a - b);
 }
 
-std::string find_plot_script(const std::string& given) {
-  if (!given.empty()) return given;
-  for (const char* candidate : {PH_PLOT_SCRIPT_SOURCE, PH_PLOT_SCRIPT_INSTALLED})
-    if (*candidate && std::filesystem::exists(candidate)) return candidate;
-  return "";
-}
 
 }  // namespace
 
@@ -325,18 +315,7 @@ int run_cantilever_experiment(const CantileverOptions& options) {
   md.close();
 
   // plots (matplotlib from Debian's python3-matplotlib)
-  const std::string script = find_plot_script(options.plot_script);
-  if (script.empty()) {
-    fmt::print(stderr, "pointhaptics: plot_cantilever.py not found; CSV and summary written, no plots\n");
-    return 1;
-  }
-  // Debian's interpreter first: python3-matplotlib is installed for it, whatever else is on PATH
-  const std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-  const std::string command = fmt::format("{} '{}' '{}'", python, script, out.string());
-  if (std::system(command.c_str()) != 0) {
-    fmt::print(stderr, "pointhaptics: the plots failed ({}); is python3-matplotlib installed?\n", command);
-    return 1;
-  }
+  if (run_plot_script("plot_cantilever.py", out.string(), options.plot_script) != 0) return 1;
   fmt::print("wrote {}\n", out.string());
   return 0;
 }

@@ -1,6 +1,7 @@
 // pointhaptics: the command line. `pointhaptics <command> [scene.toml] [options]`, --help on every command.
 #include "experiment_beam.hpp"
 #include "experiment_cantilever.hpp"
+#include "experiment_force_profile.hpp"
 #include "progress_bar.hpp"
 
 #include <pointhaptics/pointhaptics.hpp>
@@ -151,12 +152,19 @@ int main(int argc, char** argv) {
   beam_cmd->add_option("--duration", beam.duration, "Simulated seconds of the dynamic runs")->check(CLI::PositiveNumber);
   beam_cmd->add_flag("!--no-implicit", beam.implicit, "Skip the (slow) implicit runs");
 
+  ph::experiments::ForceProfileOptions profile;
+  CLI::App* profile_cmd = experiment_cmd->add_subcommand(
+      "force-profile", "Seed Fig. 2c: the force felt while dragging a point of the beam and letting it go");
+  profile_cmd->add_option("--out", profile.out, "Output folder")->required();
+  profile_cmd->add_flag("--real-time", profile.real_time, "Run the haptic thread on the wall clock (default: simulated time)");
+
   CLI11_PARSE(app, argc, argv);
   try {
     if (*run_cmd) return run_command(run);
     if (*bench_cmd) return ph::bench::run_bench_suite(bench);
     if (*cantilever_cmd) return ph::experiments::run_cantilever_experiment(cantilever);
     if (*beam_cmd) return ph::experiments::run_beam_experiment(beam);
+    if (*profile_cmd) return ph::experiments::run_force_profile_experiment(profile);
   } catch (const ph::Error& e) {
     std::fprintf(stderr, "pointhaptics: error: %s\n", e.what());
     return 1;
