@@ -4,6 +4,8 @@
 #include <pointhaptics/geometry/sampling.hpp>
 #include <pointhaptics/mechanics/forces.hpp>
 #include <pointhaptics/mechanics/model_builder.hpp>
+#include <pointhaptics/haptics/devices/virtual_device.hpp>
+#include <pointhaptics/interactive.hpp>
 #include <pointhaptics/scene_builder.hpp>
 #include <pointhaptics/simulation.hpp>
 #include <pointhaptics/solvers/explicit_solver.hpp>
@@ -122,14 +124,66 @@ void beam_benchmark(benchmark::State& state) {
       benchmark::Counter(static_cast<double>(state.iterations()) * simulated, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
+// the haptic loop in real time while the simulation steps a ~10k-point object on the other core:
+// achieved rate, period error quantiles, the longest tick (one iteration = 2 s of wall time)
+void haptic_benchmark(benchmark::State& state) {
+  Scene s;
+  s.path = "haptic-bench";
+  const int side = std::max(2, static_cast<int>(std::lround(std::cbrt(static_cast<double>(state.range(0))))));
+  s.object.spacing = 0.004;
+  s.object.size = Vec3::Constant(s.object.spacing * (side - 1));
+  s.material.young = 2e4;
+  s.material.damping = 10;
+  FixedSpec base;
+  base.box = {Vec3(-1, -1, -1), Vec3(1, 0, 1)};
+  s.fixed.push_back(base);
+  s.solver.kind = SolverKind::EXPLICIT;
+  s.solver.dt = 1e-3;
+  const Model model = build_scene_model(s);
+  HapticStats stats;
+  long long steps = 0;
+  double wall = 0;
+  for (auto _ : state) {
+    Simulation sim(model, s.solver, 1);  // one core for the simulation, one for the haptic loop
+    VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), false}, {1.0, Vec3(0, -0.02, 0), false}, {2.0, Vec3::Zero(), false}}),
+                         known_device_specs("touch"));
+    InteractiveOptions o;
+    o.duration = 2.0;
+    o.probe.radius = 0.01;
+    const Vec3 hi = model.X.rowwise().maxCoeff();
+    o.mapping.origin = Vec3(0.5 * hi.x(), hi.y() + 0.02, 0.5 * hi.z());
+    o.log = false;
+    const InteractiveResult r = run_interactive(sim, device, o);
+    stats = r.haptic;
+    steps = r.simulation_steps;
+    wall = r.simulation_wall_s;
+  }
+  state.counters["points"] = model.n_points;
+  state.counters["rate_hz"] = stats.rate_hz;
+  state.counters["period_p50_us"] = stats.period_p50_us;
+  state.counters["period_p99_us"] = stats.period_p99_us;
+  state.counters["period_max_us"] = stats.period_max_us;
+  state.counters["tick_max_us"] = stats.tick_max_us;
+  state.counters["sim_steps_per_s"] = wall > 0 ? steps / wall : 0.0;
+}
+
 // collects each run's counters for the JSON while the console reporter prints the table
 class CollectingReporter : public benchmark::ConsoleReporter {
  public:
-  nlohmann::json force = nlohmann::json::array(), step = nlohmann::json::array(), beam = nlohmann::json::array();
+  nlohmann::json force = nlohmann::json::array(), step = nlohmann::json::array(), beam = nlohmann::json::array(),
+                 haptic = nlohmann::json::array();
   void ReportRuns(const std::vector<Run>& runs) override {
     ConsoleReporter::ReportRuns(runs);
     for (const Run& run : runs) {
       if (run.error_occurred) continue;
+      if (run.benchmark_name().rfind("haptic", 0) == 0) {
+        nlohmann::json row;
+        for (const char* key : {"points", "rate_hz", "period_p50_us", "period_p99_us", "period_max_us", "tick_max_us",
+                                "sim_steps_per_s"})
+          row[key] = static_cast<double>(run.counters.at(key).value);
+        haptic.push_back(row);
+        continue;
+      }
       if (run.benchmark_name().rfind("beam4x1x1", 0) == 0) {
         beam.push_back({{"solver", run.benchmark_name().find("implicit") != std::string::npos ? "implicit" : "explicit"},
                         {"threads", static_cast<int>(run.counters.at("threads").value)},
@@ -164,6 +218,8 @@ int run_bench_suite(const BenchOptions& options) {
       benchmark::RegisterBenchmark(fmt::format("beam4x1x1/{}/threads:{}", solver ? "implicit" : "explicit", t).c_str(),
                                    beam_benchmark)
           ->Args({solver, t})->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
+  benchmark::RegisterBenchmark("haptic/points:10000", haptic_benchmark)
+      ->Args({10000})->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
   std::string filter_flag = "--benchmark_filter=" + options.filter;
   std::string name = "pointhaptics-bench";
   char* argv[] = {name.data(), filter_flag.data(), nullptr};
@@ -178,7 +234,7 @@ int run_bench_suite(const BenchOptions& options) {
       fmt::print(stderr, "pointhaptics bench: cannot write {}\n", options.json_path);
       return 1;
     }
-    out << nlohmann::json{{"force", reporter.force}, {"step", reporter.step}, {"beam_4x1x1", reporter.beam}}.dump(1) << '\n';
+    out << nlohmann::json{{"force", reporter.force}, {"step", reporter.step}, {"beam_4x1x1", reporter.beam}, {"haptic", reporter.haptic}}.dump(1) << '\n';
   }
   return 0;
 }

@@ -8,6 +8,9 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <thread>
+
 namespace pointhaptics {
 namespace {
 
@@ -145,12 +148,31 @@ TEST(Interactive, AFailingDeviceStopsTheRunWithZeroForce) {
   EXPECT_LE(r.haptic.ticks, 101);
 }
 
-TEST(Interactive, RealTimeRunTicksAtTheHapticRate) {
+TEST(Interactive, RealTimeRunTicksAtTheHapticRateAndPublishesFrames) {
   Simulation sim = seed_beam();
   VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), false}, {0.3, Vec3(0, -0.04, 0), false}}), known_device_specs("touch"));
   InteractiveOptions o = options(0.3);
   o.real_time = true;
+  // an output thread reads the published frames while the simulation and the haptic loop run
+  DisplayFrame blank;
+  blank.u = Points::Zero(3, sim.model().n_points);
+  TripleBuffer<DisplayFrame> display(blank);
+  o.display = &display;
+  std::atomic<bool> done{false};
+  long long frames_seen = 0, last_step = -1, out_of_order = 0;
+  std::thread output([&] {
+    while (!done.load()) {
+      if (!display.update()) continue;
+      out_of_order += display.front().step < last_step;
+      last_step = display.front().step;
+      ++frames_seen;
+    }
+  });
   const InteractiveResult r = run_interactive(sim, device, o);
+  done = true;
+  output.join();
+  EXPECT_GT(frames_seen, 0);
+  EXPECT_EQ(out_of_order, 0);
   EXPECT_FALSE(r.haptic.device_failed);
   EXPECT_GT(r.haptic.ticks, 150);  // 300 expected; a loaded CI machine may lose some (not a timing test)
   EXPECT_GT(r.simulation_steps, 10);

@@ -28,8 +28,9 @@ class ContactForces : public DynamicForces {
   ContactModel last;
 };
 
-// One simulation step with the latest probe; then the local model is published.
-int simulation_step(Simulation& sim, ContactForces& contact, HapticLoop& loop) {
+// One simulation step with the latest probe; then the local model (and the display frame) is published.
+int simulation_step(Simulation& sim, ContactForces& contact, HapticLoop& loop, TripleBuffer<DisplayFrame>* display,
+                    long long step) {
   loop.frames().update();
   const HapticFrame& frame = loop.frames().front();
   contact.probe = frame.probe;
@@ -37,6 +38,14 @@ int simulation_step(Simulation& sim, ContactForces& contact, HapticLoop& loop) {
   sim.step();
   loop.contact_models().back() = contact.last;
   loop.contact_models().publish();
+  if (display) {
+    DisplayFrame& d = display->back();
+    d.time = sim.state().time;
+    d.step = step;
+    d.u = sim.state().u;  // same size every time: no allocation
+    d.probe = frame.probe;
+    display->publish();
+  }
   return contact.last.contacts;
 }
 
@@ -85,6 +94,8 @@ InteractiveOptions scene_interactive_options(const Scene& scene, const Model& mo
 InteractiveResult run_interactive(Simulation& sim, Device& device, const InteractiveOptions& options) {
   if (!(options.duration >= 0) || !(options.haptic_rate > 0)) throw Error("interactive run: bad duration or haptic rate");
   if (sim.solver().kind == SolverKind::STATIC) throw Error("interactive run: needs a dynamic solver (explicit or implicit)");
+  if (options.display && options.display->back().u.cols() != sim.model().n_points)
+    throw Error("interactive run: the display frames must be sized for the model's points (3 x n)");
   ContactForces contact(sim.model(), options.probe);
   sim.set_dynamic_forces(&contact);
   struct Detach {  // the simulation must not keep a pointer to `contact` if a step throws
@@ -106,7 +117,7 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
         std::this_thread::sleep_for(std::chrono::duration<double>(sim.state().time - t0 - wall));
         continue;
       }
-      result.max_contacts = std::max(result.max_contacts, simulation_step(sim, contact, loop));
+      result.max_contacts = std::max(result.max_contacts, simulation_step(sim, contact, loop, options.display, result.simulation_steps));
       ++result.simulation_steps;
     }
     loop.stop();
@@ -117,7 +128,8 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
       const double t = k * h;
       if (!loop.tick(t, h)) break;
       while (sim.state().time - t0 < t - 1e-12) {
-        result.max_contacts = std::max(result.max_contacts, simulation_step(sim, contact, loop));
+        result.max_contacts =
+            std::max(result.max_contacts, simulation_step(sim, contact, loop, options.display, result.simulation_steps));
         ++result.simulation_steps;
       }
     }

@@ -8,6 +8,14 @@
 
 namespace pointhaptics {
 
+/// A displacement frame the simulation publishes for the output or graphics side.
+struct DisplayFrame {
+  double time = 0;
+  long long step = 0;
+  Points u;             ///< displacements, m (3 x n)
+  Vec3 probe = Vec3::Constant(NAN);
+};
+
 struct InteractiveOptions {
   ProbeParams probe;
   WorkspaceMapping mapping;
@@ -17,6 +25,9 @@ struct InteractiveOptions {
   ForceRules rules;
   bool real_time = true;         ///< threads on the wall clock; false: one thread, deterministic, simulated time
   bool log = true;               ///< keep the force log (one row per haptic tick)
+  /// If set, the simulation publishes a DisplayFrame after every step here (lock-free; the reader, e.g. a
+  /// viewer thread, calls update() and reads front()). Its frames must be sized for the model's points.
+  TripleBuffer<DisplayFrame>* display = nullptr;
 };
 
 struct InteractiveResult {

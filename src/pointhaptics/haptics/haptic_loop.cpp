@@ -5,6 +5,9 @@
 #include <cmath>
 #include <ctime>
 
+#include <pthread.h>
+#include <sched.h>
+
 namespace pointhaptics {
 
 HapticLoop::HapticLoop(Device& device, const WorkspaceMapping& mapping, const CouplingGains& gains,
@@ -83,6 +86,10 @@ void HapticLoop::stop() {
 }
 
 void HapticLoop::run() {
+  // ask for real-time scheduling; without the privilege (the usual case) the loop runs as it is
+  sched_param priority{};
+  priority.sched_priority = 80;
+  realtime_priority_ = pthread_setschedparam(pthread_self(), SCHED_FIFO, &priority) == 0;
   using clock = std::chrono::steady_clock;
   const auto start = clock::now();
   const auto period = std::chrono::duration_cast<clock::duration>(std::chrono::duration<double>(period_));
@@ -90,7 +97,11 @@ void HapticLoop::run() {
   auto previous = start;
   while (running_.load(std::memory_order_relaxed)) {
     deadline += period;
-    std::this_thread::sleep_until(deadline);  // absolute deadline: no drift
+    // absolute deadlines (no drift): sleep until shortly before, then spin, because a sleeping thread
+    // wakes up late by up to the scheduler's slack (hundreds of us on a loaded machine)
+    std::this_thread::sleep_until(deadline - std::chrono::microseconds(200));
+    while (clock::now() < deadline) {
+    }
     const auto now = clock::now();
     const double t = std::chrono::duration<double>(now - start).count();
     const double dt = std::chrono::duration<double>(now - previous).count();
@@ -135,6 +146,7 @@ HapticStats HapticLoop::stats() const {
   s.max_force_n = max_force_;
   s.min_observed_energy = renderer_.min_observed_energy();
   s.device_failed = failed_;
+  s.realtime_priority = realtime_priority_;
   s.device_error = error_;
   return s;
 }

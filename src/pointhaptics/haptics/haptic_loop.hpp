@@ -45,6 +45,7 @@ struct HapticStats {
   double min_observed_energy = 0;      ///< passivity observer's minimum, J (negative: active at some point)
   bool device_failed = false;
   std::string device_error;
+  bool realtime_priority = false;      ///< the thread got SCHED_FIFO (needs the privilege; else a normal thread)
 };
 
 class HapticLoop {
@@ -90,6 +91,7 @@ class HapticLoop {
   std::thread thread_;
   std::atomic<bool> running_{false};
   std::atomic<bool> failed_flag_{false};
+  bool realtime_priority_ = false;
 };
 
 }  // namespace pointhaptics
