@@ -18,14 +18,51 @@ namespace {
 // the step; remembers the last local contact model.
 class ContactForces : public DynamicForces {
  public:
-  ContactForces(const Model& model, const ProbeParams& params) : contact(model, params) {}
+  ContactForces(const Model& model, const ProbeParams& params, double coupling_stiffness, double max_force)
+      : contact(model, params), k(coupling_stiffness), max_force(max_force), scratch(Points::Zero(3, model.n_points)) {}
+
+  // Once per step: the probe is where the coupling spring (toward the device point, its force capped at
+  // the device's maximum: the hand cannot push harder than it can feel) balances the contact forces at
+  // the step's start; a few Newton steps on the local model from the last position. Within the step the
+  // probe stays there (re-solving it at every sub-step let the contact set chatter and excite the lattice).
+  void solve_probe(const Model& model, const State& state) {
+    if (!device.allFinite()) {
+      probe = device;
+      return;
+    }
+    Vec3 p = probe.allFinite() ? probe : device;
+    for (int it = 0; it < 8; ++it) {
+      scratch.setZero();
+      const ContactModel m = contact.apply(model, state.u, p, button, state.time, scratch);
+      Vec3 d = device;
+      const auto solver = (k * Mat3::Identity() - m.K).ldlt();
+      Vec3 next = solver.solve(k * d + m.f0 - m.K * p);
+      const double pull = k * (d - next).norm();
+      if (pull > max_force && next.allFinite()) {
+        d = next + (d - next) * (max_force / pull);
+        next = solver.solve(k * d + m.f0 - m.K * p);
+      }
+      if (!next.allFinite()) break;
+      const bool settled = (next - p).norm() < 1e-9 + 1e-6 * contact.params().radius;
+      p = next;
+      if (settled) break;
+    }
+    probe = p;
+  }
   void add(const Model& model, const State& state, Points& f) override {
     last = contact.apply(model, state.u, probe, button, state.time, f);
   }
+  bool add_stiffness(const Model&, const State&, Eigen::Matrix<double, 9, Eigen::Dynamic>& springs) override {
+    contact.add_stiffness(springs);
+    return last.contacts > 0;
+  }
   ProbeContact contact;
-  Vec3 probe = Vec3::Constant(NAN);
+  double k, max_force;
+  Vec3 device = Vec3::Constant(NAN);  ///< the device point of the latest haptic frame
+  Vec3 probe = Vec3::Constant(NAN);   ///< the probe as the simulation solved it last
   bool button = false;
   ContactModel last;
+  Points scratch;
 };
 
 // One simulation step with the latest probe; then the local model (and the display frame) is published.
@@ -33,8 +70,9 @@ int simulation_step(Simulation& sim, ContactForces& contact, HapticLoop& loop, T
                     long long step) {
   loop.frames().update();
   const HapticFrame& frame = loop.frames().front();
-  contact.probe = frame.probe;
+  contact.device = frame.device;
   contact.button = frame.button;
+  contact.solve_probe(sim.model(), sim.state());
   sim.step();
   loop.contact_models().back() = contact.last;
   loop.contact_models().publish();
@@ -43,7 +81,7 @@ int simulation_step(Simulation& sim, ContactForces& contact, HapticLoop& loop, T
     d.time = sim.state().time;
     d.step = step;
     d.u = sim.state().u;  // same size every time: no allocation
-    d.probe = frame.probe;
+    d.probe = contact.probe;
     display->publish();
   }
   return contact.last.contacts;
@@ -96,13 +134,13 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
   if (sim.solver().kind == SolverKind::STATIC) throw Error("interactive run: needs a dynamic solver (explicit or implicit)");
   if (options.display && options.display->back().u.cols() != sim.model().n_points)
     throw Error("interactive run: the display frames must be sized for the model's points (3 x n)");
-  ContactForces contact(sim.model(), options.probe);
+  const CouplingGains gains = coupling_budget(device.specs(), options.mapping.scale, options.coupling_safety);
+  ContactForces contact(sim.model(), options.probe, gains.stiffness, device.specs().max_force);
   sim.set_dynamic_forces(&contact);
   struct Detach {  // the simulation must not keep a pointer to `contact` if a step throws
     Simulation& sim;
     ~Detach() { sim.set_dynamic_forces(nullptr); }
   } detach{sim};
-  const CouplingGains gains = coupling_budget(device.specs(), options.mapping.scale, options.coupling_safety);
   const auto ticks = static_cast<std::size_t>(std::ceil(options.duration * options.haptic_rate)) + 16;
   HapticLoop loop(device, options.mapping, gains, options.rules, options.haptic_rate, options.log ? ticks : 0);
   InteractiveResult result;

@@ -52,12 +52,15 @@ void Simulation::step() {
     }
     case SolverKind::IMPLICIT: {
       const Points* extra = nullptr;
+      const Eigen::Matrix<double, 9, Eigen::Dynamic>* springs = nullptr;
       if (dynamic_forces_) {
         extra_forces_.setZero();
         dynamic_forces_->add(model_, state_, extra_forces_);
         extra = &extra_forces_;
+        springs_.setZero(9, model_.n_points);
+        if (dynamic_forces_->add_stiffness(model_, state_, springs_)) springs = &springs_;
       }
-      const NewtonStats stats = implicit_->step(model_, state_, ws_, solver_.dt, newton_settings(), extra);
+      const NewtonStats stats = implicit_->step(model_, state_, ws_, solver_.dt, newton_settings(), extra, springs);
       iterations_ += stats.iterations;
       cg_iterations_ += stats.cg_iterations;
       residual_ = stats.residual;

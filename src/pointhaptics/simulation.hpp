@@ -48,6 +48,7 @@ class Simulation {
   State state_;
   Workspace ws_;
   Points extra_forces_;
+  Eigen::Matrix<double, 9, Eigen::Dynamic> springs_;
   DynamicForces* dynamic_forces_ = nullptr;
   std::unique_ptr<NewtonSolver> newton_;      ///< static
   std::unique_ptr<ImplicitSolver> implicit_;  ///< implicit

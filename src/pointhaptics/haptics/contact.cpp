@@ -54,6 +54,8 @@ ContactModel ProbeContact::apply(const Model& model, const Points& u, const Vec3
     return out;
   }
   // push: sphere-sphere overlap (seed Fig. 5)
+  touched_.clear();
+  normals_.clear();
   x_ = model.X + u;
   grid_.rebuild(x_);
   const double reach = params_.radius + params_.point_radius;
@@ -63,13 +65,27 @@ ContactModel ProbeContact::apply(const Model& model, const Points& u, const Vec3
     // a point at the probe's centre has no direction: push it up, as good as any
     const Vec3 n = d > 1e-12 * reach ? Vec3(r / d) : Vec3::UnitY();
     const Vec3 f = k * (reach - d) * n;
-    if (!model.fixed[i]) forces.col(i) += f;
+    if (!model.fixed[i]) {
+      forces.col(i) += f;
+      touched_.push_back(i);
+      normals_.push_back(n);
+    }
     out.f0 -= f;
     // the normal part of dF/dp; the tangential part (which would make K indefinite) is left out
     out.K -= k * n * n.transpose();
     ++out.contacts;
   });
   return out;
+}
+
+void ProbeContact::add_stiffness(Eigen::Matrix<double, 9, Eigen::Dynamic>& springs) const {
+  const double k = params_.stiffness;
+  if (params_.mode == ProbeMode::GRAB) {
+    for (index_t i : grabbed_) Eigen::Map<Mat3>(springs.col(i).data()).diagonal().array() += k;
+    return;
+  }
+  for (std::size_t c = 0; c < touched_.size(); ++c)
+    Eigen::Map<Mat3>(springs.col(touched_[c]).data()) += k * normals_[c] * normals_[c].transpose();
 }
 
 }  // namespace pointhaptics

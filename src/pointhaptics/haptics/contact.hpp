@@ -40,6 +40,9 @@ class ProbeContact {
   /// current displacement u, and returns the local contact model. A non-finite probe position is ignored
   /// (no contact). No allocation after the first calls.
   ContactModel apply(const Model& model, const Points& u, const Vec3& probe, bool button, double time, Points& forces);
+  /// The stiffness -df_i/du_i of the contact springs of the last apply() per point (push: k n n^T,
+  /// grab: k I), added into `springs` (9 x n, column-major 3x3).
+  void add_stiffness(Eigen::Matrix<double, 9, Eigen::Dynamic>& springs) const;
   const ProbeParams& params() const { return params_; }
   const std::vector<index_t>& grabbed() const { return grabbed_; }
 
@@ -49,6 +52,8 @@ class ProbeContact {
   Points x_;                      // current positions
   std::vector<index_t> grabbed_;
   std::vector<Vec3> offsets_;     // grabbed point minus probe at the press
+  std::vector<index_t> touched_;  // points pushed by the last apply(), with their normals
+  std::vector<Vec3> normals_;
   bool was_pressed_ = false;
 };
 

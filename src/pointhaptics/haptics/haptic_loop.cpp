@@ -12,7 +12,12 @@ namespace pointhaptics {
 
 HapticLoop::HapticLoop(Device& device, const WorkspaceMapping& mapping, const CouplingGains& gains,
                        const ForceRules& rules, double rate_hz, std::size_t log_capacity)
-    : device_(device), mapping_(mapping), gains_(gains), renderer_(device.specs(), rules), period_(1.0 / rate_hz) {
+    : device_(device),
+      mapping_(mapping),
+      gains_(gains),
+      renderer_(device.specs(), rules),
+      period_(1.0 / rate_hz),
+      device_max_force_(device.specs().max_force) {
   if (!(rate_hz > 0) || !(mapping.scale > 0) || !(gains.stiffness > 0))
     throw Error("haptic loop: the rate, the workspace scale and the coupling stiffness must be positive");
   log_.reserve(log_capacity);
@@ -34,7 +39,13 @@ bool HapticLoop::tick(double t, double dt) {
     Vec3 p = d;
     if (m.contacts > 0 && m.p0.allFinite()) {
       const Mat3 A = k * Mat3::Identity() - m.K;
-      p = A.ldlt().solve(k * d + m.f0 - m.K * m.p0);
+      const auto solver = A.ldlt();
+      p = solver.solve(k * d + m.f0 - m.K * m.p0);
+      // the probe pushes on the object with the coupling force; the hand cannot feel more than the
+      // device's maximum, so the object is not pushed harder either: pull the device point in to where
+      // the coupling force is at that maximum, and solve again
+      const double pull = k * (d - p).norm(), limit = device_max_force_;
+      if (pull > limit && p.allFinite()) p = solver.solve(k * (p + (d - p) * (limit / pull)) + m.f0 - m.K * m.p0);
       if (!p.allFinite()) p = d;
     }
     const Vec3 vp = probe_.allFinite() && dt > 0 ? Vec3((p - probe_) / dt) : vd;
@@ -46,6 +57,7 @@ bool HapticLoop::tick(double t, double dt) {
     HapticFrame& frame = frames_.back();
     frame.time = t;
     frame.probe = p;
+    frame.device = d;
     frame.button = (state.buttons & 1u) != 0;
     frame.force = f;
     frames_.publish();
@@ -99,7 +111,7 @@ void HapticLoop::run() {
     deadline += period;
     // absolute deadlines (no drift): sleep until shortly before, then spin, because a sleeping thread
     // wakes up late by up to the scheduler's slack (hundreds of us on a loaded machine)
-    std::this_thread::sleep_until(deadline - std::chrono::microseconds(200));
+    std::this_thread::sleep_until(deadline - std::chrono::microseconds(400));
     while (clock::now() < deadline) {
     }
     const auto now = clock::now();

@@ -24,6 +24,7 @@ struct WorkspaceMapping {
 struct HapticFrame {
   double time = 0;
   Vec3 probe = Vec3::Constant(NAN);  ///< scene position of the probe (NaN until the first tick)
+  Vec3 device = Vec3::Constant(NAN); ///< scene position of the device point the coupling pulls toward
   bool button = false;
   Vec3 force = Vec3::Zero();         ///< force commanded to the device, N
 };
@@ -79,6 +80,7 @@ class HapticLoop {
   CouplingGains gains_;
   ForceRenderer renderer_;
   double period_;
+  double device_max_force_;  ///< read once: specs() builds a string, which the haptic thread must not
   TripleBuffer<ContactModel> models_;
   TripleBuffer<HapticFrame> frames_;
   std::vector<HapticLogRow> log_;

@@ -29,6 +29,10 @@ class DynamicForces {
   virtual ~DynamicForces() = default;
   /// Add the forces (N) at `state` into f (3 x n).
   virtual void add(const Model& model, const State& state, Points& f) = 0;
+  /// The forces' stiffness -df_i/du_i per point (3x3, column-major, 9 x n, N/m, symmetric positive
+  /// semi-definite), added into `springs`, for implicit steps; false if there is none to add. Called
+  /// after add() at the same state.
+  virtual bool add_stiffness(const Model&, const State&, Eigen::Matrix<double, 9, Eigen::Dynamic>&) { return false; }
 };
 
 /// extra, if given, is evaluated at every sub-step and added to the constant loads.

@@ -11,10 +11,12 @@ ImplicitSolver::ImplicitSolver(const Model& model)
     : newton_(model),
       anchor_(Points::Zero(3, model.n_points)),
       u_next_(Points::Zero(3, model.n_points)),
-      load_(Points::Zero(3, model.n_points)) {}
+      load_(Points::Zero(3, model.n_points)),
+      u_start_(Points::Zero(3, model.n_points)) {}
 
 NewtonStats ImplicitSolver::step(const Model& model, State& state, Workspace& ws, double dt,
-                                 const NewtonSettings& settings, const Points* extra_forces) {
+                                 const NewtonSettings& settings, const Points* extra_forces,
+                                 const Eigen::Matrix<double, 9, Eigen::Dynamic>* springs) {
   const double c = model.material.damping;
   const double k = 1.0 / (dt * dt) + c / dt;
   // the two quadratic terms combine into 0.5 k |u' - a|_M^2 with a = ((u + dt v)/dt^2 + c u/dt) / k
@@ -34,6 +36,11 @@ NewtonStats ImplicitSolver::step(const Model& model, State& state, Workspace& ws
   }
   problem.inertia = k;
   problem.anchor = &anchor_;
+  if (springs) {
+    u_start_ = state.u;
+    problem.springs = springs;
+    problem.spring_anchor = &u_start_;
+  }
   const NewtonStats stats = newton_.solve(model, problem, u_next_, ws, settings);
   if (!stats.converged)
     throw Error(fmt::format("implicit step at t = {:.6g} s did not converge ({}, residual {:.3g} after {} Newton "

@@ -16,13 +16,15 @@ namespace pointhaptics {
 class ImplicitSolver {
  public:
   explicit ImplicitSolver(const Model& model);
-  /// extra_forces (3 x n, N), if given, are added to the constant loads for this step (held constant over it).
+  /// extra_forces (3 x n, N), if given, are added to the constant loads for this step; with springs
+  /// (9 x n, their stiffness -df/du per point) they are linearised about the step's start,
+  /// f(u) = f - S (u - u_n), which keeps stiff contact springs stable at any dt.
   NewtonStats step(const Model& model, State& state, Workspace& ws, double dt, const NewtonSettings& settings,
-                   const Points* extra_forces = nullptr);
+                   const Points* extra_forces = nullptr, const Eigen::Matrix<double, 9, Eigen::Dynamic>* springs = nullptr);
 
  private:
   NewtonSolver newton_;
-  Points anchor_, u_next_, load_;
+  Points anchor_, u_next_, load_, u_start_;
 };
 
 }  // namespace pointhaptics

@@ -32,6 +32,10 @@ double NewtonSolver::energy(const Model& model, const NewtonProblem& problem, co
     if (model.fixed[i]) continue;
     pi -= problem.load->col(i).dot(u.col(i));
     if (problem.inertia > 0) pi += 0.5 * problem.inertia * model.mass[i] * (u.col(i) - problem.anchor->col(i)).squaredNorm();
+    if (problem.springs) {
+      const Vec3 e = u.col(i) - problem.spring_anchor->col(i);
+      pi += 0.5 * e.dot(Eigen::Map<const Mat3>(problem.springs->col(i).data()) * e);
+    }
   }
   return pi;
 }
@@ -48,12 +52,16 @@ double NewtonSolver::residual(const Model& model, const NewtonProblem& problem, 
       r.col(i) -= f;
     }
   }
+  if (problem.springs)
+    for (index_t i = 0; i < model.n_points; ++i)
+      r.col(i) -= Eigen::Map<const Mat3>(problem.springs->col(i).data()) * (u.col(i) - problem.spring_anchor->col(i));
   mask_held(model, r);
   const double scale = std::max({problem.load->norm(), ws.f_int.norm(), std::sqrt(inertial), 1e-300});
   return r.norm() / scale;
 }
 
-void NewtonSolver::build_preconditioner(const Model& model, double inertia) {
+void NewtonSolver::build_preconditioner(const Model& model, const NewtonProblem& problem) {
+  const double inertia = problem.inertia;
   tangent_.diagonal_blocks(model, blocks_);
   for (index_t i = 0; i < model.n_points; ++i) {
     Eigen::Map<Mat3> B(blocks_.col(i).data());
@@ -62,6 +70,7 @@ void NewtonSolver::build_preconditioner(const Model& model, double inertia) {
       continue;
     }
     B.diagonal().array() += inertia * model.mass[i];
+    if (problem.springs) B += Eigen::Map<const Mat3>(problem.springs->col(i).data());
     Mat3 sym = 0.5 * (B + B.transpose());
     Eigen::LLT<Mat3> llt(sym);
     if (llt.info() == Eigen::Success && std::isfinite(sym.trace())) {
@@ -78,8 +87,9 @@ void NewtonSolver::precondition(const Points& r, Points& z) const {
   for (Eigen::Index i = 0; i < r.cols(); ++i) z.col(i) = Eigen::Map<const Mat3>(blocks_.col(i).data()) * r.col(i);
 }
 
-bool NewtonSolver::conjugate_gradients(const Model& model, double inertia, const Points& r, double eta,
+bool NewtonSolver::conjugate_gradients(const Model& model, const NewtonProblem& problem, const Points& r, double eta,
                                        int max_iterations, Workspace& ws, Points& x, long long& iterations) {
+  const double inertia = problem.inertia;
   x.setZero();
   cg_r_ = r;
   precondition(cg_r_, cg_z_);
@@ -89,6 +99,9 @@ bool NewtonSolver::conjugate_gradients(const Model& model, double inertia, const
   for (int k = 0; k < max_iterations; ++k) {
     tangent_.apply(model, cg_p_, ws, cg_q_);
     if (inertia > 0) cg_q_ += inertia * (cg_p_.array().rowwise() * model.mass.transpose().array()).matrix();
+    if (problem.springs)
+      for (index_t i = 0; i < model.n_points; ++i)
+        cg_q_.col(i) += Eigen::Map<const Mat3>(problem.springs->col(i).data()) * cg_p_.col(i);
     mask_held(model, cg_q_);
     const double curvature = dot(cg_p_, cg_q_);
     ++iterations;
@@ -108,7 +121,6 @@ bool NewtonSolver::conjugate_gradients(const Model& model, double inertia, const
 NewtonStats NewtonSolver::solve(const Model& model, const NewtonProblem& problem, Points& u, Workspace& ws,
                                 const NewtonSettings& settings) {
   NewtonStats stats;
-  const double inertia = problem.inertia;
   double rel = residual(model, problem, u, ws, r_);
   // Pi at the current iterate, evaluated only when a line search needs it (NaN: not yet)
   double pi = NAN;
@@ -140,10 +152,10 @@ NewtonStats NewtonSolver::solve(const Model& model, const NewtonProblem& problem
       tangent_.linearise(model, u, mode);
       // the block-Jacobi preconditioner is rebuilt at the first iteration of a solve and when the tangent's
       // mode changes; in between it lags (it changes slowly and costs about two tangent products)
-      if (stats.iterations == 1 || mode != preconditioner_mode_) build_preconditioner(model, inertia);
+      if (stats.iterations == 1 || mode != preconditioner_mode_) build_preconditioner(model, problem);
       preconditioner_mode_ = mode;
       const bool positive =
-          conjugate_gradients(model, inertia, r_, eta, settings.max_cg_iterations, ws, dx_, stats.cg_iterations);
+          conjugate_gradients(model, problem, r_, eta, settings.max_cg_iterations, ws, dx_, stats.cg_iterations);
       if (positive && dot(dx_, r_) > 0) {
         descent = true;
         break;

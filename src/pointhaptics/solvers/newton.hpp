@@ -21,6 +21,11 @@ struct NewtonProblem {
   const Points* load = nullptr;    ///< b, N  (3 x n)
   double inertia = 0;              ///< k, 1/s^2
   const Points* anchor = nullptr;  ///< a, m  (3 x n); needed when inertia > 0
+  /// Optional per-point 3x3 springs (column-major, 9 x n, N/m) toward `spring_anchor`: the energy gains
+  /// 0.5 sum_i (u_i - c_i)^T S_i (u_i - c_i). Implicit dynamics uses them to treat stiff contact springs
+  /// linearly implicitly (S_i symmetric positive semi-definite).
+  const Eigen::Matrix<double, 9, Eigen::Dynamic>* springs = nullptr;
+  const Points* spring_anchor = nullptr;
 };
 
 struct NewtonStats {
@@ -46,11 +51,11 @@ class NewtonSolver {
   double energy(const Model& model, const NewtonProblem& problem, const Points& u) const;
   /// r = -grad Pi at u, zero at held points; returns the relative residual
   double residual(const Model& model, const NewtonProblem& problem, const Points& u, Workspace& ws, Points& r) const;
-  void build_preconditioner(const Model& model, double inertia);
+  void build_preconditioner(const Model& model, const NewtonProblem& problem);
   /// PCG on (K + k M) x = r over the free points to relative tolerance eta; returns false when it meets
   /// a direction of non-positive curvature (an indefinite tangent).
-  bool conjugate_gradients(const Model& model, double inertia, const Points& r, double eta, int max_iterations,
-                           Workspace& ws, Points& x, long long& iterations);
+  bool conjugate_gradients(const Model& model, const NewtonProblem& problem, const Points& r, double eta,
+                           int max_iterations, Workspace& ws, Points& x, long long& iterations);
   void precondition(const Points& r, Points& z) const;
   void mask_held(const Model& model, Points& x) const;
 
