@@ -3,6 +3,9 @@
 #include <pointhaptics/core/error.hpp>
 #include <pointhaptics/geometry/neighbour_search.hpp>
 #include <pointhaptics/mechanics/forces.hpp>
+#include <pointhaptics/mechanics/tangent.hpp>
+
+#include <Eigen/Eigenvalues>
 
 #include <fmt/format.h>
 
@@ -10,10 +13,11 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <random>
 
 namespace pointhaptics {
 
-double stable_time_step(const Model& model, double safety) {
+double estimated_stable_time_step(const Model& model, double safety) {
   const std::vector<index_t> nearest = nearest_neighbour(model.X);
   double a = std::numeric_limits<double>::infinity();
   for (index_t i = 0; i < model.n_points; ++i)
@@ -25,6 +29,53 @@ double stable_time_step(const Model& model, double safety) {
   const MaterialParams& m = model.material;
   const double modulus = model.lambda + 2 * model.mu + m.volume_stiffness + m.hourglass * m.young;
   return safety * a / std::sqrt(modulus / rho);
+}
+
+double stable_time_step(const Model& model, double safety) {
+  // Lanczos on M^-1/2 K M^-1/2 over the free points at rest: its largest Ritz value approaches the
+  // largest omega^2 from below, and symplectic Euler is stable for h < 2 / omega_max
+  const Eigen::Index n = 3 * static_cast<Eigen::Index>(model.n_points);
+  Eigen::VectorXd scale(n);
+  for (index_t i = 0; i < model.n_points; ++i)
+    for (int a = 0; a < 3; ++a) scale[3 * i + a] = model.fixed[i] || !(model.mass[i] > 0) ? 0.0 : 1.0 / std::sqrt(model.mass[i]);
+  const double fallback = estimated_stable_time_step(model, 0.7);
+  if (scale.squaredNorm() == 0) return fallback;
+  Workspace ws(model, 1);
+  Tangent K;
+  K.linearise(model, Points::Zero(3, model.n_points), TangentMode::EXACT);
+  std::mt19937 rng(12345);
+  std::normal_distribution<double> noise;
+  Eigen::VectorXd q(n), q_prev = Eigen::VectorXd::Zero(n);
+  for (Eigen::Index k = 0; k < n; ++k) q[k] = scale[k] > 0 ? noise(rng) : 0.0;
+  q.normalize();
+  Points in(3, model.n_points), out(3, model.n_points);
+  const int steps = static_cast<int>(std::min<Eigen::Index>(40, n));
+  Eigen::VectorXd alpha = Eigen::VectorXd::Zero(steps), beta = Eigen::VectorXd::Zero(steps);
+  int done = 0;
+  double b = 0;
+  for (; done < steps; ++done) {
+    Eigen::Map<Eigen::VectorXd>(in.data(), n) = q.cwiseProduct(scale);
+    K.apply(model, in, ws, out);
+    Eigen::VectorXd w = Eigen::Map<const Eigen::VectorXd>(out.data(), n).cwiseProduct(scale);
+    alpha[done] = w.dot(q);
+    w -= alpha[done] * q + b * q_prev;
+    b = w.norm();
+    beta[done] = b;
+    if (!(b > 1e-12 * std::abs(alpha[done]))) {
+      ++done;
+      break;  // an invariant subspace: the Ritz values are exact
+    }
+    q_prev = q;
+    q = w / b;
+  }
+  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(done, done);
+  for (int k = 0; k < done; ++k) {
+    T(k, k) = alpha[k];
+    if (k + 1 < done) T(k, k + 1) = T(k + 1, k) = beta[k];
+  }
+  const double omega2 = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(T, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
+  if (!(omega2 > 0) || !std::isfinite(omega2)) return fallback;
+  return safety * 2.0 / std::sqrt(omega2);
 }
 
 Vec3 prescribed_displacement(const FixedGroup& group, double t) {
