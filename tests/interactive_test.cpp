@@ -14,8 +14,8 @@
 namespace pointhaptics {
 namespace {
 
-// the seed's beam (both ends held), soft enough to be pushed in by a hand
-Simulation seed_beam(double damping = 5.0, double young = 1e4) {
+// the seed's beam (both ends held), by default soft enough to be pushed in by a hand
+Simulation seed_beam(double damping = 5.0, double young = 1e4, const std::string& solver = "explicit") {
   const std::string text = R"(
 [object]
 shape = "box"
@@ -31,7 +31,7 @@ box = { min = [-1.0, -1.0, -1.0], max = [0.0, 1.0, 1.0] }
 [[fixed]]
 box = { min = [0.135, -1.0, -1.0], max = [1.0, 1.0, 1.0] }
 [solver]
-kind = "explicit"
+kind = ")" + solver + R"("
 dt = 1e-3
 )";
   const Scene scene = parse_scene(text);
@@ -87,25 +87,7 @@ TEST(Interactive, ImplicitStiffBeamTreatsContactLinearlyImplicitly) {
   // E = 1e6 Pa at dt = 1 ms: the contact springs (E x spacing) held over a step would blow up; with the
   // linearly implicit contact the run is stable, the force reaches the device's limit, and after the
   // hand lets go the beam is back at rest
-  const std::string text = R"(
-[object]
-shape = "box"
-size = [0.135, 0.03, 0.03]
-spacing = 0.015
-[material]
-young = 1e6
-poisson = 0.4
-damping = 5.0
-[[fixed]]
-box = { min = [-1.0, -1.0, -1.0], max = [0.0, 1.0, 1.0] }
-[[fixed]]
-box = { min = [0.135, -1.0, -1.0], max = [1.0, 1.0, 1.0] }
-[solver]
-kind = "implicit"
-dt = 1e-3
-)";
-  const Scene scene = parse_scene(text);
-  Simulation sim(build_scene_model(scene), scene.solver, 1);
+  Simulation sim = seed_beam(5.0, 1e6, "implicit");
   VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), false}, {1.0, Vec3(0, -0.04, 0), false}, {2.0, Vec3(0, -0.04, 0), false},
                                    {2.5, Vec3::Zero(), false}, {3.0, Vec3::Zero(), false}}),
                        known_device_specs("touch"));
