@@ -26,7 +26,8 @@ struct Model {
   Eigen::VectorXd volume;           ///< v_i, m^3  (n)
   Eigen::VectorXd mass;             ///< m_i, kg  (n)
   double spacing = 0;               ///< nominal sample spacing, m
-  double h = 0;                     ///< kernel support radius, m
+  double h = 0;                     ///< kernel support radius, m (the base one when `support` is set)
+  Eigen::VectorXd support;          ///< per-point support h_i, m, when they differ (levels of detail); else empty
   double extent = 0;                ///< diagonal of the reference bounding box plus h, m (scale for divergence checks)
   KernelParams kernel;
   MaterialParams material;

@@ -11,6 +11,7 @@ struct PointCloud {
   Eigen::VectorXd volume;             ///< volume each point represents, m^3  (n); sums to the body's volume
   std::vector<unsigned char> surface; ///< 1 where the point lies on the body's surface  (n)
   double spacing = 0;                 ///< nominal sample spacing, m
+  Eigen::VectorXd support;            ///< optional per-point kernel support h_i, m (empty: the kernel's one h)
 
   index_t size() const { return static_cast<index_t>(X.cols()); }
 };

@@ -1,5 +1,7 @@
 #include <pointhaptics/geometry/neighbour_search.hpp>
 
+#include <pointhaptics/core/error.hpp>
+
 #include <pointhaptics/geometry/kd_tree.hpp>
 #include <oneapi/tbb/parallel_for.h>
 
@@ -36,6 +38,31 @@ Csr radius_neighbours(const Points& X, double h) {
       auto& row = rows[i];
       for (const auto& [j, r2] : found)
         if (j != i && within_support((X.col(j) - q).squaredNorm(), h)) row.push_back(j);
+      std::sort(row.begin(), row.end());
+    }
+  });
+  return rows_to_csr(rows);
+}
+
+Csr radius_neighbours(const Points& X, const Eigen::VectorXd& support) {
+  const index_t n = static_cast<index_t>(X.cols());
+  if (support.size() != n) throw Error("neighbour search: one support radius per point is needed");
+  const double h_max = n ? support.maxCoeff() : 0.0;
+  const KdTree tree(X);
+  std::vector<std::vector<index_t>> rows(n);
+  tbb::parallel_for(tbb::blocked_range<index_t>(0, n, 256), [&](const tbb::blocked_range<index_t>& range) {
+    std::vector<std::pair<index_t, double>> found;
+    nanoflann::SearchParams params;
+    params.sorted = false;
+    for (index_t i = range.begin(); i != range.end(); ++i) {
+      found.clear();
+      const Vec3 q = X.col(i);
+      tree.index().radiusSearch(q.data(), h_max * h_max * (1.0 + 1e-6), found, params);
+      auto& row = rows[i];
+      // symmetric: i and j are neighbours when either one's support reaches the other
+      for (const auto& [j, r2] : found)
+        if (j != i && within_support((X.col(j) - q).squaredNorm(), std::max(support[i], support[static_cast<index_t>(j)])))
+          row.push_back(j);
       std::sort(row.begin(), row.end());
     }
   });

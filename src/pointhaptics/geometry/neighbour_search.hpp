@@ -14,6 +14,9 @@ Csr radius_neighbours(const Points& X, double h);
 
 /// The same by testing all pairs: O(n^2), for tests.
 Csr radius_neighbours_brute_force(const Points& X, double h);
+/// With a support radius per point: i and j are neighbours when |X_j - X_i| < max(h_i, h_j), so that
+/// neighbourhoods stay symmetric (used by levels of detail, which widen the support of sparse points).
+Csr radius_neighbours(const Points& X, const Eigen::VectorXd& support);
 
 /// For each point, the index of the nearest other point (-1 when there is only one point).
 std::vector<index_t> nearest_neighbour(const Points& X);

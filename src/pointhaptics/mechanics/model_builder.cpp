@@ -51,10 +51,14 @@ void compute_hourglass(Model& model, const Eigen::VectorXd& w, const std::vector
   const index_t n = model.n_points;
   const double scale = 0.5 * model.material.hourglass * model.material.young;
   auto share = [&](index_t i) { return weight_sum[i] > 0 ? model.volume[i] / weight_sum[i] : 0.0; };
+  const bool per_point = model.support.size() == n;
   for (index_t i = 0; i < n; ++i)
     for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
       const index_t j = nbr.index[e];
-      model.hg_coef[e] = scale * w[e] * (share(i) + share(j)) / (model.X.col(j) - model.X.col(i)).squaredNorm();
+      const double r2 = (model.X.col(j) - model.X.col(i)).squaredNorm();
+      // w_ji from j's own support (equal to w_ij with one support for all), so that k_ij = k_ji
+      const double w_ji = per_point ? kernel_value(model.kernel.type, std::sqrt(r2), model.support[j]) : w[e];
+      model.hg_coef[e] = scale * (w[e] * share(i) + w_ji * share(j)) / r2;
     }
   model.hg_diagonal = Eigen::VectorXd::Zero(n);
   if (!(model.material.hourglass > 0)) return;
@@ -103,7 +107,13 @@ Model build_model(const PointCloud& cloud, const MaterialParams& material, const
   model.extent = (model.X.rowwise().maxCoeff() - model.X.rowwise().minCoeff()).norm() + h;
 
   // neighbours in the reference configuration
-  model.neighbours = radius_neighbours(model.X, h);
+  const bool per_point = cloud.support.size() > 0;
+  if (per_point) {
+    if (cloud.support.size() != n || !(cloud.support.array() > 0).all() || !cloud.support.allFinite())
+      throw Error("model: per-point supports must be positive, one per point");
+    model.support = cloud.support;
+  }
+  model.neighbours = per_point ? radius_neighbours(model.X, cloud.support) : radius_neighbours(model.X, h);
   const Csr& nbr = model.neighbours;
   const index_t n_pairs = nbr.n_entries();
 
@@ -114,7 +124,8 @@ Model build_model(const PointCloud& cloud, const MaterialParams& material, const
     for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
       const double r = (model.X.col(nbr.index[e]) - model.X.col(i)).norm();
       if (r <= 1e-9 * h) coincident = i;
-      w[e] = kernel_value(kernel.type, r, h);
+      // with per-point supports the stencil of i uses its own h_i (zero weight for the pairs only j reaches)
+      w[e] = kernel_value(kernel.type, r, per_point ? cloud.support[i] : h);
     }
   });
   if (coincident >= 0) {
@@ -137,9 +148,10 @@ Model build_model(const PointCloud& cloud, const MaterialParams& material, const
     // kernel is infinite at r = 0, so it is left out there)
     const double total_mass = material.density * cloud.volume.sum();
     model.mass = Eigen::VectorXd::Constant(n, total_mass / n);
-    const double w0 = kernel.type == KernelType::VISCOSITY ? 0.0 : kernel_value(kernel.type, 0.0, h);
     model.volume.resize(n);
     for (index_t i = 0; i < n; ++i) {
+      const double w0 =
+          kernel.type == KernelType::VISCOSITY ? 0.0 : kernel_value(kernel.type, 0.0, per_point ? cloud.support[i] : h);
       double rho = model.mass[i] * w0;  // seed Eq. 7
       for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) rho += model.mass[nbr.index[e]] * w[e];
       model.volume[i] = rho > 0 ? model.mass[i] / rho : cloud.volume[i];  // seed Eq. 8
