@@ -1,0 +1,141 @@
+#include <pointhaptics/lod/active_set.hpp>
+
+#include <pointhaptics/core/error.hpp>
+#include <pointhaptics/geometry/kd_tree.hpp>
+#include <pointhaptics/mechanics/deformation.hpp>
+#include <pointhaptics/mechanics/model_builder.hpp>
+
+#include <algorithm>
+#include <chrono>
+
+namespace pointhaptics {
+
+ActiveSet build_active_set(const Model& full, const Selection& selection, const ActiveSetParams& params) {
+  const auto start = std::chrono::steady_clock::now();
+  if (selection.selected.empty()) throw Error("lod: the selection is empty");
+  if (static_cast<index_t>(selection.band.size()) != full.n_points) throw Error("lod: the selection is for another model");
+  ActiveSet a;
+  const index_t n_full = full.n_points;
+  a.active_of.assign(n_full, -1);
+  a.follows.assign(n_full, -1);
+  a.follow_offset = Points::Zero(3, n_full);
+  for (index_t i : selection.selected) {
+    a.active_of[i] = static_cast<index_t>(a.full_of.size());
+    a.full_of.push_back(i);
+  }
+  a.n_selected = static_cast<index_t>(a.full_of.size());
+  const double h = full.h, reach = params.max_widening * h;
+
+  // the nearest selected point of every unselected one (a k-d tree over the selected)
+  Points selected_X(3, a.n_selected);
+  for (index_t k = 0; k < a.n_selected; ++k) selected_X.col(k) = full.X.col(a.full_of[k]);
+  const KdTree tree(selected_X);
+  std::vector<index_t> absorbed_by(n_full, -1);
+  for (index_t j = 0; j < n_full; ++j) {
+    if (a.active_of[j] >= 0) continue;
+    index_t nearest = -1;
+    double d2 = 0;
+    tree.index().knnSearch(full.X.col(j).data(), 1, &nearest, &d2);
+    if (selection.band[j] >= 0) {
+      absorbed_by[j] = nearest;  // inside the bands: absorbed by, and following, its nearest selected point
+      a.follows[j] = nearest;
+      a.follow_offset.col(j) = full.X.col(j) - selected_X.col(nearest);
+    } else if (d2 < reach * reach) {
+      a.active_of[j] = static_cast<index_t>(a.full_of.size());  // the frozen ring
+      a.full_of.push_back(j);
+    }
+  }
+  const index_t n = static_cast<index_t>(a.full_of.size());
+
+  // the active cloud: volumes (absorbed ones added), per-point supports
+  PointCloud cloud;
+  cloud.spacing = full.spacing;
+  cloud.X.resize(3, n);
+  cloud.volume.resize(n);
+  for (index_t k = 0; k < n; ++k) {
+    cloud.X.col(k) = full.X.col(a.full_of[k]);
+    cloud.volume[k] = full.volume[a.full_of[k]];
+  }
+  Eigen::VectorXd mass(n), absorbed_volume = Eigen::VectorXd::Zero(n);
+  for (index_t k = 0; k < n; ++k) mass[k] = full.mass[a.full_of[k]];
+  Points f_ext(3, n);
+  for (index_t k = 0; k < n; ++k) f_ext.col(k) = full.f_ext.col(a.full_of[k]);
+  for (index_t j = 0; j < n_full; ++j)
+    if (absorbed_by[j] >= 0) {
+      cloud.volume[absorbed_by[j]] += full.volume[j];
+      mass[absorbed_by[j]] += full.mass[j];
+      f_ext.col(absorbed_by[j]) += full.f_ext.col(j);
+    }
+  // widen sparse supports: the smallest h_i in steps of h/4 that reaches min_neighbours active points
+  cloud.support = Eigen::VectorXd::Constant(n, h);
+  const KdTree active_tree(cloud.X);
+  std::vector<std::pair<index_t, double>> found;
+  nanoflann::SearchParams search;
+  search.sorted = true;
+  for (index_t k = 0; k < a.n_selected; ++k) {
+    found.clear();
+    active_tree.index().radiusSearch(cloud.X.col(k).data(), reach * reach, found, search);
+    // found is sorted by distance and includes the point itself; a point never needs more neighbours
+    // than it had in the full model (surface points have fewer)
+    const std::size_t needed =
+        static_cast<std::size_t>(std::min<index_t>(params.min_neighbours, full.neighbours.row_size(a.full_of[k]))) + 1;
+    if (found.size() < needed) {
+      cloud.support[k] = reach;
+    } else {
+      const double r = std::sqrt(found[needed - 1].second);
+      double hk = h;
+      while (hk <= r * (1 + 1e-9) && hk < reach) hk = std::min(reach, hk + 0.25 * h);
+      cloud.support[k] = hk;
+    }
+    a.widened += cloud.support[k] > h * (1 + 1e-12);
+  }
+  MaterialParams material = full.material;
+  KernelParams kernel = full.kernel;
+  kernel.support = h;
+  a.model = build_model(cloud, material, kernel);
+  a.model.mass = mass;  // kernel-volume mode included: the region's mass is what it was
+  a.model.f_ext = f_ext;
+  // held points: the full model's groups (restricted), and the frozen ring held where it is
+  for (index_t k = 0; k < n; ++k)
+    if (k >= a.n_selected || full.fixed[a.full_of[k]]) a.model.fixed[k] = 1;
+  for (const FixedGroup& g : full.fixed_groups) {
+    FixedGroup sub = g;
+    sub.points.clear();
+    for (index_t i : g.points)
+      if (a.active_of[i] >= 0 && a.active_of[i] < a.n_selected) sub.points.push_back(a.active_of[i]);
+    if (!sub.points.empty()) a.model.fixed_groups.push_back(sub);
+  }
+  a.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return a;
+}
+
+State ActiveSet::restrict_state(const State& full) const {
+  State s;
+  const index_t n = static_cast<index_t>(full_of.size());
+  s.u.resize(3, n);
+  s.velocity.resize(3, n);
+  for (index_t k = 0; k < n; ++k) {
+    s.u.col(k) = full.u.col(full_of[k]);
+    s.velocity.col(k) = k < n_selected ? Vec3(full.velocity.col(full_of[k])) : Vec3::Zero();  // the ring is held
+  }
+  s.time = full.time;
+  return s;
+}
+
+void ActiveSet::prolong_state(const State& active, State& full) const {
+  for (index_t k = 0; k < n_selected; ++k) {
+    full.u.col(full_of[k]) = active.u.col(k);
+    full.velocity.col(full_of[k]) = active.velocity.col(k);
+  }
+  for (index_t j = 0; j < static_cast<index_t>(follows.size()); ++j) {
+    const index_t k = follows[j];
+    if (k < 0) continue;
+    // first-order MLS from the followed point: exact for any affine field
+    const Vec3 dX = follow_offset.col(j);
+    full.u.col(j) = active.u.col(k) + displacement_gradient(model, active.u, k) * dX;
+    full.velocity.col(j) = active.velocity.col(k) + displacement_gradient(model, active.velocity, k) * dX;
+  }
+  full.time = active.time;
+}
+
+}  // namespace pointhaptics

@@ -1,0 +1,145 @@
+// Tests for lod/active_set: the whole selection is the full model, mass and load are kept, absorbed
+// points follow exactly for affine fields, sparse points get enough neighbours, held points stay held,
+// and a static solve on the active set agrees with the full model near the contact.
+#include <pointhaptics/lod/active_set.hpp>
+#include <pointhaptics/mechanics/forces.hpp>
+#include <pointhaptics/solvers/static_solver.hpp>
+
+#include "support/test_models.hpp"
+
+#include <gtest/gtest.h>
+
+namespace pointhaptics {
+namespace {
+
+const double s = 0.005;
+
+// a 0.1 x 0.03 x 0.03 m bar (21 x 7 x 7 points), clamped at x = 0
+Model bar() {
+  Model m = build_model(test::jittered_box(21, 7, 7, s, 0.0), MaterialParams{}, KernelParams{});
+  FixedGroup clamp;
+  clamp.name = "clamp";
+  for (index_t i = 0; i < m.n_points; ++i)
+    if (m.X(0, i) < 1e-9) {
+      m.fixed[i] = 1;
+      clamp.points.push_back(i);
+    }
+  m.fixed_groups.push_back(clamp);
+  return m;
+}
+
+Selection select(const Model& m, const Vec3& c, const LodParams& p) {
+  std::mt19937_64 rng(p.seed);
+  return select_points(m, c, p, rng);
+}
+
+LodParams levels() {
+  LodParams p;
+  p.levels = {{3.0, 6}, {5.0, 8}};
+  return p;
+}
+
+TEST(ActiveSet, SelectingEverythingGivesTheFullModel) {
+  const Model full = bar();
+  LodParams p;
+  p.k1 = p.k2 = 100.0;
+  const ActiveSet a = build_active_set(full, select(full, full.X.col(0), p));
+  ASSERT_EQ(a.model.n_points, full.n_points);
+  EXPECT_EQ(a.widened, 0);
+  const Points u = test::random_field(full.n_points, 0.01 * s, 3);
+  Workspace wf(full, 1), wa(a.model, 1);
+  compute_internal_forces(full, u, wf);
+  compute_internal_forces(a.model, u, wa);
+  EXPECT_LE((wf.f_int - wa.f_int).norm(), 1e-10 * wf.f_int.norm());
+}
+
+TEST(ActiveSet, KeepsMassAndLoadAndGivesSparsePointsEnoughNeighbours) {
+  Model full = bar();
+  full.f_ext.row(1).setConstant(-1e-3);  // a load on every point
+  const Vec3 c(0.1, 0.03, 0.015);
+  const Selection sel = select(full, c, levels());
+  ActiveSetParams params;
+  const ActiveSet a = build_active_set(full, sel, params);
+  EXPECT_LT(a.n_selected, full.n_points);
+  double mass_bands = 0, mass_active = 0, load_bands = 0, load_active = 0;
+  for (index_t i = 0; i < full.n_points; ++i)
+    if (sel.band[i] >= 0 || (a.active_of[i] >= 0 && a.active_of[i] < a.n_selected)) {
+      mass_bands += full.mass[i];
+      load_bands += full.f_ext(1, i);
+    }
+  for (index_t k = 0; k < a.n_selected; ++k) {
+    mass_active += a.model.mass[k];
+    load_active += a.model.f_ext(1, k);
+  }
+  EXPECT_NEAR(mass_active, mass_bands, 1e-12 * mass_bands);
+  EXPECT_NEAR(load_active, load_bands, 1e-12 * std::abs(load_bands));
+  for (index_t k = 0; k < a.n_selected; ++k) {
+    const bool enough = a.model.neighbours.row_size(k) >= std::min<index_t>(params.min_neighbours, full.neighbours.row_size(a.full_of[k]));
+    const bool at_limit = a.model.support[k] >= params.max_widening * full.h * (1 - 1e-12);
+    EXPECT_TRUE(enough || at_limit) << "active point " << k;
+  }
+  EXPECT_GT(a.widened, 0);
+  // the frozen ring and the clamp are held
+  for (index_t k = a.n_selected; k < a.model.n_points; ++k) EXPECT_TRUE(a.model.fixed[k]);
+  for (index_t k = 0; k < a.n_selected; ++k) EXPECT_EQ(a.model.fixed[k] != 0, full.fixed[a.full_of[k]] != 0);
+}
+
+TEST(ActiveSet, AbsorbedPointsFollowAffineFieldsExactly) {
+  const Model full = bar();
+  const ActiveSet a = build_active_set(full, select(full, Vec3(0.05, 0.03, 0.015), levels()));
+  Mat3 A;
+  A << 0.01, 0.002, -0.003, 0.0, -0.02, 0.004, 0.005, 0.001, 0.01;
+  State f = State::at_rest(full);
+  f.u = A * full.X;
+  State active = a.restrict_state(f);
+  State back = State::at_rest(full);
+  a.prolong_state(active, back);
+  for (index_t j = 0; j < full.n_points; ++j)
+    if (a.follows[j] >= 0 || (a.active_of[j] >= 0 && a.active_of[j] < a.n_selected)) {
+      ASSERT_LE((back.u.col(j) - f.u.col(j)).norm(), 1e-12) << "point " << j;
+    }
+}
+
+TEST(ActiveSet, StaticSolveAgreesWithTheFullModelNearTheContact) {
+  Model full = bar();
+  // a point load at the free end's top edge, the contact
+  index_t loaded = 0;
+  for (index_t i = 0; i < full.n_points; ++i)
+    if ((full.X.col(i) - Vec3(0.1, 0.03, 0.015)).norm() < 1e-9) loaded = i;
+  full.f_ext(1, loaded) = -0.02;
+  State reference = State::at_rest(full);
+  {
+    Workspace ws(full, 1);
+    NewtonSolver newton(full);
+    ASSERT_TRUE(solve_static(full, reference, ws, newton, NewtonSettings{}).converged);
+  }
+  LodParams p;
+  p.k1 = 6.0;              // the free half of the bar fully selected,
+  p.k2 = 7.0;
+  p.levels = {{20.0, 2}};  // the clamped half at selection weight 0.8
+  const Selection sel = select(full, full.X.col(loaded), p);
+  const ActiveSet a = build_active_set(full, sel);
+  State active = a.restrict_state(State::at_rest(full));
+  Workspace ws(a.model, 1);
+  NewtonSolver newton(a.model);
+  ASSERT_TRUE(solve_static(a.model, active, ws, newton, NewtonSettings{}).converged);
+  State lod = State::at_rest(full);
+  a.prolong_state(active, lod);
+  // displacement error inside T_r1 against the full model
+  double err = 0, ref = 0;
+  for (index_t i = 0; i < full.n_points; ++i)
+    if (sel.band[i] == 0) {
+      err = std::max(err, (lod.u.col(i) - reference.u.col(i)).norm());
+      ref = std::max(ref, reference.u.col(i).norm());
+    }
+  RecordProperty("lod_error_inside_tr1", std::to_string(err / ref));
+  std::printf("active set: %d of %d points selected (%d widened), max displacement error inside T_r1: %.2f%%\n",
+              a.n_selected, full.n_points, a.widened, 100 * err / ref);
+  // measured: 13% with the seed's random thinning at weight 0.8 where the bar carries its largest bending
+  // moment (11-14% for 8-20 neighbours; 60-90% at weight 0.4): the seed's scheme costs accuracy wherever
+  // the coarse region carries load. A guard against regressions, not the goal of issue 5.
+  EXPECT_LT(err, 0.2 * ref);
+}
+
+}  // namespace
+}  // namespace pointhaptics
