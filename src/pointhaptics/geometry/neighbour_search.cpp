@@ -20,9 +20,10 @@ Csr rows_to_csr(const std::vector<std::vector<index_t>>& rows) {
   return Csr{std::move(offset), std::move(index)};
 }
 
-}  // namespace
-
-Csr radius_neighbours(const Points& X, double h) {
+// The k-d tree search shared by both supports: candidates within `reach` (slightly widened), then
+// support(i, j) decides with the one support predicate.
+template <class Support>
+Csr search_neighbours(const Points& X, double reach, Support&& support) {
   const index_t n = static_cast<index_t>(X.cols());
   const KdTree tree(X);
   std::vector<std::vector<index_t>> rows(n);
@@ -33,40 +34,28 @@ Csr radius_neighbours(const Points& X, double h) {
     for (index_t i = range.begin(); i != range.end(); ++i) {
       found.clear();
       const Vec3 q = X.col(i);
-      // search slightly wider than h, then apply the one support predicate
-      tree.index().radiusSearch(q.data(), h * h * (1.0 + 1e-6), found, params);
+      tree.index().radiusSearch(q.data(), reach * reach * (1.0 + 1e-6), found, params);
       auto& row = rows[i];
       for (const auto& [j, r2] : found)
-        if (j != i && within_support((X.col(j) - q).squaredNorm(), h)) row.push_back(j);
+        if (j != i && within_support((X.col(j) - q).squaredNorm(), support(i, static_cast<index_t>(j)))) row.push_back(j);
       std::sort(row.begin(), row.end());
     }
   });
   return rows_to_csr(rows);
 }
 
+}  // namespace
+
+Csr radius_neighbours(const Points& X, double h) {
+  return search_neighbours(X, h, [h](index_t, index_t) { return h; });
+}
+
 Csr radius_neighbours(const Points& X, const Eigen::VectorXd& support) {
   const index_t n = static_cast<index_t>(X.cols());
   if (support.size() != n) throw Error("neighbour search: one support radius per point is needed");
-  const double h_max = n ? support.maxCoeff() : 0.0;
-  const KdTree tree(X);
-  std::vector<std::vector<index_t>> rows(n);
-  tbb::parallel_for(tbb::blocked_range<index_t>(0, n, 256), [&](const tbb::blocked_range<index_t>& range) {
-    std::vector<std::pair<index_t, double>> found;
-    nanoflann::SearchParams params;
-    params.sorted = false;
-    for (index_t i = range.begin(); i != range.end(); ++i) {
-      found.clear();
-      const Vec3 q = X.col(i);
-      tree.index().radiusSearch(q.data(), h_max * h_max * (1.0 + 1e-6), found, params);
-      auto& row = rows[i];
-      // symmetric: i and j are neighbours when either one's support reaches the other
-      for (const auto& [j, r2] : found)
-        if (j != i && within_support((X.col(j) - q).squaredNorm(), std::max(support[i], support[static_cast<index_t>(j)])))
-          row.push_back(j);
-      std::sort(row.begin(), row.end());
-    }
-  });
-  return rows_to_csr(rows);
+  // symmetric: i and j are neighbours when either one's support reaches the other
+  return search_neighbours(X, n ? support.maxCoeff() : 0.0,
+                           [&support](index_t i, index_t j) { return std::max(support[i], support[j]); });
 }
 
 Csr radius_neighbours_brute_force(const Points& X, double h) {
