@@ -27,9 +27,9 @@ struct RunOptions {
   int threads = 0;
 };
 
-void print_summary(const ph::Simulation& sim, const ph::RunSummary& s, double setup_s) {
-  const ph::Model& m = sim.model();
-  const ph::State& st = sim.state();
+void print_summary(ph::Simulation& sim, const ph::RunSummary& s, double setup_s) {
+  const ph::Model& m = sim.full_model();
+  const ph::State& st = sim.full_state();
   Eigen::Index worst = 0;
   const double max_u = m.n_points ? st.u.colwise().norm().maxCoeff(&worst) : 0.0;
   fmt::print("points          {} ({} held), h = {:.4g} m, {:.1f} neighbours per point (min {}), kernel {}\n", m.n_points,
@@ -55,6 +55,15 @@ void print_summary(const ph::Simulation& sim, const ph::RunSummary& s, double se
   for (size_t g = 0; g < s.reactions.size(); ++g)
     fmt::print("reaction        {}: ({:.4g}, {:.4g}, {:.4g}) N on {} points\n", m.fixed_groups[g].name, s.reactions[g][0],
                s.reactions[g][1], s.reactions[g][2], m.fixed_groups[g].points.size());
+  if (s.lod.enabled) {
+    std::string bands;
+    for (size_t b = 0; b < s.lod.band_count.size(); ++b)
+      bands += fmt::format("{}{}/{}", b ? ", " : "", s.lod.band_selected[b], s.lod.band_count[b]);
+    fmt::print("levels of detail {} of {} points simulated ({} held around them, {} with wider supports); selected per "
+               "band {}; {} selections, the last {:.2f} ms + {:.2f} ms to build, the longest {:.2f} ms\n",
+               s.lod.selected, m.n_points, s.lod.frozen, s.lod.widened, bands, s.lod.selections, s.lod.selection_ms,
+               s.lod.build_ms, s.lod.max_reselect_ms);
+  }
   fmt::print("timing          set-up {:.3f} s, stepping {:.3f} s, {:.3f} ms per step, {:.0f} steps/s\n", setup_s, s.wall_s,
              s.step_ms_mean, s.steps_per_s);
 }
@@ -63,12 +72,13 @@ int run_command(const RunOptions& opt) {
   const auto start = std::chrono::steady_clock::now();
   const ph::Scene scene = ph::read_scene_file(opt.scene);
   ph::Simulation sim(ph::build_scene_model(scene), scene.solver, opt.threads);
+  if (scene.lod.present) sim.enable_lod(scene.lod.params, ph::scene_lod_contact(scene, sim.model()));
   const double setup_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ph::InteractiveResult interactive;
   if (scene.probe.present) {
     // with a probe: the haptic loop at 1 kHz and the simulation, in real time unless asked otherwise
     const std::unique_ptr<ph::Device> device = ph::make_scene_device(scene);
-    ph::InteractiveOptions options = ph::scene_interactive_options(scene, sim.model());
+    ph::InteractiveOptions options = ph::scene_interactive_options(scene, sim.full_model());
     options.real_time = !opt.deterministic;
     options.log = !opt.force_log.empty();
     interactive = ph::run_interactive(sim, *device, options);
@@ -84,7 +94,7 @@ int run_command(const RunOptions& opt) {
     summary.haptic_period_p99_us = interactive.haptic.period_p99_us;
     summary.haptic_max_force_n = interactive.haptic.max_force_n;
   }
-  if (!opt.json.empty()) ph::write_result_json(opt.json, sim.model(), sim.state(), summary);
+  if (!opt.json.empty()) ph::write_result_json(opt.json, sim.full_model(), sim.full_state(), summary);
   if (!opt.quiet) {
     print_summary(sim, summary, setup_s);
     if (scene.probe.present) {

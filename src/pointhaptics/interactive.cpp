@@ -52,6 +52,11 @@ class ContactForces : public DynamicForces {
   void add(const Model& model, const State& state, Points& f) override {
     last = contact.apply(model, state.u, probe, button, state.time, f);
   }
+  // levels of detail re-selected: the simulated points were renumbered
+  void remap(const Model& model, const std::vector<index_t>& new_index) {
+    contact.remap(model, new_index);
+    scratch = Points::Zero(3, model.n_points);
+  }
   bool add_stiffness(const Model&, const State&, Eigen::Matrix<double, 9, Eigen::Dynamic>& springs) override {
     contact.add_stiffness(springs);
     return last.contacts > 0;
@@ -73,14 +78,22 @@ int simulation_step(Simulation& sim, ContactForces& contact, HapticLoop& loop, T
   contact.device = frame.device;
   contact.button = frame.button;
   contact.solve_probe(sim.model(), sim.state());
+  const int contacts_before = contact.last.contacts;
   sim.step();
   loop.contact_models().back() = contact.last;
   loop.contact_models().publish();
+  if (sim.lod_enabled()) {
+    // levels of detail follow the contact point: at contact onset and when it moved far enough; on this
+    // thread, while the haptic thread keeps rendering the local model just published
+    const bool onset = contacts_before == 0 && contact.last.contacts > 0;
+    const std::vector<index_t> new_index = sim.update_lod(sim.lod_contact_of_probe(contact.probe, contact.contact.grabbed()), onset);
+    if (!new_index.empty()) contact.remap(sim.model(), new_index);
+  }
   if (display) {
     DisplayFrame& d = display->back();
     d.time = sim.state().time;
     d.step = step;
-    d.u = sim.state().u;  // same size every time: no allocation
+    d.u = sim.full_state().u;  // same size every time: no allocation
     d.probe = contact.probe;
     display->publish();
   }
@@ -132,7 +145,7 @@ InteractiveOptions scene_interactive_options(const Scene& scene, const Model& mo
 InteractiveResult run_interactive(Simulation& sim, Device& device, const InteractiveOptions& options) {
   if (!(options.duration >= 0) || !(options.haptic_rate > 0)) throw Error("interactive run: bad duration or haptic rate");
   if (sim.solver().kind == SolverKind::STATIC) throw Error("interactive run: needs a dynamic solver (explicit or implicit)");
-  if (options.display && options.display->back().u.cols() != sim.model().n_points)
+  if (options.display && options.display->back().u.cols() != sim.full_model().n_points)
     throw Error("interactive run: the display frames must be sized for the model's points (3 x n)");
   const CouplingGains gains = coupling_budget(device.specs(), options.mapping.scale, options.coupling_safety);
   ContactForces contact(sim.model(), options.probe, gains.stiffness, device.specs().max_force);

@@ -26,7 +26,8 @@ struct InteractiveOptions {
   bool real_time = true;         ///< threads on the wall clock; false: one thread, deterministic, simulated time
   bool log = true;               ///< keep the force log (one row per haptic tick)
   /// If set, the simulation publishes a DisplayFrame after every step here (lock-free; the reader, e.g. a
-  /// viewer thread, calls update() and reads front()). Its frames must be sized for the model's points.
+  /// viewer thread, calls update() and reads front()). Its frames must be sized for the object's points
+  /// (all of them, with levels of detail too).
   TripleBuffer<DisplayFrame>* display = nullptr;
 };
 

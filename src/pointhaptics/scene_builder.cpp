@@ -79,4 +79,17 @@ Model build_scene_model(const Scene& scene) {
   return model;
 }
 
+Vec3 scene_lod_contact(const Scene& scene, const Model& model) {
+  if (scene.lod.contact.allFinite()) return scene.lod.contact;
+  if (scene.probe.present) {
+    const Vec3 lo = model.X.rowwise().minCoeff(), hi = model.X.rowwise().maxCoeff();
+    const Vec3 origin = scene.probe.origin.allFinite() ? scene.probe.origin : Vec3(0.5 * (lo.x() + hi.x()), hi.y(), 0.5 * (lo.z() + hi.z()));
+    return Vec3(origin.x(), std::min(origin.y(), hi.y()), origin.z());
+  }
+  for (const LoadSpec& l : scene.loads)
+    if (l.kind == LoadKind::POINT) return model.X.col(static_cast<index_t>(l.point));
+  throw Error(fmt::format("{}:{}: lod.contact: missing (give contact = [x, y, z], a [probe] or one point load)", scene.path,
+                          scene.lod.line));
+}
+
 }  // namespace pointhaptics

@@ -15,4 +15,9 @@ PointCloud sample_object(const Scene& scene);
 /// Throws Error naming the scene file and line for a box that selects no point or a point index out of range.
 Model build_scene_model(const Scene& scene);
 
+/// Where a scene's levels of detail start (reference configuration, m): lod.contact if given; else with a
+/// [probe], the point of the object below the probe's origin (the top centre by default; an interactive
+/// run then follows the probe); else the point of the scene's one point load.
+Vec3 scene_lod_contact(const Scene& scene, const Model& model);
+
 }  // namespace pointhaptics

@@ -1,6 +1,7 @@
 #include <pointhaptics/simulation.hpp>
 
 #include <pointhaptics/core/error.hpp>
+#include <pointhaptics/geometry/kd_tree.hpp>
 #include <pointhaptics/mechanics/energy.hpp>
 #include <pointhaptics/mechanics/forces.hpp>
 #include <pointhaptics/solvers/explicit_solver.hpp>
@@ -14,12 +15,31 @@
 
 namespace pointhaptics {
 
+// Levels of detail: the object, its state, and the active set simulated in its place.
+struct Simulation::Lod {
+  Model full;
+  State full_state;
+  std::unique_ptr<KdTree> tree;  // over full.X, for snapping contact points
+  LodParams params;
+  ActiveSet active;
+  Selection selection;
+  Vec3 centre = Vec3::Constant(NAN);   // of the selection: the object's point nearest the contact
+  Vec3 contact = Vec3::Constant(NAN);  // the contact point the selection was made for
+  bool full_state_current = true;
+  long long selections = 0;
+  double last_build_ms = 0, max_reselect_ms = 0;
+
+  Vec3 snap(const Vec3& c) const {
+    index_t nearest = 0;
+    double d2 = 0;
+    tree->index().knnSearch(c.data(), 1, &nearest, &d2);
+    return full.X.col(nearest);
+  }
+};
+
 Simulation::Simulation(Model model, const SolverSpec& solver, int n_threads)
-    : model_(std::move(model)), solver_(solver), state_(State::at_rest(model_)), ws_(model_, n_threads) {
-  stable_dt_ = stable_time_step(model_);
-  extra_forces_ = Points::Zero(3, model_.n_points);
-  if (solver_.kind == SolverKind::STATIC) newton_ = std::make_unique<NewtonSolver>(model_);
-  if (solver_.kind == SolverKind::IMPLICIT) implicit_ = std::make_unique<ImplicitSolver>(model_);
+    : model_(std::move(model)), solver_(solver), state_(State::at_rest(model_)), ws_(model_, n_threads), n_threads_(n_threads) {
+  prepare_solver();
   // held points start at their prescribed displacement at t = 0
   for (const FixedGroup& group : model_.fixed_groups)
     for (index_t i : group.points) state_.u.col(i) = prescribed_displacement(group, 0.0);
@@ -27,6 +47,102 @@ Simulation::Simulation(Model model, const SolverSpec& solver, int n_threads)
 
 Simulation::~Simulation() = default;
 Simulation::Simulation(Simulation&&) noexcept = default;
+
+void Simulation::prepare_solver() {
+  stable_dt_ = stable_time_step(model_);
+  extra_forces_ = Points::Zero(3, model_.n_points);
+  newton_.reset();
+  implicit_.reset();
+  if (solver_.kind == SolverKind::STATIC) newton_ = std::make_unique<NewtonSolver>(model_);
+  if (solver_.kind == SolverKind::IMPLICIT) implicit_ = std::make_unique<ImplicitSolver>(model_);
+}
+
+void Simulation::enable_lod(const LodParams& params, const Vec3& contact) {
+  validate(params);
+  if (!contact.allFinite()) throw Error("lod: the contact point is not finite");
+  if (lod_) throw Error("lod: levels of detail are already on");
+  auto lod = std::make_unique<Lod>();
+  lod->params = params;
+  lod->full = std::move(model_);
+  lod->full_state = state_;
+  lod->tree = std::make_unique<KdTree>(lod->full.X);
+  lod_ = std::move(lod);
+  lod_->contact = contact;
+  reselect(lod_->snap(contact));
+}
+
+void Simulation::set_state(const State& state) {
+  if (state.u.cols() != model_.n_points || state.velocity.cols() != model_.n_points)
+    throw Error("simulation: the state is for another model");
+  state_ = state;
+  if (lod_) lod_->full_state_current = false;
+}
+
+const Model& Simulation::full_model() const { return lod_ ? lod_->full : model_; }
+const ActiveSet* Simulation::active_set() const { return lod_ ? &lod_->active : nullptr; }
+
+const State& Simulation::full_state() {
+  if (!lod_) return state_;
+  if (!lod_->full_state_current) {
+    lod_->active.prolong_state(state_, lod_->full_state);
+    lod_->full_state_current = true;
+  }
+  return lod_->full_state;
+}
+
+Vec3 Simulation::lod_contact_of_probe(const Vec3& probe, const std::vector<index_t>& grabbed) const {
+  // grabbing: where the grabbed points are in the object, however far they were dragged
+  if (!grabbed.empty()) {
+    Vec3 sum = Vec3::Zero();
+    for (index_t i : grabbed) sum += model_.X.col(i);
+    return sum / static_cast<double>(grabbed.size());
+  }
+  // pushing: the probe itself. Not the reference position of the touched points, which jumps from one
+  // point to the next as the probe slides; the probe moves smoothly, and is never farther from them
+  // than the indentation plus its radius
+  return probe;
+}
+
+std::vector<index_t> Simulation::update_lod(const Vec3& contact, bool onset) {
+  if (!lod_) throw Error("lod: levels of detail are off");
+  if (!contact.allFinite()) return {};
+  // the distance is the contact point's own, not its snapped point's: a probe that trembles between two
+  // points of the lattice must not re-select at every step
+  const double moved = (contact - lod_->contact).norm();
+  if (onset ? moved < 0.25 * lod_->params.reselect * lod_->full.h : moved <= lod_->params.reselect * lod_->full.h) return {};
+  lod_->contact = contact;
+  return reselect(lod_->snap(contact));
+}
+
+std::vector<index_t> Simulation::reselect(const Vec3& c) {
+  Lod& l = *lod_;
+  const auto start = std::chrono::steady_clock::now();
+  const State& carried = full_state();  // the active state so far, back on the object
+  std::mt19937_64 rng(l.params.seed);   // a fresh generator: every point keeps its draw across selections
+  Selection selection = select_points(l.full, c, l.params, rng);
+  ActiveSet active = build_active_set(l.full, selection, l.params);
+  std::vector<index_t> new_index(model_.n_points, -1);
+  if (l.selections > 0)
+    for (index_t k = 0; k < l.active.n_selected; ++k) {
+      const index_t now = active.active_of[l.active.full_of[k]];
+      new_index[k] = now < active.n_selected ? now : -1;
+    }
+  const double time = carried.time;
+  state_ = active.restrict_state(carried);
+  state_.time = time;
+  l.active = std::move(active);
+  l.selection = std::move(selection);
+  l.centre = c;
+  model_ = l.active.model;
+  ws_ = Workspace(model_, n_threads_);
+  prepare_solver();
+  l.full_state_current = false;
+  ++l.selections;
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  l.last_build_ms = ms - l.selection.milliseconds;
+  l.max_reselect_ms = std::max(l.max_reselect_ms, ms);
+  return new_index;
+}
 
 NewtonSettings Simulation::newton_settings() const {
   NewtonSettings s;
@@ -79,6 +195,7 @@ void Simulation::step() {
     }
   }
   ++steps_;
+  if (lod_) lod_->full_state_current = false;
   step_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
@@ -114,6 +231,22 @@ RunSummary Simulation::summary() {
   s.wall_s = step_seconds_;
   s.step_ms_mean = steps_ > 0 ? 1e3 * step_seconds_ / steps_ : 0;
   s.steps_per_s = step_seconds_ > 0 ? steps_ / step_seconds_ : 0;
+  if (lod_) {
+    const Lod& l = *lod_;
+    LodSummary& o = s.lod;
+    o.enabled = true;
+    o.selected = l.active.n_selected;
+    o.frozen = l.active.model.n_points - l.active.n_selected;
+    o.widened = l.active.widened;
+    o.band_count = l.selection.band_count;
+    o.band_selected = l.selection.band_selected;
+    o.active.assign(l.full.n_points, 0);
+    for (index_t k = 0; k < l.active.n_selected; ++k) o.active[l.active.full_of[k]] = 1;
+    o.selections = l.selections;
+    o.selection_ms = l.selection.milliseconds;
+    o.build_ms = l.last_build_ms;
+    o.max_reselect_ms = l.max_reselect_ms;
+  }
   return s;
 }
 

@@ -4,6 +4,7 @@
 #include <pointhaptics/core/workspace.hpp>
 #include <pointhaptics/io/result_json.hpp>
 #include <pointhaptics/io/scene.hpp>
+#include <pointhaptics/lod/active_set.hpp>
 #include <pointhaptics/solvers/explicit_solver.hpp>
 #include <pointhaptics/solvers/implicit_solver.hpp>
 #include <pointhaptics/solvers/newton.hpp>
@@ -27,10 +28,31 @@ class Simulation {
   /// called after each step.
   void run(double duration, const std::function<void(double)>& progress = {});
 
+  /// The simulated model and its state: the whole object, or with levels of detail the active set.
   const Model& model() const { return model_; }
   const State& state() const { return state_; }
+
+  /// Levels of detail (seed §3): from now on simulate only the points selected around `contact` (the
+  /// reference configuration, m; snapped to the nearest point of the object); model() becomes the active
+  /// set and full_model() the object. Throws Error on bad parameters.
+  void enable_lod(const LodParams& params, const Vec3& contact);
+  bool lod_enabled() const { return lod_ != nullptr; }
+  /// Re-select when the contact point is farther than params.reselect h from the one of the last
+  /// selection, or at contact onset (`onset`) when it is farther than a quarter of that. The state carries over: the active state goes back to the object
+  /// (absorbed points follow by MLS), the new active set takes its points' displacements and velocities.
+  /// Returns the new index of each old active point (-1 if no longer simulated), or an empty vector when
+  /// nothing changed. Allocates (a new model): not a per-step operation; its cost is in the summary.
+  std::vector<index_t> update_lod(const Vec3& contact, bool onset = false);
+  /// The contact point of a probe at `probe` for update_lod(): the probe itself when pushing; when
+  /// grabbing (`grabbed`: indices into model()), where the grabbed points are in the object.
+  Vec3 lod_contact_of_probe(const Vec3& probe, const std::vector<index_t>& grabbed = {}) const;
+  const Model& full_model() const;
+  /// The object's state (with levels of detail: the active state carried back; absorbed points follow
+  /// their selected point by first-order MLS, the rest keep their last displacement).
+  const State& full_state();
+  const ActiveSet* active_set() const;
   /// Replace the state (same model); used by tests and by replay.
-  void set_state(const State& state) { state_ = state; }
+  void set_state(const State& state);
   const SolverSpec& solver() const { return solver_; }
   /// State-dependent forces added at every dynamic step (probe contact): explicit dynamics evaluates them
   /// at every sub-step, implicit dynamics once per step (held over it). Not owned; nullptr: none.
@@ -42,11 +64,16 @@ class Simulation {
 
  private:
   NewtonSettings newton_settings() const;
+  void prepare_solver();  // for model_: workspace, stable step, solver objects
+  std::vector<index_t> reselect(const Vec3& snapped_contact);
+  struct Lod;
+  std::unique_ptr<Lod> lod_;
 
   Model model_;
   SolverSpec solver_;
   State state_;
   Workspace ws_;
+  int n_threads_ = 0;
   Points extra_forces_;
   Eigen::Matrix<double, 9, Eigen::Dynamic> springs_;
   DynamicForces* dynamic_forces_ = nullptr;

@@ -32,7 +32,8 @@ TEST(ResultJson, HasEveryContractKeyWithOneEntryPerPoint) {
   for (const char* key : {"strain", "kinetic"}) EXPECT_TRUE(doc["energy"].contains(key)) << key;
   for (const char* key : {"wall_s", "step_ms_mean", "steps_per_s"}) EXPECT_TRUE(doc["timing"].contains(key)) << key;
   for (const char* key : {"ticks", "rate_hz", "period_p99_us", "max_force_n"}) EXPECT_TRUE(doc["haptic"].contains(key)) << key;
-  for (const char* key : {"selected", "selection_ms"}) EXPECT_TRUE(doc["lod"].contains(key)) << key;
+  for (const char* key : {"selected", "selection_ms", "enabled", "band_count", "band_selected", "selections", "frozen"})
+    EXPECT_TRUE(doc["lod"].contains(key)) << key;
   EXPECT_EQ(doc["points"]["displacement"][3][1].get<double>(), -2e-3);
   EXPECT_EQ(doc["points"]["fixed"][1].get<bool>(), true);
   EXPECT_EQ(doc["points"]["fixed"][2].get<bool>(), false);

@@ -147,8 +147,58 @@ TEST(SceneToml, SyntaxErrorNamesTheLine) {
   EXPECT_NE(e.find("bad.toml:" + std::to_string(line_of("density = 1000.0")) + ": TOML syntax error"), std::string::npos) << e;
 }
 
-TEST(SceneToml, SectionsOfLaterVersionsAreRefusedClearly) {
-  EXPECT_NE(error_of("[solver]", "[lod]\nk1 = 1.0\n[solver]").find("lod"), std::string::npos);
+TEST(SceneToml, ReadsTheLodSection) {
+  const std::string lod = "[lod]\nk1 = 1.5\nk2 = 2\nlevels = [ { distance = 2.5, K = 6 }, { distance = 4.0, K = 8 } ]\n"
+                          "seed = 7\nscheme = \"dither\"\nreselect = 0.25\nmin_neighbours = 10\nmax_widening = 2.5\n"
+                          "contact = [0.1, 0.03, 0.0]\n[solver]";
+  std::string text = full_scene;
+  text.replace(text.find("[solver]"), 8, lod);
+  const Scene s = parse_scene(text, "lod.toml");
+  ASSERT_TRUE(s.lod.present);
+  EXPECT_DOUBLE_EQ(s.lod.params.k1, 1.5);
+  EXPECT_DOUBLE_EQ(s.lod.params.k2, 2.0);
+  ASSERT_EQ(s.lod.params.levels.size(), 2u);
+  EXPECT_DOUBLE_EQ(s.lod.params.levels[1].distance, 4.0);
+  EXPECT_EQ(s.lod.params.levels[1].K, 8);
+  EXPECT_EQ(s.lod.params.seed, 7u);
+  EXPECT_EQ(s.lod.params.scheme, LodScheme::DITHER);
+  EXPECT_DOUBLE_EQ(s.lod.params.reselect, 0.25);
+  EXPECT_EQ(s.lod.params.min_neighbours, 10);
+  EXPECT_DOUBLE_EQ(s.lod.params.max_widening, 2.5);
+  EXPECT_DOUBLE_EQ(s.lod.contact.x(), 0.1);
+  EXPECT_FALSE(parse_scene(full_scene).lod.present);
+}
+
+TEST(SceneToml, BadLodSectionsNameTheKey) {
+  auto lod_error = [](const std::string& body) {
+    std::string text = full_scene;
+    text.replace(text.find("[solver]"), 8, "[lod]\n" + body + "\n[solver]");
+    try {
+      parse_scene(text, "bad.toml");
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(lod_error("k1 = 2\nk2 = 1").find("lod.k2"), std::string::npos);
+  EXPECT_NE(lod_error("levels = [ { distance = 1.0, K = 6 } ]").find("lod.levels.distance"), std::string::npos);
+  EXPECT_NE(lod_error("levels = [ { distance = 3.0, K = 11 } ]").find("lod.levels.K"), std::string::npos);
+  EXPECT_NE(lod_error("levels = [ { distance = 3.0, K = 8 }, { distance = 4.0, K = 6 } ]").find("non-decreasing"),
+            std::string::npos);
+  EXPECT_NE(lod_error("levels = [ { distance = 3.0 } ]").find("both distance and K"), std::string::npos);
+  EXPECT_NE(lod_error("levels = [ { distance = 3.0, K = 6, w = 1 } ]").find("lod.levels.w: unknown key"), std::string::npos);
+  EXPECT_NE(lod_error("scheme = \"blue\"").find("lod.scheme"), std::string::npos);
+  EXPECT_NE(lod_error("reselect = 0").find("lod.reselect"), std::string::npos);
+  EXPECT_NE(lod_error("seed = -1").find("lod.seed"), std::string::npos);
+  EXPECT_NE(lod_error("k3 = 1").find("lod.k3: unknown key"), std::string::npos);
+  // the scene has a point load (a contact point); without one and without a probe, contact is needed
+  std::string no_contact = "[object]\nshape = \"box\"\nsize = [0.1, 0.02, 0.02]\nspacing = 0.01\n[lod]\nk1 = 1.0\n";
+  try {
+    parse_scene(no_contact, "nc.toml");
+    ADD_FAILURE() << "a [lod] without a contact point was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("lod.contact"), std::string::npos) << e.what();
+  }
 }
 
 TEST(SceneToml, FilesAreReadAndRelativePathsResolved) {

@@ -58,7 +58,7 @@ TEST(ActiveSet, KeepsMassAndLoadAndGivesSparsePointsEnoughNeighbours) {
   full.f_ext.row(1).setConstant(-1e-3);  // a load on every point
   const Vec3 c(0.1, 0.03, 0.015);
   const Selection sel = select(full, c, levels());
-  ActiveSetParams params;
+  LodParams params;
   const ActiveSet a = build_active_set(full, sel, params);
   EXPECT_LT(a.n_selected, full.n_points);
   double mass_bands = 0, mass_active = 0, load_bands = 0, load_active = 0;

@@ -42,6 +42,50 @@ TEST(LodSelection, BandsFollowTheDistances) {
   EXPECT_TRUE(std::is_sorted(sel.selected.begin(), sel.selected.end()));
 }
 
+TEST(LodSelection, DitherSelectsEachWeightExactlyAndEvenlyOnALattice) {
+  // on a lattice, every 4x4x4 block of a band holds exactly round(64 (10 - K) / 10) selected points with
+  // the dithered scheme, for every K
+  const Model model = build_model(test::jittered_box(16, 16, 16, s, 0.0), MaterialParams{}, KernelParams{});
+  for (int K = 0; K <= 10; ++K) {
+    int per_block[64] = {};
+    for (index_t i = 0; i < model.n_points; ++i) {
+      const double r = dither_threshold(model.X.col(i), s);
+      ASSERT_GE(r, 0.0);
+      ASSERT_LT(r, 10.0);
+      if (r < K) continue;
+      int block = 0;
+      for (int a = 0; a < 3; ++a) block = 4 * block + static_cast<int>(std::floor(model.X(a, i) / s + 0.5)) / 4;
+      ++per_block[block];
+    }
+    // thresholds 10 (v + 0.5) / 64 >= K  <=>  v >= 6.4 K - 0.5
+    const int expected = 64 - static_cast<int>(std::ceil(6.4 * K - 0.5));
+    for (int b = 0; b < 64; ++b) ASSERT_EQ(per_block[b], expected) << "K = " << K << ", block " << b;
+  }
+  // and evenly: at weight 1/8 (values 56..63) the selected points form a lattice of twice the spacing,
+  // so no two are closer than 2 s
+  std::vector<Vec3> eighth;
+  for (index_t i = 0; i < model.n_points; ++i)
+    if (dither_threshold(model.X.col(i), s) >= 10.0 * 56.0 / 64.0) eighth.push_back(model.X.col(i));
+  double closest = INFINITY;
+  for (std::size_t a = 0; a < eighth.size(); ++a)
+    for (std::size_t b = a + 1; b < eighth.size(); ++b) closest = std::min(closest, (eighth[a] - eighth[b]).norm());
+  EXPECT_NEAR(closest, 2 * s, 1e-12);
+}
+
+TEST(LodSelection, DitherSchemeKeepsTheBandsAndIsTheSameForEverySeed) {
+  const Model model = cube();
+  const Vec3 c = model.X.rowwise().mean();
+  LodParams p = seed_params();
+  p.scheme = LodScheme::DITHER;
+  std::mt19937_64 a(1), b(99);
+  const Selection s1 = select_points(model, c, p, a), s2 = select_points(model, c, p, b);
+  EXPECT_EQ(s1.selected, s2.selected);
+  EXPECT_EQ(s1.band_selected[0], s1.band_count[0]);
+  const double expected[] = {1.0, 0.8, 0.4, 0.2};
+  for (int band = 1; band < 4; ++band)
+    EXPECT_NEAR(static_cast<double>(s1.band_selected[band]) / s1.band_count[band], expected[band], 0.08) << "band " << band;
+}
+
 TEST(LodSelection, EachBandIsSelectedWithTheSeedsProbability) {
   const Model model = cube();
   const Vec3 c = model.X.rowwise().mean();

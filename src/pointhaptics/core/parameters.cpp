@@ -20,4 +20,6 @@ std::string_view to_string(KernelType type) {
 
 std::string_view to_string(VolumeMode mode) { return mode == VolumeMode::CELL ? "cell" : "kernel"; }
 
+std::string_view to_string(LodScheme scheme) { return scheme == LodScheme::RANDOM ? "random" : "dither"; }
+
 }  // namespace pointhaptics

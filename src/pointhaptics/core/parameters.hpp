@@ -1,6 +1,8 @@
 #pragma once
 /// @file Plain parameter structs: material, kernel and volume choices (all SI units).
+#include <cstdint>
 #include <string_view>
+#include <vector>
 
 namespace pointhaptics {
 
@@ -41,7 +43,34 @@ struct KernelParams {
   double support = 0.0;         ///< h in m; 0 means "use support_factor"
 };
 
+/// How points in the thinned bands are chosen (design.md, "Levels of detail").
+enum class LodScheme {
+  RANDOM,  ///< the seed's: a uniform draw Ran in [0, 10) per point (seeded; a point keeps its draw)
+  DITHER,  ///< ours: Ran from a 4x4x4 ordered-dither matrix over the sampling lattice, so that every band's
+           ///< selected points are spread evenly (same weights as the seed's, no clusters or holes)
+};
+
+/// A propagation level: the points with P_(i-1) < d <= P_i are selected with probability (10 - K) / 10.
+struct LodLevel {
+  double distance = 2.5;  ///< P_i, in units of h, increasing with i and beyond k2
+  int K = 6;              ///< in [0, 10], non-decreasing with i
+};
+
+/// Levels of detail (seed §3): which points are simulated around the contact point, and how.
+struct LodParams {
+  double k1 = 1.0;               ///< T_r1 = k1 h: every point within is selected
+  double k2 = 1.5;               ///< T_r2 = k2 h: points within (T_r1, T_r2] are selected if Ran > 2
+  std::vector<LodLevel> levels;  ///< propagation levels beyond T_r2 (none: nothing beyond T_r2)
+  std::uint64_t seed = 1;        ///< of the random generator, so that runs are reproducible
+  LodScheme scheme = LodScheme::RANDOM;
+  double reselect = 0.5;         ///< re-select when the contact point moved farther than this (units of h)
+  int min_neighbours = 12;       ///< a selected point's support widens until it reaches this many points
+                                 ///< (or as many as it had in the full model, if fewer) ...
+  double max_widening = 3.0;     ///< ... but never beyond this multiple of h
+};
+
 std::string_view to_string(KernelType type);
+std::string_view to_string(LodScheme scheme);
 std::string_view to_string(VolumeMode mode);
 
 }  // namespace pointhaptics

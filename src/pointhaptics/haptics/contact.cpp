@@ -20,6 +20,23 @@ ProbeParams resolved(const Model& model, ProbeParams p) {
 ProbeContact::ProbeContact(const Model& model, const ProbeParams& params)
     : params_(resolved(model, params)), grid_(params_.radius + params_.point_radius), x_(model.X) {}
 
+void ProbeContact::remap(const Model& model, const std::vector<index_t>& new_index) {
+  x_ = model.X;
+  std::size_t kept = 0;
+  for (std::size_t g = 0; g < grabbed_.size(); ++g) {
+    const index_t old = grabbed_[g];
+    const index_t now = old < static_cast<index_t>(new_index.size()) ? new_index[old] : -1;
+    if (now < 0 || model.fixed[now]) continue;
+    grabbed_[kept] = now;
+    offsets_[kept] = offsets_[g];
+    ++kept;
+  }
+  grabbed_.resize(kept);
+  offsets_.resize(kept);
+  touched_.clear();
+  normals_.clear();
+}
+
 ContactModel ProbeContact::apply(const Model& model, const Points& u, const Vec3& probe, bool button, double time,
                                  Points& forces) {
   ContactModel out;

@@ -43,6 +43,10 @@ class ProbeContact {
   /// The stiffness -df_i/du_i of the contact springs of the last apply() per point (push: k n n^T,
   /// grab: k I), added into `springs` (9 x n, column-major 3x3).
   void add_stiffness(Eigen::Matrix<double, 9, Eigen::Dynamic>& springs) const;
+  /// The model's points were renumbered (a level-of-detail re-selection): grabbed points follow their
+  /// new index new_index[old] (a point without one, -1, is let go) and the touched set is forgotten.
+  /// Allocates; not for every step.
+  void remap(const Model& model, const std::vector<index_t>& new_index);
   const ProbeParams& params() const { return params_; }
   const std::vector<index_t>& grabbed() const { return grabbed_; }
 

@@ -28,7 +28,7 @@ std::string result_json(const Model& model, const State& state, const RunSummary
   json fixed = json::array(), active = json::array();
   for (index_t i = 0; i < model.n_points; ++i) {
     fixed.push_back(model.fixed[i] != 0);
-    active.push_back(true);
+    active.push_back(!s.lod.enabled || (i < static_cast<index_t>(s.lod.active.size()) && s.lod.active[i]));
   }
   doc["points"] = {{"reference", columns(model.X)}, {"displacement", columns(state.u)}, {"fixed", fixed}, {"active", active}};
   doc["solver"] = {{"kind", s.solver_kind},     {"converged", s.converged}, {"iterations", s.iterations},
@@ -42,10 +42,21 @@ std::string result_json(const Model& model, const State& state, const RunSummary
     constraints.push_back({{"points", model.fixed_groups[g].points.size()},
                            {"reaction", g < s.reactions.size() ? vec(s.reactions[g]) : vec(Vec3::Zero())}});
   doc["constraints"] = constraints;
-  // zero without a probe; no levels of detail yet: that block is there, with every point selected
+  // zero without a probe
   doc["haptic"] = {{"ticks", s.haptic_ticks}, {"rate_hz", s.haptic_rate_hz}, {"period_p99_us", s.haptic_period_p99_us},
                    {"max_force_n", s.haptic_max_force_n}};
-  doc["lod"] = {{"selected", model.n_points}, {"selection_ms", 0.0}};
+  // without levels of detail every point is simulated
+  const LodSummary& l = s.lod;
+  doc["lod"] = {{"enabled", l.enabled},
+                {"selected", l.enabled ? l.selected : model.n_points},
+                {"selection_ms", l.selection_ms},
+                {"frozen", l.frozen},
+                {"widened", l.widened},
+                {"band_count", l.band_count},
+                {"band_selected", l.band_selected},
+                {"selections", l.selections},
+                {"build_ms", l.build_ms},
+                {"max_reselect_ms", l.max_reselect_ms}};
   const ModelDiagnostics& d = model.diagnostics;
   doc["model"] = {{"points", model.n_points},
                   {"h", model.h},

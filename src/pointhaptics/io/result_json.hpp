@@ -7,6 +7,21 @@
 
 namespace pointhaptics {
 
+/// Levels of detail in a run (all zero and empty without).
+struct LodSummary {
+  bool enabled = false;
+  index_t selected = 0;                 ///< points simulated at the end
+  index_t frozen = 0;                   ///< points held around them (the frozen ring)
+  index_t widened = 0;                  ///< selected points with a widened support
+  std::vector<index_t> band_count;      ///< points per band (T_r1, T_r2, levels), selected or not
+  std::vector<index_t> band_selected;   ///< selected points per band
+  std::vector<char> active;             ///< per point of the object: simulated at the end
+  long long selections = 0;             ///< selections made (the first and the re-selections)
+  double selection_ms = 0;              ///< the last selection, ms
+  double build_ms = 0;                  ///< the last active model's build (neighbours, M_i, stable step), ms
+  double max_reselect_ms = 0;           ///< the longest selection + build, ms
+};
+
 /// What a run reports besides the points: solver outcome, energies, timing, support reactions.
 struct RunSummary {
   std::string solver_kind;
@@ -24,6 +39,7 @@ struct RunSummary {
   // haptic loop (runs with a probe)
   long long haptic_ticks = 0;
   double haptic_rate_hz = 0, haptic_period_p99_us = 0, haptic_max_force_n = 0;
+  LodSummary lod;
 };
 
 /// The result document as a string (indented JSON).

@@ -79,6 +79,14 @@ struct DeviceSpec {
   std::string library = "libHD.so";        ///< openhaptics: the HD library to load
 };
 
+/// [lod]: levels of detail around the contact point (design.md, "Levels of detail").
+struct LodSpec {
+  bool present = false;
+  LodParams params;
+  Vec3 contact = Vec3::Constant(NAN);  ///< reference position of the contact, m (NaN: the probe, else the point load)
+  int line = 0;
+};
+
 struct Scene {
   std::string path;  ///< the scene file ("<string>" when parsed from text), for messages
   ObjectSpec object;
@@ -89,6 +97,7 @@ struct Scene {
   SolverSpec solver;
   ProbeSpec probe;
   DeviceSpec device;
+  LodSpec lod;
 };
 
 std::string_view to_string(SolverKind kind);

@@ -297,6 +297,49 @@ void read_device(TableReader& r, DeviceSpec& d, const Context& ctx) {
   }
 }
 
+void read_lod(TableReader& r, LodSpec& l) {
+  l.present = true;
+  l.line = r.line();
+  LodParams& p = l.params;
+  p.k1 = r.number("k1", p.k1, non_negative, "must be >= 0 (units of h)");
+  p.k2 = r.number("k2", p.k2, [&](double x) { return x >= p.k1; }, "must be >= k1 (units of h)");
+  if (const toml::node* node = r.find("levels")) {
+    const toml::array* rows = node->as_array();
+    if (!rows) r.fail_at(*node, "levels", "expected [ { distance = <h>, K = <0..10> }, ... ]");
+    double previous = p.k2;
+    int previous_k = 0;
+    for (const toml::node& row : *rows) {
+      const toml::table* t = row.as_table();
+      if (!t) r.fail_at(row, "levels", "each level is { distance = <units of h>, K = <integer 0..10> }");
+      TableReader level(r.context(), *t, r.name("levels"));
+      if (!t->get("distance") || !t->get("K")) level.fail_table("distance", "each level needs both distance and K");
+      LodLevel lv;
+      lv.distance = level.number("distance", 0.0, [&](double x) { return x > previous; },
+                                 fmt::format("must exceed {} (k2 or the previous level's distance)", previous));
+      const long long k = level.integer("K", 0);
+      if (k < 0 || k > 10 || k < previous_k)
+        level.fail_at(*t->get("K"), "K", fmt::format("{} must be an integer in [{}, 10] (non-decreasing)", k, previous_k));
+      lv.K = static_cast<int>(k);
+      level.finish();
+      previous = lv.distance;
+      previous_k = lv.K;
+      p.levels.push_back(lv);
+    }
+  }
+  const toml::node* seed = r.find("seed");
+  const long long seed_value = r.integer("seed", 1);
+  if (seed_value < 0) r.fail_at(*seed, "seed", "must be >= 0");
+  p.seed = static_cast<std::uint64_t>(seed_value);
+  p.scheme = r.choice("scheme", "random", {"random", "dither"}) == "random" ? LodScheme::RANDOM : LodScheme::DITHER;
+  p.reselect = r.number("reselect", p.reselect, positive, "must be > 0 (units of h)");
+  const toml::node* mn = r.find("min_neighbours");
+  const long long min_neighbours = r.integer("min_neighbours", p.min_neighbours);
+  if (min_neighbours < 1 || min_neighbours > 1000) r.fail_at(*mn, "min_neighbours", "must lie in [1, 1000]");
+  p.min_neighbours = static_cast<int>(min_neighbours);
+  p.max_widening = r.number("max_widening", p.max_widening, [](double x) { return x >= 1 && x <= 10; }, "must lie in [1, 10]");
+  if (r.find("contact")) l.contact = r.vec3("contact", l.contact);
+}
+
 // [[name]] arrays of tables
 template <class Read>
 void read_array_of_tables(TableReader& root, std::string_view key, Read read) {
@@ -326,9 +369,6 @@ Scene parse_scene(std::string_view text, const std::string& name, const std::str
   Scene scene;
   scene.path = name;
   TableReader top(ctx, root, "");
-  for (std::string_view later : {"lod"})
-    if (const toml::node* node = top.find(later))
-      top.fail_at(*node, later, fmt::format("[{}] is part of the design but not implemented in this version yet", later));
   auto section = [&](std::string_view key, auto read) {
     if (const toml::table* t = top.subtable(key)) {
       TableReader r(ctx, *t, std::string(key));
@@ -343,6 +383,7 @@ Scene parse_scene(std::string_view text, const std::string& name, const std::str
   section("solver", [&](TableReader& r) { read_solver(r, scene.solver); });
   section("probe", [&](TableReader& r) { read_probe(r, scene.probe, ctx); });
   section("device", [&](TableReader& r) { read_device(r, scene.device, ctx); });
+  section("lod", [&](TableReader& r) { read_lod(r, scene.lod); });
   if (scene.probe.present && scene.device.kind == "virtual" && scene.probe.trajectory.empty() && scene.probe.keyframes.empty())
     throw Error(fmt::format("{}:{}: probe: a virtual device needs trajectory = \"probe.csv\" or keyframes = [[t, x, y, z], ...]",
                             name, scene.probe.line));
@@ -354,6 +395,13 @@ Scene parse_scene(std::string_view text, const std::string& name, const std::str
   read_array_of_tables(top, "fixed", [&](TableReader& r) { scene.fixed.push_back(read_fixed(r)); });
   read_array_of_tables(top, "load", [&](TableReader& r) { scene.loads.push_back(read_load(r)); });
   top.finish();
+  if (scene.lod.present && !scene.probe.present && !scene.lod.contact.allFinite()) {
+    int point_loads = 0;
+    for (const LoadSpec& l : scene.loads) point_loads += l.kind == LoadKind::POINT;
+    if (point_loads != 1)
+      throw Error(fmt::format("{}:{}: lod.contact: missing; without a [probe] or exactly one point load, give the "
+                              "contact point as contact = [x, y, z] (m)", name, scene.lod.line));
+  }
   return scene;
 }
 

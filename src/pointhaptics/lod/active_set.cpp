@@ -10,7 +10,7 @@
 
 namespace pointhaptics {
 
-ActiveSet build_active_set(const Model& full, const Selection& selection, const ActiveSetParams& params) {
+ActiveSet build_active_set(const Model& full, const Selection& selection, const LodParams& params) {
   const auto start = std::chrono::steady_clock::now();
   if (selection.selected.empty()) throw Error("lod: the selection is empty");
   if (static_cast<index_t>(selection.band.size()) != full.n_points) throw Error("lod: the selection is for another model");
@@ -19,12 +19,18 @@ ActiveSet build_active_set(const Model& full, const Selection& selection, const 
   a.active_of.assign(n_full, -1);
   a.follows.assign(n_full, -1);
   a.follow_offset = Points::Zero(3, n_full);
-  for (index_t i : selection.selected) {
-    a.active_of[i] = static_cast<index_t>(a.full_of.size());
-    a.full_of.push_back(i);
-  }
+  // the simulated points: the selected ones in the bands; held points selected beyond the bands are
+  // held anyway, so they join the frozen ring below where the active set reaches them, and are left out
+  // elsewhere (a clamped base far from the contact costs nothing)
+  for (index_t i : selection.selected)
+    if (selection.band[i] >= 0) {
+      a.active_of[i] = static_cast<index_t>(a.full_of.size());
+      a.full_of.push_back(i);
+    }
   a.n_selected = static_cast<index_t>(a.full_of.size());
+  if (a.n_selected == 0) throw Error("lod: no point of the selection lies in its bands");
   const double h = full.h, reach = params.max_widening * h;
+  const double candidate_radius = selection.outer_radius + reach;
 
   // the nearest selected point of every unselected one (a k-d tree over the selected)
   Points selected_X(3, a.n_selected);
@@ -33,6 +39,8 @@ ActiveSet build_active_set(const Model& full, const Selection& selection, const 
   std::vector<index_t> absorbed_by(n_full, -1);
   for (index_t j = 0; j < n_full; ++j) {
     if (a.active_of[j] >= 0) continue;
+    if (selection.band[j] < 0 && (full.X.col(j) - selection.centre).squaredNorm() > candidate_radius * candidate_radius)
+      continue;  // beyond the reach of any selected point
     index_t nearest = -1;
     double d2 = 0;
     tree.index().knnSearch(full.X.col(j).data(), 1, &nearest, &d2);
@@ -67,28 +75,70 @@ ActiveSet build_active_set(const Model& full, const Selection& selection, const 
       f_ext.col(absorbed_by[j]) += full.f_ext.col(j);
     }
   // widen sparse supports: the smallest h_i in steps of h/4 that reaches min_neighbours active points
-  cloud.support = Eigen::VectorXd::Constant(n, h);
-  const KdTree active_tree(cloud.X);
-  std::vector<std::pair<index_t, double>> found;
-  nanoflann::SearchParams search;
-  search.sorted = true;
-  for (index_t k = 0; k < a.n_selected; ++k) {
-    found.clear();
-    active_tree.index().radiusSearch(cloud.X.col(k).data(), reach * reach, found, search);
-    // found is sorted by distance and includes the point itself; a point never needs more neighbours
-    // than it had in the full model (surface points have fewer)
-    const std::size_t needed =
-        static_cast<std::size_t>(std::min<index_t>(params.min_neighbours, full.neighbours.row_size(a.full_of[k]))) + 1;
-    if (found.size() < needed) {
-      cloud.support[k] = reach;
-    } else {
-      const double r = std::sqrt(found[needed - 1].second);
-      double hk = h;
-      while (hk <= r * (1 + 1e-9) && hk < reach) hk = std::min(reach, hk + 0.25 * h);
-      cloud.support[k] = hk;
+  Eigen::VectorXd support = Eigen::VectorXd::Constant(n, h);
+  std::vector<char> ring_needed(n, 0);
+  {
+    const KdTree active_tree(cloud.X);
+    std::vector<std::pair<index_t, double>> found;
+    nanoflann::SearchParams search;
+    search.sorted = true;
+    for (index_t k = 0; k < a.n_selected; ++k) {
+      found.clear();
+      active_tree.index().radiusSearch(cloud.X.col(k).data(), reach * reach, found, search);
+      // found is sorted by distance and includes the point itself; a point never needs more neighbours
+      // than it had in the full model (surface points have fewer)
+      const std::size_t needed =
+          static_cast<std::size_t>(std::min<index_t>(params.min_neighbours, full.neighbours.row_size(a.full_of[k]))) + 1;
+      if (found.size() < needed) {
+        support[k] = reach;
+      } else {
+        const double r = std::sqrt(found[needed - 1].second);
+        double hk = h;
+        while (hk <= r * (1 + 1e-9) && hk < reach) hk = std::min(reach, hk + 0.25 * h);
+        support[k] = hk;
+      }
+      a.widened += support[k] > h * (1 + 1e-12);
+      // the frozen points this one reaches are the ring that holds the active set
+      for (const auto& [j, d2] : found) {
+        if (d2 >= support[k] * support[k]) break;
+        if (j >= a.n_selected) ring_needed[j] = 1;
+      }
     }
-    a.widened += cloud.support[k] > h * (1 + 1e-12);
+    // ... and their own neighbours, so that the ring points next to the active set have the whole
+    // neighbourhood (M_i, d_ij) they have in the object
+    const std::vector<char> touching = ring_needed;
+    for (index_t k = a.n_selected; k < n; ++k) {
+      if (!touching[k]) continue;
+      found.clear();
+      active_tree.index().radiusSearch(cloud.X.col(k).data(), h * h, found, search);
+      for (const auto& [j, d2] : found)
+        if (j >= a.n_selected) ring_needed[j] = 1;
+    }
   }
+  // drop the ring candidates no selected point reaches
+  index_t kept = a.n_selected;
+  for (index_t k = a.n_selected; k < n; ++k) {
+    const index_t j = a.full_of[k];
+    if (!ring_needed[k]) {
+      a.active_of[j] = -1;
+      continue;
+    }
+    a.full_of[kept] = j;
+    a.active_of[j] = kept;
+    cloud.X.col(kept) = cloud.X.col(k);
+    cloud.volume[kept] = cloud.volume[k];
+    mass[kept] = mass[k];
+    f_ext.col(kept) = f_ext.col(k);
+    support[kept] = support[k];
+    ++kept;
+  }
+  a.full_of.resize(kept);
+  cloud.X.conservativeResize(3, kept);
+  cloud.volume.conservativeResize(kept);
+  mass.conservativeResize(kept);
+  f_ext.conservativeResize(3, kept);
+  support.conservativeResize(kept);
+  cloud.support = support;
   MaterialParams material = full.material;
   KernelParams kernel = full.kernel;
   kernel.support = h;
@@ -96,13 +146,13 @@ ActiveSet build_active_set(const Model& full, const Selection& selection, const 
   a.model.mass = mass;  // kernel-volume mode included: the region's mass is what it was
   a.model.f_ext = f_ext;
   // held points: the full model's groups (restricted), and the frozen ring held where it is
-  for (index_t k = 0; k < n; ++k)
+  for (index_t k = 0; k < kept; ++k)
     if (k >= a.n_selected || full.fixed[a.full_of[k]]) a.model.fixed[k] = 1;
   for (const FixedGroup& g : full.fixed_groups) {
     FixedGroup sub = g;
     sub.points.clear();
     for (index_t i : g.points)
-      if (a.active_of[i] >= 0 && a.active_of[i] < a.n_selected) sub.points.push_back(a.active_of[i]);
+      if (a.active_of[i] >= 0) sub.points.push_back(a.active_of[i]);
     if (!sub.points.empty()) a.model.fixed_groups.push_back(sub);
   }
   a.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -123,7 +173,8 @@ State ActiveSet::restrict_state(const State& full) const {
 }
 
 void ActiveSet::prolong_state(const State& active, State& full) const {
-  for (index_t k = 0; k < n_selected; ++k) {
+  // the ring too: its held points with a prescribed displacement moved with it
+  for (index_t k = 0; k < static_cast<index_t>(full_of.size()); ++k) {
     full.u.col(full_of[k]) = active.u.col(k);
     full.velocity.col(full_of[k]) = active.velocity.col(k);
   }

@@ -8,24 +8,19 @@
 
 namespace pointhaptics {
 
-struct ActiveSetParams {
-  int min_neighbours = 12;      ///< a selected point's support widens until it reaches this many points
-                                ///< (or as many as it had in the full model, if fewer)
-  double max_widening = 3.0;    ///< ... but never beyond this multiple of h
-};
-
 /// The model over the selected points (design.md's reading of seed §3):
 /// - each unselected point inside the selection bands gives its volume, mass and external load to its
 ///   nearest selected point (so the active set keeps the region's mass and load), and follows it:
 ///   u_j = u_i + G_i (X_j - X_i), first-order MLS from that point;
-/// - unselected points beyond the last band but within reach of a selected point form a frozen ring,
-///   held at their current displacement, so the active set is supported by the rest of the object as it
-///   is, not left floating; points beyond that are not simulated at all;
+/// - unselected points beyond the last band that a selected point's support reaches, and their own
+///   neighbours, form a frozen ring, held at their current displacement (or their prescribed one), so the
+///   active set is supported by the rest of the object as it is, not left floating; held points that the
+///   seed selects beyond the bands join that ring where it reaches them; the rest is not simulated;
 /// - a selected point whose neighbourhood became sparse gets a wider support (per-point h_i, up to
 ///   max_widening h), symmetric neighbourhoods by max(h_i, h_j); the dense core keeps h.
 struct ActiveSet {
   Model model;                        ///< active points first (selected), then the frozen ring
-  index_t n_selected = 0;
+  index_t n_selected = 0;             ///< simulated points: the selected ones inside the bands
   std::vector<index_t> full_of;       ///< active index -> full index
   std::vector<index_t> active_of;     ///< full index -> active index, or -1
   std::vector<index_t> follows;       ///< full index -> the active point an absorbed point follows, or -1
@@ -35,12 +30,12 @@ struct ActiveSet {
 
   /// The active state from the full one (selected and frozen points copy theirs).
   State restrict_state(const State& full) const;
-  /// Write the active state back: selected points copy, absorbed points follow by first-order MLS,
-  /// frozen and unsimulated points keep theirs.
+  /// Write the active state back: active points (selected and ring) copy, absorbed points follow by
+  /// first-order MLS, unsimulated points keep theirs.
   void prolong_state(const State& active, State& full) const;
 };
 
 /// Throws Error if nothing is selected.
-ActiveSet build_active_set(const Model& full, const Selection& selection, const ActiveSetParams& params = {});
+ActiveSet build_active_set(const Model& full, const Selection& selection, const LodParams& params = {});
 
 }  // namespace pointhaptics

@@ -8,21 +8,13 @@
 
 namespace pointhaptics {
 
-/// A propagation level: the points with P_(i-1) < d <= P_i are selected with probability (10 - K) / 10.
-struct LodLevel {
-  double distance = 2.5;  ///< P_i, in units of h, increasing with i and beyond k2
-  int K = 6;              ///< in [0, 10], non-decreasing with i
-};
-
-struct LodParams {
-  double k1 = 1.0;               ///< T_r1 = k1 h: every point within is selected
-  double k2 = 1.5;               ///< T_r2 = k2 h: points within (T_r1, T_r2] are selected if Ran > 2
-  std::vector<LodLevel> levels;  ///< propagation levels beyond T_r2 (none: nothing beyond T_r2)
-  std::uint64_t seed = 1;        ///< of the random generator, so that runs are reproducible
-};
-
 /// Throws Error naming the parameter if the bands are not well ordered or a K is outside [0, 10].
 void validate(const LodParams& params);
+
+/// The ordered-dither draw in [0, 10) of a point at X on a lattice of `spacing` (LodScheme::DITHER): a
+/// 4x4x4 Bayer-style matrix, so that in every 4x4x4 block the points with threshold >= K are the
+/// (10 - K) / 10 fraction spread farthest apart.
+double dither_threshold(const Vec3& X, double spacing);
 
 /// The band of each point: 0 within T_r1, 1 within T_r2, 1 + i within level i, -1 beyond the last level.
 struct Selection {
@@ -31,6 +23,8 @@ struct Selection {
   std::vector<index_t> band_count;        ///< points per band (0, 1, 1 + i), selected or not
   std::vector<index_t> band_selected;     ///< selected points per band
   double milliseconds = 0;                ///< time the selection took
+  Vec3 centre = Vec3::Zero();             ///< the contact point it was made around, m
+  double outer_radius = 0;                ///< of the last band, m (no point beyond it is in a band)
 };
 
 /// Select the points around the contact point c (reference configuration, m) as the seed does: for each
