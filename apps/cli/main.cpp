@@ -2,6 +2,7 @@
 #include "experiment_beam.hpp"
 #include "experiment_cantilever.hpp"
 #include "experiment_force_profile.hpp"
+#include "experiment_lod.hpp"
 #include "progress_bar.hpp"
 
 #include <pointhaptics/pointhaptics.hpp>
@@ -168,6 +169,23 @@ int main(int argc, char** argv) {
   profile_cmd->add_option("--out", profile.out, "Output folder")->required();
   profile_cmd->add_flag("--real-time", profile.real_time, "Run the haptic thread on the wall clock (default: simulated time)");
 
+  ph::experiments::LodExperimentOptions lod_table, propagation, lod_error;
+  auto lod_options = [](CLI::App* cmd, ph::experiments::LodExperimentOptions& o) {
+    cmd->add_option("--out", o.out, "Output folder")->required();
+    cmd->add_flag("--quick", o.quick, "Small objects and short runs (seconds)");
+    cmd->add_option("--threads", o.threads, "Threads (0: all)")->check(CLI::NonNegativeNumber);
+    cmd->add_option("--seconds", o.seconds, "Wall seconds per timed configuration")->check(CLI::PositiveNumber);
+  };
+  CLI::App* lod_table_cmd = experiment_cmd->add_subcommand(
+      "lod-table", "Seed Table 1: steps per second with levels of detail, 224 to 100k points, against the full model");
+  lod_options(lod_table_cmd, lod_table);
+  CLI::App* propagation_cmd = experiment_cmd->add_subcommand(
+      "propagation", "Seed Fig. 8-9: a constant pull at point 111, one propagation level at weight 0.4 and 0.2");
+  lod_options(propagation_cmd, propagation);
+  CLI::App* lod_error_cmd = experiment_cmd->add_subcommand(
+      "lod-error", "Displacement error against speed-up: the seed's random selection and the dithered one");
+  lod_options(lod_error_cmd, lod_error);
+
   CLI11_PARSE(app, argc, argv);
   try {
     if (*run_cmd) return run_command(run);
@@ -175,6 +193,9 @@ int main(int argc, char** argv) {
     if (*cantilever_cmd) return ph::experiments::run_cantilever_experiment(cantilever);
     if (*beam_cmd) return ph::experiments::run_beam_experiment(beam);
     if (*profile_cmd) return ph::experiments::run_force_profile_experiment(profile);
+    if (*lod_table_cmd) return ph::experiments::run_lod_table_experiment(lod_table);
+    if (*propagation_cmd) return ph::experiments::run_propagation_experiment(propagation);
+    if (*lod_error_cmd) return ph::experiments::run_lod_error_experiment(lod_error);
   } catch (const ph::Error& e) {
     std::fprintf(stderr, "pointhaptics: error: %s\n", e.what());
     return 1;
