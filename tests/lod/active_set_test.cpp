@@ -2,7 +2,9 @@
 // points follow exactly for affine fields, sparse points get enough neighbours, held points stay held,
 // and a static solve on the active set agrees with the full model near the contact.
 #include <pointhaptics/lod/active_set.hpp>
+#include <pointhaptics/mechanics/energy.hpp>
 #include <pointhaptics/mechanics/forces.hpp>
+#include <pointhaptics/mechanics/tangent.hpp>
 #include <pointhaptics/solvers/static_solver.hpp>
 
 #include "support/test_models.hpp"
@@ -82,6 +84,49 @@ TEST(ActiveSet, KeepsMassAndLoadAndGivesSparsePointsEnoughNeighbours) {
   // the frozen ring and the clamp are held
   for (index_t k = a.n_selected; k < a.model.n_points; ++k) EXPECT_TRUE(a.model.fixed[k]);
   for (index_t k = 0; k < a.n_selected; ++k) EXPECT_EQ(a.model.fixed[k] != 0, full.fixed[a.full_of[k]] != 0);
+}
+
+TEST(ActiveSet, ThePassiveOuterRingOnlyCompletesNeighbourhoodsAndForcesStayExact) {
+  const Model full = bar();
+  LodParams p;
+  p.levels = {{3.0, 4}};
+  const ActiveSet a = build_active_set(full, select(full, Vec3(0.06, 0.03, 0.015), p));
+  const Model& m = a.model;
+  ASSERT_GT(m.n_passive, 0);
+  // passive points are held, last, and no simulated point has one as a neighbour
+  for (index_t k = m.stencil_end(); k < m.n_points; ++k) {
+    EXPECT_TRUE(m.fixed[k]);
+    for (index_t e = m.neighbours.begin(k); e < m.neighbours.end(k); ++e) EXPECT_GE(m.neighbours.index[e], a.n_selected);
+  }
+  // the forces on the simulated points are still the exact gradient of the energy, and the tangent the
+  // exact derivative of the forces, on 1 and 2 threads
+  const Points u = test::random_field(m.n_points, 0.05 * s, 5);
+  Workspace w1(m, 1), w2(m, 2);
+  compute_internal_forces(m, u, w1);
+  compute_internal_forces(m, u, w2);
+  EXPECT_LE((w1.f_int - w2.f_int).norm(), 1e-12 * w1.f_int.norm());
+  const double eps = 1e-7 * s;
+  for (index_t k : {index_t{0}, a.n_selected / 2, a.n_selected - 2, a.n_selected - 1})
+    for (int c = 0; c < 3; ++c) {
+      Points up = u, down = u;
+      up(c, k) += eps;
+      down(c, k) -= eps;
+      const double dE = (strain_energy(m, up).total() - strain_energy(m, down).total()) / (2 * eps);
+      EXPECT_NEAR(-dE, w1.f_int(c, k), 1e-6 * w1.f_int.cwiseAbs().maxCoeff()) << "point " << k << " axis " << c;
+    }
+  Tangent K;
+  K.linearise(m, u, TangentMode::EXACT);
+  Points v = test::random_field(m.n_points, 1.0, 9);
+  v.rightCols(m.n_points - a.n_selected).setZero();  // held points do not move
+  Points Kv(3, m.n_points);
+  K.apply(m, v, w1, Kv);
+  Points up = u + eps * v, down = u - eps * v;
+  compute_internal_forces(m, up, w1);
+  const Points f_up = w1.f_int;
+  compute_internal_forces(m, down, w1);
+  const Points fd = -(f_up - w1.f_int) / (2 * eps);
+  const auto free_rows = [&](const Points& P) { return P.leftCols(a.n_selected); };
+  EXPECT_LE((free_rows(Kv) - free_rows(fd)).norm(), 1e-5 * free_rows(fd).norm());
 }
 
 TEST(ActiveSet, AbsorbedPointsFollowAffineFieldsExactly) {

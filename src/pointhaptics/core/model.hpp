@@ -49,7 +49,14 @@ struct Model {
 
   ModelDiagnostics diagnostics;
 
+  /// The last n_passive points are held, carry no stencil (no strain energy, no force of their own) and
+  /// are there only as neighbours of the others: the outer frozen ring of a level-of-detail active set,
+  /// which completes the neighbourhoods (M_i, d_ij) of the held points next to the simulated ones.
+  index_t n_passive = 0;
+
   index_t n_pairs() const { return neighbours.n_entries(); }
+  /// Points [0, stencil_end()) carry a stencil.
+  index_t stencil_end() const { return n_points - n_passive; }
 };
 
 }  // namespace pointhaptics

@@ -18,8 +18,10 @@ Workspace::Workspace(const Model& model, int n_threads) {
   // a chunk per thread, but never a chunk without points
   n_threads_ = std::max(1, std::min<int>(n_threads, std::max<index_t>(1, model.n_points)));
   chunk_offset_.resize(n_threads_ + 1);
-  for (int c = 0; c <= n_threads_; ++c)
-    chunk_offset_[c] = static_cast<index_t>(static_cast<std::int64_t>(model.n_points) * c / n_threads_);
+  // chunks split the stencils evenly; the last one also takes the passive points (no stencil)
+  const std::int64_t stencils = model.n_points - model.n_passive;
+  for (int c = 0; c < n_threads_; ++c) chunk_offset_[c] = static_cast<index_t>(stencils * c / n_threads_);
+  chunk_offset_[n_threads_] = model.n_points;
   // the columns each chunk scatters into: its own points and their neighbours
   scatter_range_.resize(2 * n_threads_);
   const Csr& nbr = model.neighbours;

@@ -105,39 +105,46 @@ ActiveSet build_active_set(const Model& full, const Selection& selection, const 
       }
     }
     // ... and their own neighbours, so that the ring points next to the active set have the whole
-    // neighbourhood (M_i, d_ij) they have in the object
+    // neighbourhood (M_i, d_ij) they have in the object; these outer ones are passive (no stencil)
     const std::vector<char> touching = ring_needed;
     for (index_t k = a.n_selected; k < n; ++k) {
       if (!touching[k]) continue;
       found.clear();
       active_tree.index().radiusSearch(cloud.X.col(k).data(), h * h, found, search);
       for (const auto& [j, d2] : found)
-        if (j >= a.n_selected) ring_needed[j] = 1;
+        if (j >= a.n_selected && !ring_needed[j]) ring_needed[j] = 2;
     }
   }
-  // drop the ring candidates no selected point reaches
-  index_t kept = a.n_selected;
-  for (index_t k = a.n_selected; k < n; ++k) {
-    const index_t j = a.full_of[k];
-    if (!ring_needed[k]) {
-      a.active_of[j] = -1;
-      continue;
-    }
-    a.full_of[kept] = j;
-    a.active_of[j] = kept;
-    cloud.X.col(kept) = cloud.X.col(k);
-    cloud.volume[kept] = cloud.volume[k];
-    mass[kept] = mass[k];
-    f_ext.col(kept) = f_ext.col(k);
-    support[kept] = support[k];
-    ++kept;
-  }
+  // keep the ring the active set reaches (1), then the passive outer ring (2); drop the other candidates
+  std::vector<index_t> order;
+  for (char pass : {1, 2})
+    for (index_t k = a.n_selected; k < n; ++k)
+      if (ring_needed[k] == pass) order.push_back(k);
+  for (index_t k = a.n_selected; k < n; ++k)
+    if (!ring_needed[k]) a.active_of[a.full_of[k]] = -1;
+  const std::vector<index_t> old_full_of = a.full_of;
+  const PointCloud old_cloud = cloud;
+  const Eigen::VectorXd old_mass = mass, old_support = support;
+  const Points old_f_ext = f_ext;
+  const index_t kept = a.n_selected + static_cast<index_t>(order.size());
   a.full_of.resize(kept);
   cloud.X.conservativeResize(3, kept);
   cloud.volume.conservativeResize(kept);
   mass.conservativeResize(kept);
   f_ext.conservativeResize(3, kept);
   support.conservativeResize(kept);
+  index_t n_passive = 0;
+  for (std::size_t r = 0; r < order.size(); ++r) {
+    const index_t from = order[r], to = a.n_selected + static_cast<index_t>(r);
+    a.full_of[to] = old_full_of[from];
+    a.active_of[old_full_of[from]] = to;
+    cloud.X.col(to) = old_cloud.X.col(from);
+    cloud.volume[to] = old_cloud.volume[from];
+    mass[to] = old_mass[from];
+    f_ext.col(to) = old_f_ext.col(from);
+    support[to] = old_support[from];
+    n_passive += ring_needed[from] == 2;
+  }
   cloud.support = support;
   MaterialParams material = full.material;
   KernelParams kernel = full.kernel;
@@ -145,6 +152,7 @@ ActiveSet build_active_set(const Model& full, const Selection& selection, const 
   a.model = build_model(cloud, material, kernel);
   a.model.mass = mass;  // kernel-volume mode included: the region's mass is what it was
   a.model.f_ext = f_ext;
+  a.model.n_passive = n_passive;
   // held points: the full model's groups (restricted), and the frozen ring held where it is
   for (index_t k = 0; k < kept; ++k)
     if (k >= a.n_selected || full.fixed[a.full_of[k]]) a.model.fixed[k] = 1;

@@ -24,6 +24,16 @@ EnergyTerms strain_energy(const Model& model, const Points& u) {
       [&](const tbb::blocked_range<index_t>& range, EnergyTerms acc) {
         for (index_t i = range.begin(); i != range.end(); ++i) {
           const Mat3& G = gradients[i];
+          if (i >= model.stencil_end()) {
+            // a passive point (Model::n_passive): no elastic energy of its own, but its hourglass pairs stay,
+            // since the force loop charges their derivative through the neighbour's gradient to that neighbour
+            for (index_t e = nbr.begin(i); hourglass && e < nbr.end(i); ++e) {
+              const index_t j = nbr.index[e];
+              const Vec3 r = u.col(j) - u.col(i) - 0.5 * (G + gradients[j]) * (model.X.col(j) - model.X.col(i));
+              acc.hourglass += 0.5 * model.hg_coef[e] * r.squaredNorm();
+            }
+            continue;
+          }
           const Mat3 F = Mat3::Identity() + G;
           const Mat3 E = green_strain(G);  // seed Eq. 2
           const Mat3 S = svk_stress(E, model.lambda, model.mu);

@@ -84,7 +84,7 @@ void Tangent::diagonal_blocks(const Model& model, Eigen::Matrix<double, 9, Eigen
     blocks.col(j) += K.reshaped();
   };
   // serial: stencils scatter into shared points; about two force evaluations in cost
-  for (index_t i = 0; i < model.n_points; ++i) {
+  for (index_t i = 0; i < model.stencil_end(); ++i) {
     const Mat3 F = Eigen::Map<const Mat3>(F_.data() + 9 * i), S = Eigen::Map<const Mat3>(S_.data() + 9 * i);
     Mat9 C;
     for (int col = 0; col < 9; ++col) {

@@ -122,10 +122,11 @@ void stencil_sum(const Model& model, const Points& u, Workspace& ws, Points& y, 
     else stencil_loop<false>(model, u, ws.gradients, first, last, target, stress);
   };
   const int n_chunks = ws.n_threads();
+  const index_t stencil_end = model.stencil_end();  // passive points: gradients (their neighbours read them), no stencil
   if (n_chunks == 1) {
     gradient_pass(model, u, 0, model.n_points, ws.gradients);
     y.setZero();
-    run(0, model.n_points, y);
+    run(0, stencil_end, y);
     if (sign != 1.0) y *= sign;
     return;
   }
@@ -135,7 +136,7 @@ void stencil_sum(const Model& model, const Points& u, Workspace& ws, Points& y, 
     Points& buffer = ws.chunk_forces[c];
     const index_t lo = ws.scatter_begin(c), hi = ws.scatter_end(c);
     buffer.middleCols(lo, hi - lo).setZero();
-    run(ws.chunk_begin(c), ws.chunk_end(c), buffer);
+    run(ws.chunk_begin(c), std::min(ws.chunk_end(c), stencil_end), buffer);
   });
   ws.for_each_chunk([&](int c) {
     const index_t first = ws.chunk_begin(c), last = ws.chunk_end(c);
