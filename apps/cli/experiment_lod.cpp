@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cmath>
 #include <filesystem>
 #include <optional>
@@ -105,18 +106,22 @@ std::string csv_or_empty(std::optional<double> v) { return v ? fmt::format("{}",
 // displacement errors of `u` against `reference`: max inside radius r of c relative to the largest
 // reference displacement there, and the RMS over the object relative to the reference's RMS
 struct Errors {
-  double near = 0, whole = 0;
+  double near = 0, near_rms = 0, whole = 0;
 };
 
 Errors errors(const Model& m, const Points& u, const Points& reference, const Vec3& c, double r) {
-  double err = 0, ref = 0;
+  double err = 0, ref = 0, err2 = 0, ref2 = 0;
   for (index_t i = 0; i < m.n_points; ++i)
     if ((m.X.col(i) - c).norm() <= r * (1 + 1e-9)) {
-      err = std::max(err, (u.col(i) - reference.col(i)).norm());
-      ref = std::max(ref, reference.col(i).norm());
+      const double e = (u.col(i) - reference.col(i)).norm(), f = reference.col(i).norm();
+      err = std::max(err, e);
+      ref = std::max(ref, f);
+      err2 += e * e;
+      ref2 += f * f;
     }
   Errors e;
   e.near = ref > 0 ? err / ref : 0;
+  e.near_rms = ref2 > 0 ? std::sqrt(err2 / ref2) : 0;
   e.whole = (u - reference).norm() / std::max(reference.norm(), 1e-300);
   return e;
 }
@@ -257,27 +262,83 @@ int run_propagation_experiment(const LodExperimentOptions& options) {
   return run_plot_script("plot_propagation.py", out.string());
 }
 
+namespace {
+
+// "k1,k2;P:K;P:K" (units of h; P = 0: the whole object)
+LodParams parse_config(const std::string& text, double whole) {
+  LodParams p;
+  std::size_t at = text.find(';');
+  const std::string head = text.substr(0, at);
+  if (std::sscanf(head.c_str(), "%lf,%lf", &p.k1, &p.k2) != 2)
+    throw Error(fmt::format("lod-error: --config \"{}\": expected \"k1,k2;P:K;...\"", text));
+  while (at != std::string::npos) {
+    const std::size_t next = text.find(';', at + 1);
+    const std::string level = text.substr(at + 1, next == std::string::npos ? std::string::npos : next - at - 1);
+    LodLevel l;
+    if (std::sscanf(level.c_str(), "%lf:%d", &l.distance, &l.K) != 2)
+      throw Error(fmt::format("lod-error: --config: level \"{}\" is not P:K", level));
+    if (l.distance == 0) l.distance = whole;
+    p.levels.push_back(l);
+    at = next;
+  }
+  if (const char* mn = std::getenv("PH_MINNB")) p.min_neighbours = std::atoi(mn);
+  if (const char* mw = std::getenv("PH_MAXW")) p.max_widening = std::atof(mw);
+  validate(p);
+  return p;
+}
+
+std::string describe(const LodParams& p, double whole) {
+  std::string s = fmt::format("T_r1 = {}h, T_r2 = {}h", p.k1, p.k2);
+  for (const LodLevel& l : p.levels)
+    s += l.distance >= whole ? fmt::format("; whole object at K = {}", l.K) : fmt::format("; to {}h at K = {}", l.distance, l.K);
+  return s;
+}
+
+}  // namespace
+
 int run_lod_error_experiment(const LodExperimentOptions& options) {
   fs::create_directories(options.out);
   const fs::path out = options.out;
-  // the displacement error against the full model's equilibrium (a pull at the pole), against the
-  // speed-up of the explicit step, for the seed's random selection (three seeds) and the dithered one
-  const int target = options.quick ? 1200 : 10000;
+  // the displacement error against the full model's equilibrium, against the speed-up of the explicit
+  // step, for the seed's random selection (three seeds) and the dithered one
+  const int target = options.points > 0 ? options.points : options.quick ? 1200 : 10000;
   const double spacing = spacing_for(target);
   Scene scene = half_sphere(spacing);
   Model model = build_scene_model(scene);
   const index_t pole = nearest_point(model, Vec3(0, radius, 0));
   const Vec3 c = model.X.col(pole);
-  model.f_ext(1, pole) = 0.01;
+  const bool indent = options.load == "indent";
+  std::string load_text;
+  if (indent) {
+    // a probe's imprint: the points within 0.75 h of the pole pushed 1 mm down (prescribed)
+    FixedGroup imprint;
+    imprint.name = "imprint";
+    imprint.displacement = Vec3(0, -1e-3, 0);
+    for (index_t i = 0; i < model.n_points; ++i)
+      if ((model.X.col(i) - c).norm() <= 0.75 * model.h) {
+        imprint.points.push_back(i);
+        model.fixed[i] = 1;
+      }
+    model.fixed_groups.push_back(imprint);
+    load_text = fmt::format("the {} points within 0.75 h of the pole pushed 1 mm in", imprint.points.size());
+  } else {
+    model.f_ext(1, pole) = 0.01;
+    load_text = "a pull of 0.01 N at the pole";
+  }
   SolverSpec statics = scene.solver;
   statics.kind = SolverKind::STATIC;
   Points reference;
+  Vec3 full_force = Vec3::Zero();  // indent: what the imprint's support (the probe) feels
   double full_steps = 0, full_realtime = 0;
   {
+    const auto start = std::chrono::steady_clock::now();
     Simulation sim(model, statics, options.threads);
     sim.step();
     if (!sim.summary().converged) throw Error("lod-error: the full model's static solve did not converge");
     reference = sim.state().u;
+    full_force = sim.summary().reactions.back();
+    fmt::print("lod-error: full model, {} points: static solve in {:.1f} s\n", model.n_points,
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     Simulation dyn(model, scene.solver, options.threads);
     const Timing t = time_steps(dyn, options.seconds);
     full_steps = t.steps_per_s;
@@ -285,62 +346,86 @@ int run_lod_error_experiment(const LodExperimentOptions& options) {
   }
   const double whole = 2.0 * radius / model.h + 1.0;
   auto csv = fmt::output_file((out / "lod-error.csv").string());
-  csv.print("points,scheme,seed,level_distance_h,K,weight,selected,active,steps_per_s,speedup,realtime_speedup,error_near_pct,error_whole_pct\n");
-  csv.print("{},full,,,,1,{},{},{:.6g},1,1,0,0\n", model.n_points, model.n_points, model.n_points, full_steps);
+  csv.print("points,scheme,seed,level_distance_h,K,weight,selected,active,steps_per_s,speedup,realtime_speedup,error_near_pct,"
+            "error_whole_pct,error_near_rms_pct,force_error_pct,config\n");
+  csv.print("{},full,,,,1,{},{},{:.6g},1,1,0,0,0,0,full\n", model.n_points, model.n_points, model.n_points, full_steps);
   struct Row {
-    std::string scheme;
+    std::string scheme, config;
     double P;
     int K;
-    double speedup = 0, near = 0, whole = 0;
+    double speedup = 0, steps = 0, near = 0, near_rms = 0, whole = 0, force = 0;
     int n = 0;
   };
   std::vector<Row> rows;
-  const std::vector<double> distances = {3.0, whole};
-  for (double P : distances)
-    for (int K : {0, 4, 6, 8, 9})
-      for (LodScheme scheme : {LodScheme::RANDOM, LodScheme::DITHER}) {
-        if (K == 0 && scheme == LodScheme::DITHER) continue;  // weight 1: both select everything
-        Row row{K == 0 ? std::string("all") : std::string(to_string(scheme)), P, K};
-        const int seeds = scheme == LodScheme::RANDOM && K > 0 ? 3 : 1;
-        for (int seed = 1; seed <= seeds; ++seed) {
-          LodParams p = bands(1.0, 1.5, {{P, K}}, scheme);
-          p.seed = static_cast<std::uint64_t>(seed);
-          Simulation sim(model, statics, options.threads);
-          sim.enable_lod(p, c);
-          sim.step();
-          const RunSummary s = sim.summary();
-          const Errors e = errors(model, sim.full_state().u, reference, c, model.h);
-          Simulation dyn(model, scene.solver, options.threads);
-          dyn.enable_lod(p, c);
-          const Timing t = time_steps(dyn, options.seconds / 2);
-          csv.print("{},{},{},{:.4g},{},{:.1f},{},{},{:.6g},{:.4g},{:.4g},{:.4g},{:.4g}\n", model.n_points, row.scheme, seed, P, K,
-                    (10 - K) / 10.0, s.lod.selected, s.lod.selected + s.lod.frozen, t.steps_per_s, t.steps_per_s / full_steps,
-                    t.realtime / full_realtime, 100 * e.near, 100 * e.whole);
-          row.speedup += t.steps_per_s / full_steps / seeds;
-          row.near += e.near / seeds;
-          row.whole += e.whole / seeds;
-          row.n += s.lod.selected;
-          if (!s.converged) fmt::print(stderr, "lod-error: a static solve did not converge ({} K={} seed {})\n", row.scheme, K, seed);
+  struct Config {
+    LodParams params;
+    bool single_scheme;
+  };
+  std::vector<Config> configs;
+  if (!options.levels.empty()) {
+    for (LodScheme scheme : {LodScheme::RANDOM, LodScheme::DITHER}) {
+      LodParams p = parse_config(options.levels, whole);
+      p.scheme = scheme;
+      configs.push_back({p, false});
+    }
+  } else {
+    for (double P : {3.0, whole})
+      for (int K : {0, 4, 6, 8, 9})
+        for (LodScheme scheme : {LodScheme::RANDOM, LodScheme::DITHER}) {
+          if (K == 0 && scheme == LodScheme::DITHER) continue;  // weight 1: both select everything
+          configs.push_back({bands(1.0, 1.5, {{P, K}}, scheme), K == 0});
         }
-        row.n /= seeds;
-        fmt::print("lod-error: P = {:.3g}h K = {} {}: {} points, speed-up {:.2f}, error near {:.2f}% whole {:.2f}%\n", P, K,
-                   row.scheme, row.n, row.speedup, 100 * row.near, 100 * row.whole);
-        rows.push_back(row);
-      }
+  }
+  for (const Config& cfg : configs) {
+    const LodParams& base = cfg.params;
+    const double P = base.levels.empty() ? base.k2 : base.levels.back().distance;
+    const int K = base.levels.empty() ? 0 : base.levels.back().K;
+    Row row{cfg.single_scheme ? std::string("all") : std::string(to_string(base.scheme)), describe(base, whole), P, K};
+    const int seeds = base.scheme == LodScheme::RANDOM && !cfg.single_scheme ? 3 : 1;
+    for (int seed = 1; seed <= seeds; ++seed) {
+      LodParams p = base;
+      p.seed = static_cast<std::uint64_t>(seed);
+      Simulation sim(model, statics, options.threads);
+      sim.enable_lod(p, c);
+      sim.step();
+      const RunSummary s = sim.summary();
+      const Errors e = errors(model, sim.full_state().u, reference, c, p.k1 * model.h);
+      Simulation dyn(model, scene.solver, options.threads);
+      dyn.enable_lod(p, c);
+      const Timing t = time_steps(dyn, options.seconds / 2);
+      const double force = indent ? (s.reactions.back() - full_force).norm() / full_force.norm() : 0.0;
+      csv.print("{},{},{},{:.4g},{},{:.1f},{},{},{:.6g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},\"{}\"\n", model.n_points, row.scheme,
+                seed, P, K, (10 - K) / 10.0, s.lod.selected, s.lod.selected + s.lod.frozen, t.steps_per_s, t.steps_per_s / full_steps,
+                t.realtime / full_realtime, 100 * e.near, 100 * e.whole, 100 * e.near_rms, 100 * force, row.config);
+      row.near_rms += e.near_rms / seeds;
+      row.force += force / seeds;
+      row.steps += t.steps_per_s / seeds;
+      row.speedup += t.steps_per_s / full_steps / seeds;
+      row.near += e.near / seeds;
+      row.whole += e.whole / seeds;
+      row.n += s.lod.selected;
+      if (!s.converged) fmt::print(stderr, "lod-error: a static solve did not converge ({}, {}, seed {})\n", row.config, row.scheme, seed);
+    }
+    row.n /= seeds;
+    fmt::print("lod-error: {} {}: {} points, {:.0f} steps/s (x{:.1f}), error inside T_r1 max {:.2f}% rms {:.2f}%, whole {:.2f}%, "
+               "force {:.2f}%\n", row.config, row.scheme, row.n, row.steps, row.speedup, 100 * row.near, 100 * row.near_rms,
+               100 * row.whole, 100 * row.force);
+    rows.push_back(row);
+  }
   csv.close();
   std::string md = fmt::format(
       "# Displacement error against speed-up: the seed's random selection and the dithered one\n\n"
-      "The {}-point half-sphere, a pull of 0.01 N at the pole, static equilibrium; T_r1 = h, T_r2 = 1.5h and one "
-      "propagation level to P (3h, or the whole object) at weight (10 - K)/10; the random scheme averaged over 3 "
-      "seeds. Speed-up: explicit steps per second against the full model's ({:.0f}/s). Errors: the largest inside "
-      "T_r1 relative to the largest displacement there, and the RMS over the object.\n\n"
-      "| level to | K (weight) | scheme | points simulated | speed-up | error inside T_r1 | error, whole object |\n"
-      "|---|---|---|---|---|---|---|\n",
-      model.n_points, full_steps);
+      "The {}-point half-sphere, {}, static equilibrium, with levels of detail around the pole; the random scheme "
+      "averaged over 3 seeds. Steps: explicit steps per second ({} threads; the full model makes {:.0f}/s), each of "
+      "which can publish a local contact model to the haptic loop. Displacement errors against the full model: inside "
+      "T_r1 the largest (relative to the largest displacement there) and the RMS (relative to the RMS there); over the "
+      "whole object the RMS; with an imprint, the error of the force the probe feels.\n\n"
+      "| configuration | scheme | points simulated | steps/s | speed-up | inside T_r1, max | inside T_r1, RMS | whole object | force |\n"
+      "|---|---|---|---|---|---|---|---|---|\n",
+      model.n_points, load_text, options.threads == 0 ? std::string("all") : std::to_string(options.threads), full_steps);
   for (const Row& r : rows)
-    md += fmt::format("| {} | {} ({:.1f}) | {} | {} | {:.1f} | {:.1f}% | {:.1f}% |\n",
-                      r.P == whole ? std::string("whole object") : fmt::format("{}h", r.P), r.K, (10 - r.K) / 10.0, r.scheme,
-                      r.n, r.speedup, 100 * r.near, 100 * r.whole);
+    md += fmt::format("| {} | {} | {} | {:.0f} | {:.1f} | {:.1f}% | {:.1f}% | {:.1f}% | {} |\n", r.config, r.scheme, r.n, r.steps,
+                      r.speedup, 100 * r.near, 100 * r.near_rms, 100 * r.whole, indent ? fmt::format("{:.1f}%", 100 * r.force) : "");
   auto summary = fmt::output_file((out / "lod-error.md").string());
   summary.print("{}", md);
   summary.close();

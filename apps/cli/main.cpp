@@ -185,6 +185,13 @@ int main(int argc, char** argv) {
   CLI::App* lod_error_cmd = experiment_cmd->add_subcommand(
       "lod-error", "Displacement error against speed-up: the seed's random selection and the dithered one");
   lod_options(lod_error_cmd, lod_error);
+  lod_error_cmd->add_option("--points", lod_error.points, "Points in the half-sphere (default 10000; --quick 1200)")
+      ->check(CLI::Range(100, 2000000));
+  lod_error_cmd->add_option("--load", lod_error.load, "pull: 0.01 N at the pole | indent: the pole pushed 1 mm in")
+      ->check(CLI::IsMember({"pull", "indent"}));
+  lod_error_cmd->add_option("--config", lod_error.levels,
+                            "One configuration instead of the sweep, both schemes: \"k1,k2;P1:K1;P2:K2\" (units of h; "
+                            "P = 0: the whole object)");
 
   CLI11_PARSE(app, argc, argv);
   try {

@@ -72,7 +72,7 @@ class ContactForces : public DynamicForces {
 
 // One simulation step with the latest probe; then the local model (and the display frame) is published.
 int simulation_step(Simulation& sim, ContactForces& contact, HapticLoop& loop, TripleBuffer<DisplayFrame>* display,
-                    long long step) {
+                    long long step, bool real_time) {
   loop.frames().update();
   const HapticFrame& frame = loop.frames().front();
   contact.device = frame.device;
@@ -86,7 +86,11 @@ int simulation_step(Simulation& sim, ContactForces& contact, HapticLoop& loop, T
     // levels of detail follow the contact point: at contact onset and when it moved far enough; on this
     // thread, while the haptic thread keeps rendering the local model just published
     const bool onset = contacts_before == 0 && contact.last.contacts > 0;
-    const std::vector<index_t> new_index = sim.update_lod(sim.lod_contact_of_probe(contact.probe, contact.contact.grabbed()), onset);
+    // in real time built on a worker thread and taken over at the first step after it is ready; in
+    // deterministic runs built here, so that a run is reproducible
+    const std::vector<index_t> new_index =
+        sim.update_lod(sim.lod_contact_of_probe(contact.probe, contact.contact.grabbed(), contact.contact.touched()), onset,
+                       real_time);
     if (!new_index.empty()) contact.remap(sim.model(), new_index);
   }
   if (display) {
@@ -168,7 +172,7 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
         std::this_thread::sleep_for(std::chrono::duration<double>(sim.state().time - t0 - wall));
         continue;
       }
-      result.max_contacts = std::max(result.max_contacts, simulation_step(sim, contact, loop, options.display, result.simulation_steps));
+      result.max_contacts = std::max(result.max_contacts, simulation_step(sim, contact, loop, options.display, result.simulation_steps, options.real_time));
       ++result.simulation_steps;
     }
     loop.stop();
@@ -180,7 +184,7 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
       if (!loop.tick(t, h)) break;
       while (sim.state().time - t0 < t - 1e-12) {
         result.max_contacts =
-            std::max(result.max_contacts, simulation_step(sim, contact, loop, options.display, result.simulation_steps));
+            std::max(result.max_contacts, simulation_step(sim, contact, loop, options.display, result.simulation_steps, options.real_time));
         ++result.simulation_steps;
       }
     }

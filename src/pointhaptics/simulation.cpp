@@ -12,8 +12,30 @@
 
 #include <chrono>
 #include <cmath>
+#include <future>
 
 namespace pointhaptics {
+
+// A selection and its active model, ready to take over (built on a worker thread or in place).
+struct LodBuild {
+  Selection selection;
+  ActiveSet active;
+  Vec3 centre;
+  double stable_dt = 0;
+  double ms = 0;  // selection, active model and its stable step
+};
+
+LodBuild build_lod(const Model& full, const LodParams& params, const Vec3& centre, SolverKind solver) {
+  const auto start = std::chrono::steady_clock::now();
+  LodBuild b;
+  std::mt19937_64 rng(params.seed);  // a fresh generator: every point keeps its draw across selections
+  b.selection = select_points(full, centre, params, rng);
+  b.active = build_active_set(full, b.selection, params);
+  b.centre = centre;
+  if (solver == SolverKind::EXPLICIT) b.stable_dt = stable_time_step(b.active.model);
+  b.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return b;
+}
 
 // Levels of detail: the object, its state, and the active set simulated in its place.
 struct Simulation::Lod {
@@ -28,6 +50,7 @@ struct Simulation::Lod {
   bool full_state_current = true;
   long long selections = 0;
   double last_build_ms = 0, max_reselect_ms = 0;
+  std::future<LodBuild> pending;  // an asynchronous re-selection in flight
 
   Vec3 snap(const Vec3& c) const {
     index_t nearest = 0;
@@ -45,11 +68,13 @@ Simulation::Simulation(Model model, const SolverSpec& solver, int n_threads)
     for (index_t i : group.points) state_.u.col(i) = prescribed_displacement(group, 0.0);
 }
 
-Simulation::~Simulation() = default;
+Simulation::~Simulation() {
+  if (lod_ && lod_->pending.valid()) lod_->pending.wait();  // the worker reads lod_->full
+}
 Simulation::Simulation(Simulation&&) noexcept = default;
 
-void Simulation::prepare_solver() {
-  stable_dt_ = stable_time_step(model_);
+void Simulation::prepare_solver(double stable_dt) {
+  stable_dt_ = stable_dt > 0 ? stable_dt : stable_time_step(model_);
   extra_forces_ = Points::Zero(3, model_.n_points);
   newton_.reset();
   implicit_.reset();
@@ -68,7 +93,7 @@ void Simulation::enable_lod(const LodParams& params, const Vec3& contact) {
   lod->tree = std::make_unique<KdTree>(lod->full.X);
   lod_ = std::move(lod);
   lod_->contact = contact;
-  reselect(lod_->snap(contact));
+  take_over(build_lod(lod_->full, params, lod_->snap(contact), solver_.kind), true);
 }
 
 void Simulation::set_state(const State& state) {
@@ -90,37 +115,50 @@ const State& Simulation::full_state() {
   return lod_->full_state;
 }
 
-Vec3 Simulation::lod_contact_of_probe(const Vec3& probe, const std::vector<index_t>& grabbed) const {
+Vec3 Simulation::lod_contact_of_probe(const Vec3& probe, const std::vector<index_t>& grabbed,
+                                      const std::vector<index_t>& touched) const {
   // grabbing: where the grabbed points are in the object, however far they were dragged
   if (!grabbed.empty()) {
     Vec3 sum = Vec3::Zero();
     for (index_t i : grabbed) sum += model_.X.col(i);
     return sum / static_cast<double>(grabbed.size());
   }
-  // pushing: the probe itself. Not the reference position of the touched points, which jumps from one
-  // point to the next as the probe slides; the probe moves smoothly, and is never farther from them
-  // than the indentation plus its radius
+  // pushing: the probe carried back by the mean displacement of the touched points, so that pressing in
+  // does not move the contact point (the touched material stays where it is in the object). The mean of
+  // many points moves smoothly as the probe slides, unlike the nearest point
+  if (!touched.empty()) {
+    Vec3 sum = Vec3::Zero();
+    for (index_t i : touched) sum += state_.u.col(i);
+    return probe - sum / static_cast<double>(touched.size());
+  }
   return probe;
 }
 
-std::vector<index_t> Simulation::update_lod(const Vec3& contact, bool onset) {
+std::vector<index_t> Simulation::update_lod(const Vec3& contact, bool onset, bool asynchronous) {
   if (!lod_) throw Error("lod: levels of detail are off");
+  Lod& l = *lod_;
+  if (l.pending.valid()) {
+    // a re-selection in flight: take it over once it is built (waiting for it unless asynchronous)
+    if (asynchronous && l.pending.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return {};
+    return take_over(l.pending.get(), false);
+  }
   if (!contact.allFinite()) return {};
   // the distance is the contact point's own, not its snapped point's: a probe that trembles between two
   // points of the lattice must not re-select at every step
-  const double moved = (contact - lod_->contact).norm();
-  if (onset ? moved < 0.25 * lod_->params.reselect * lod_->full.h : moved <= lod_->params.reselect * lod_->full.h) return {};
-  lod_->contact = contact;
-  return reselect(lod_->snap(contact));
+  const double moved = (contact - l.contact).norm();
+  if (onset ? moved < 0.25 * l.params.reselect * l.full.h : moved <= l.params.reselect * l.full.h) return {};
+  l.contact = contact;
+  if (!asynchronous) return take_over(build_lod(l.full, l.params, l.snap(contact), solver_.kind), true);
+  // the worker only reads the object's model, which nothing writes while levels of detail are on
+  l.pending = std::async(std::launch::async, build_lod, std::cref(l.full), l.params, l.snap(contact), solver_.kind);
+  return {};
 }
 
-std::vector<index_t> Simulation::reselect(const Vec3& c) {
+std::vector<index_t> Simulation::take_over(LodBuild build, bool built_here) {
   Lod& l = *lod_;
   const auto start = std::chrono::steady_clock::now();
   const State& carried = full_state();  // the active state so far, back on the object
-  std::mt19937_64 rng(l.params.seed);   // a fresh generator: every point keeps its draw across selections
-  Selection selection = select_points(l.full, c, l.params, rng);
-  ActiveSet active = build_active_set(l.full, selection, l.params);
+  ActiveSet& active = build.active;
   std::vector<index_t> new_index(model_.n_points, -1);
   if (l.selections > 0)
     for (index_t k = 0; k < l.active.n_selected; ++k) {
@@ -131,16 +169,17 @@ std::vector<index_t> Simulation::reselect(const Vec3& c) {
   state_ = active.restrict_state(carried);
   state_.time = time;
   l.active = std::move(active);
-  l.selection = std::move(selection);
-  l.centre = c;
+  l.selection = std::move(build.selection);
+  l.centre = build.centre;
   model_ = l.active.model;
   ws_ = Workspace(model_, n_threads_);
-  prepare_solver();
+  prepare_solver(build.stable_dt);
   l.full_state_current = false;
   ++l.selections;
-  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  l.last_build_ms = ms - l.selection.milliseconds;
-  l.max_reselect_ms = std::max(l.max_reselect_ms, ms);
+  const double stall = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  l.last_build_ms = build.ms - l.selection.milliseconds;
+  // the time this thread was held: the swap, and the build too when it was made here
+  l.max_reselect_ms = std::max(l.max_reselect_ms, stall + (built_here ? build.ms : 0.0));
   return new_index;
 }
 

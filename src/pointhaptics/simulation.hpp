@@ -14,6 +14,8 @@
 
 namespace pointhaptics {
 
+struct LodBuild;  // simulation.cpp
+
 class Simulation {
  public:
   /// Take the model (never written again) and prepare the solver; n_threads = 0: all hardware threads.
@@ -38,14 +40,19 @@ class Simulation {
   void enable_lod(const LodParams& params, const Vec3& contact);
   bool lod_enabled() const { return lod_ != nullptr; }
   /// Re-select when the contact point is farther than params.reselect h from the one of the last
-  /// selection, or at contact onset (`onset`) when it is farther than a quarter of that. The state carries over: the active state goes back to the object
-  /// (absorbed points follow by MLS), the new active set takes its points' displacements and velocities.
-  /// Returns the new index of each old active point (-1 if no longer simulated), or an empty vector when
-  /// nothing changed. Allocates (a new model): not a per-step operation; its cost is in the summary.
-  std::vector<index_t> update_lod(const Vec3& contact, bool onset = false);
-  /// The contact point of a probe at `probe` for update_lod(): the probe itself when pushing; when
-  /// grabbing (`grabbed`: indices into model()), where the grabbed points are in the object.
-  Vec3 lod_contact_of_probe(const Vec3& probe, const std::vector<index_t>& grabbed = {}) const;
+  /// selection, or at contact onset (`onset`) when it is farther than a quarter of that. The state
+  /// carries over: the active state goes back to the object (absorbed points follow by MLS), the new
+  /// active set takes its points' displacements and velocities. `asynchronous`: the new active set is
+  /// built on a worker thread while this one keeps stepping the old one, and takes over at the first call
+  /// after it is ready (the contact may have moved meanwhile; the next call re-selects again if so).
+  /// Returns the new index of each old active point (-1 if no longer simulated) when a new active set
+  /// took over, else an empty vector. Allocates (a new model): not a per-step operation.
+  std::vector<index_t> update_lod(const Vec3& contact, bool onset = false, bool asynchronous = false);
+  /// The contact point of a probe at `probe` for update_lod(), in the reference configuration: when
+  /// grabbing (`grabbed`: indices into model()), where the grabbed points are in the object; when pushing,
+  /// the probe carried back by the mean displacement of the `touched` points (the probe itself if none).
+  Vec3 lod_contact_of_probe(const Vec3& probe, const std::vector<index_t>& grabbed = {},
+                            const std::vector<index_t>& touched = {}) const;
   const Model& full_model() const;
   /// The object's state (with levels of detail: the active state carried back; absorbed points follow
   /// their selected point by first-order MLS, the rest keep their last displacement).
@@ -64,8 +71,8 @@ class Simulation {
 
  private:
   NewtonSettings newton_settings() const;
-  void prepare_solver();  // for model_: workspace, stable step, solver objects
-  std::vector<index_t> reselect(const Vec3& snapped_contact);
+  void prepare_solver(double stable_dt = 0);  // for model_: stable step (0: compute it), solver objects
+  std::vector<index_t> take_over(LodBuild build, bool built_here);
   struct Lod;
   std::unique_ptr<Lod> lod_;
 

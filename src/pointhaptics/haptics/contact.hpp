@@ -49,6 +49,8 @@ class ProbeContact {
   void remap(const Model& model, const std::vector<index_t>& new_index);
   const ProbeParams& params() const { return params_; }
   const std::vector<index_t>& grabbed() const { return grabbed_; }
+  /// The points the last apply() pushed.
+  const std::vector<index_t>& touched() const { return touched_; }
 
  private:
   ProbeParams params_;
