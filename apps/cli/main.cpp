@@ -101,8 +101,9 @@ int run_command(const RunOptions& opt) {
     if (scene.probe.present) {
       const ph::HapticStats& h = interactive.haptic;
       fmt::print("haptics         {} ticks at {:.0f} Hz, period error p50 {:.0f} us, p99 {:.0f} us, max {:.0f} us; "
-                 "longest tick {:.1f} us; max force {:.3g} N; up to {} points in contact; {} simulation steps\n",
-                 h.ticks, h.rate_hz, h.period_p50_us, h.period_p99_us, h.period_max_us, h.tick_max_us, h.max_force_n,
+                 "longest tick {:.1f} us, spin-wait {:.0f} us on average; max force {:.3g} N; up to {} points in contact; "
+                 "{} simulation steps\n",
+                 h.ticks, h.rate_hz, h.period_p50_us, h.period_p99_us, h.period_max_us, h.tick_max_us, h.spin_mean_us, h.max_force_n,
                  interactive.max_contacts, interactive.simulation_steps);
     }
   }

@@ -33,7 +33,8 @@ class ContactForces : public DynamicForces {
     Vec3 p = probe.allFinite() ? probe : device;
     for (int it = 0; it < 8; ++it) {
       scratch.setZero();
-      const ContactModel m = contact.apply(model, state.u, p, button, state.time, scratch);
+      // the state is the same at every iteration: the positions and their grid are made once
+      const ContactModel m = contact.apply(model, state.u, p, button, state.time, scratch, it > 0);
       Vec3 d = device;
       const auto solver = (k * Mat3::Identity() - m.K).ldlt();
       Vec3 next = solver.solve(k * d + m.f0 - m.K * p);

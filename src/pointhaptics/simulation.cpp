@@ -32,7 +32,7 @@ LodBuild build_lod(const Model& full, const LodParams& params, const Vec3& centr
   b.selection = select_points(full, centre, params, rng);
   b.active = build_active_set(full, b.selection, params);
   b.centre = centre;
-  if (solver == SolverKind::EXPLICIT) b.stable_dt = stable_time_step(b.active.model);
+  if (solver == SolverKind::EXPLICIT) b.stable_dt = stable_time_step(b.active.model, 0.8, 20);
   b.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return b;
 }

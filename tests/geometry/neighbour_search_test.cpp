@@ -27,6 +27,22 @@ TEST(RadiusNeighbours, MatchesBruteForceOnAGrid) {
   }
 }
 
+TEST(RadiusNeighbours, PerPointSupportsAreSymmetricAndMatchBruteForce) {
+  // supports from h to 3h: i and j are neighbours when max(h_i, h_j) reaches
+  const Points X = test::random_field(1200, 0.05, 4);
+  Eigen::VectorXd support(X.cols());
+  for (Eigen::Index i = 0; i < X.cols(); ++i) support[i] = 0.01 * (1.0 + 2.0 * (i % 7) / 6.0);
+  const Csr a = radius_neighbours(X, support);
+  std::vector<index_t> offset{0}, index;
+  for (index_t i = 0; i < X.cols(); ++i) {
+    for (index_t j = 0; j < X.cols(); ++j)
+      if (j != i && within_support((X.col(j) - X.col(i)).squaredNorm(), std::max(support[i], support[j]))) index.push_back(j);
+    offset.push_back(static_cast<index_t>(index.size()));
+  }
+  EXPECT_EQ(a.offset, offset);
+  EXPECT_EQ(a.index, index);
+}
+
 TEST(RadiusNeighbours, GridStencilAtTwiceTheSpacingHas26Points) {
   // points exactly h apart are not neighbours (every kernel is zero there), whatever the round-off
   const PointCloud c = sample_box(Vec3(0.013, 0.0, 0.0), Vec3::Constant(0.06), 0.0075);

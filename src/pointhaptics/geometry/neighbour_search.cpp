@@ -53,9 +53,36 @@ Csr radius_neighbours(const Points& X, double h) {
 Csr radius_neighbours(const Points& X, const Eigen::VectorXd& support) {
   const index_t n = static_cast<index_t>(X.cols());
   if (support.size() != n) throw Error("neighbour search: one support radius per point is needed");
-  // symmetric: i and j are neighbours when either one's support reaches the other
-  return search_neighbours(X, n ? support.maxCoeff() : 0.0,
-                           [&support](index_t i, index_t j) { return std::max(support[i], support[j]); });
+  // symmetric: i and j are neighbours when either one's support reaches the other. Each point searches
+  // its own support only (searching the largest one from every point would cost (h_max / h_i)^3 more
+  // candidates in a dense core); a pair only the wider side reaches is added to the other side's row after
+  const KdTree tree(X);
+  std::vector<std::vector<index_t>> rows(n);
+  tbb::parallel_for(tbb::blocked_range<index_t>(0, n, 256), [&](const tbb::blocked_range<index_t>& range) {
+    std::vector<std::pair<index_t, double>> found;
+    nanoflann::SearchParams params;
+    params.sorted = false;
+    for (index_t i = range.begin(); i != range.end(); ++i) {
+      found.clear();
+      const Vec3 q = X.col(i);
+      tree.index().radiusSearch(q.data(), support[i] * support[i] * (1.0 + 1e-6), found, params);
+      for (const auto& [j, r2] : found)
+        if (static_cast<index_t>(j) != i && within_support((X.col(j) - q).squaredNorm(), support[i])) rows[i].push_back(j);
+    }
+  });
+  // the pairs (i, j) that i's support reaches and j's does not: j's row lacks i
+  std::vector<std::vector<index_t>> extra(n);
+  for (index_t i = 0; i < n; ++i)
+    for (index_t j : rows[i])
+      if (!within_support((X.col(j) - X.col(i)).squaredNorm(), support[j])) extra[j].push_back(i);
+  tbb::parallel_for(tbb::blocked_range<index_t>(0, n, 256), [&](const tbb::blocked_range<index_t>& range) {
+    for (index_t i = range.begin(); i != range.end(); ++i) {
+      auto& row = rows[i];
+      row.insert(row.end(), extra[i].begin(), extra[i].end());
+      std::sort(row.begin(), row.end());
+    }
+  });
+  return rows_to_csr(rows);
 }
 
 Csr radius_neighbours_brute_force(const Points& X, double h) {

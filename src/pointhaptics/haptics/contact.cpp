@@ -22,6 +22,7 @@ ProbeContact::ProbeContact(const Model& model, const ProbeParams& params)
 
 void ProbeContact::remap(const Model& model, const std::vector<index_t>& new_index) {
   x_ = model.X;
+  positions_valid_ = false;
   std::size_t kept = 0;
   for (std::size_t g = 0; g < grabbed_.size(); ++g) {
     const index_t old = grabbed_[g];
@@ -38,7 +39,7 @@ void ProbeContact::remap(const Model& model, const std::vector<index_t>& new_ind
 }
 
 ContactModel ProbeContact::apply(const Model& model, const Points& u, const Vec3& probe, bool button, double time,
-                                 Points& forces) {
+                                 Points& forces, bool same_u) {
   ContactModel out;
   out.time = time;
   out.p0 = probe;
@@ -49,6 +50,7 @@ ContactModel ProbeContact::apply(const Model& model, const Points& u, const Vec3
       // press: grab the points under the probe, keeping their offsets
       x_ = model.X + u;
       grid_.rebuild(x_);
+      positions_valid_ = true;
       grabbed_.clear();
       offsets_.clear();
       grid_.for_each_within(x_, probe, params_.radius + params_.point_radius, [&](index_t i) {
@@ -73,8 +75,11 @@ ContactModel ProbeContact::apply(const Model& model, const Points& u, const Vec3
   // push: sphere-sphere overlap (seed Fig. 5)
   touched_.clear();
   normals_.clear();
-  x_ = model.X + u;
-  grid_.rebuild(x_);
+  if (!same_u || !positions_valid_ || x_.cols() != model.n_points) {
+    x_ = model.X + u;
+    grid_.rebuild(x_);
+    positions_valid_ = true;
+  }
   const double reach = params_.radius + params_.point_radius;
   grid_.for_each_within(x_, probe, reach, [&](index_t i) {
     const Vec3 r = x_.col(i) - probe;

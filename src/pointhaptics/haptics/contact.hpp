@@ -38,8 +38,10 @@ class ProbeContact {
   ProbeContact(const Model& model, const ProbeParams& params);
   /// Adds the contact forces on the points (N) into `forces` (3 x n) for the probe at `probe` (m) and the
   /// current displacement u, and returns the local contact model. A non-finite probe position is ignored
-  /// (no contact). No allocation after the first calls.
-  ContactModel apply(const Model& model, const Points& u, const Vec3& probe, bool button, double time, Points& forces);
+  /// (no contact). No allocation after the first calls. `same_u`: u is the one of the last call, so the
+  /// current positions and their grid are reused (the probe solve tries several probe positions at once).
+  ContactModel apply(const Model& model, const Points& u, const Vec3& probe, bool button, double time, Points& forces,
+                     bool same_u = false);
   /// The stiffness -df_i/du_i of the contact springs of the last apply() per point (push: k n n^T,
   /// grab: k I), added into `springs` (9 x n, column-major 3x3).
   void add_stiffness(Eigen::Matrix<double, 9, Eigen::Dynamic>& springs) const;
@@ -61,6 +63,7 @@ class ProbeContact {
   std::vector<index_t> touched_;  // points pushed by the last apply(), with their normals
   std::vector<Vec3> normals_;
   bool was_pressed_ = false;
+  bool positions_valid_ = false;  // x_ and grid_ hold the positions of the last apply()
 };
 
 }  // namespace pointhaptics

@@ -107,11 +107,19 @@ void HapticLoop::run() {
   const auto period = std::chrono::duration_cast<clock::duration>(std::chrono::duration<double>(period_));
   auto deadline = start;
   auto previous = start;
+  int spin_us = 400;
   while (running_.load(std::memory_order_relaxed)) {
     deadline += period;
     // absolute deadlines (no drift): sleep until shortly before, then spin, because a sleeping thread
-    // wakes up late by up to the scheduler's slack (hundreds of us on a loaded machine)
-    std::this_thread::sleep_until(deadline - std::chrono::microseconds(400));
+    // wakes up late by up to the scheduler's slack (hundreds of us on a loaded machine). The spin margin
+    // follows the lateness seen: up at once past a late wake-up, down by 1 us per tick when wake-ups are
+    // punctual, within [60, 400] us; spinning is CPU the simulation does not get on a small machine
+    const auto wake = deadline - std::chrono::microseconds(spin_us);
+    std::this_thread::sleep_until(wake);
+    const double late_us = std::chrono::duration<double, std::micro>(clock::now() - wake).count();
+    if (late_us > spin_us - 50) spin_us = std::min(400, static_cast<int>(late_us) + 100);
+    else if (spin_us > 60) --spin_us;
+    spin_us_sum_ += spin_us;
     while (clock::now() < deadline) {
     }
     const auto now = clock::now();
@@ -155,6 +163,7 @@ HapticStats HapticLoop::stats() const {
       break;
     }
   s.tick_max_us = tick_max_us_;
+  s.spin_mean_us = s.ticks > 0 ? spin_us_sum_ / static_cast<double>(s.ticks) : 0.0;
   s.max_force_n = max_force_;
   s.min_observed_energy = renderer_.min_observed_energy();
   s.device_failed = failed_;

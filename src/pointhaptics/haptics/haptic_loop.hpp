@@ -42,6 +42,7 @@ struct HapticStats {
   double rate_hz = 0;                  ///< ticks per second of wall time (threaded) or of simulated time
   double period_p50_us = 0, period_p99_us = 0, period_max_us = 0;  ///< |period - nominal| quantiles, us
   double tick_max_us = 0;              ///< the longest tick's own work, us
+  double spin_mean_us = 0;             ///< mean busy-wait before a tick (threaded), us: CPU the loop burns
   double max_force_n = 0;              ///< largest commanded force magnitude, N
   double min_observed_energy = 0;      ///< passivity observer's minimum, J (negative: active at some point)
   bool device_failed = false;
@@ -88,7 +89,7 @@ class HapticLoop {
   bool failed_ = false;
   std::string error_;
   long long ticks_ = 0;
-  double last_t_ = 0, tick_max_us_ = 0, max_force_ = 0, wall_s_ = 0;
+  double last_t_ = 0, tick_max_us_ = 0, max_force_ = 0, wall_s_ = 0, spin_us_sum_ = 0;
   std::array<long long, 2001> period_histogram_{};  ///< |period error| in 1 us bins, the last one open-ended
   std::thread thread_;
   std::atomic<bool> running_{false};

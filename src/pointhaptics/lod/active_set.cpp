@@ -5,6 +5,8 @@
 #include <pointhaptics/mechanics/deformation.hpp>
 #include <pointhaptics/mechanics/model_builder.hpp>
 
+#include <oneapi/tbb/parallel_for.h>
+
 #include <algorithm>
 #include <chrono>
 
@@ -36,14 +38,21 @@ ActiveSet build_active_set(const Model& full, const Selection& selection, const 
   Points selected_X(3, a.n_selected);
   for (index_t k = 0; k < a.n_selected; ++k) selected_X.col(k) = full.X.col(a.full_of[k]);
   const KdTree tree(selected_X);
-  std::vector<index_t> absorbed_by(n_full, -1);
+  std::vector<index_t> absorbed_by(n_full, -1), nearest_of(n_full, -1);
+  std::vector<double> nearest_d2(n_full, 0.0);
+  // the searches in parallel (each writes its own entries), the bookkeeping after, in index order
+  tbb::parallel_for(tbb::blocked_range<index_t>(0, n_full, 1024), [&](const tbb::blocked_range<index_t>& range) {
+    for (index_t j = range.begin(); j != range.end(); ++j) {
+      if (a.active_of[j] >= 0) continue;
+      if (selection.band[j] < 0 && (full.X.col(j) - selection.centre).squaredNorm() > candidate_radius * candidate_radius)
+        continue;  // beyond the reach of any selected point
+      tree.index().knnSearch(full.X.col(j).data(), 1, &nearest_of[j], &nearest_d2[j]);
+    }
+  });
   for (index_t j = 0; j < n_full; ++j) {
-    if (a.active_of[j] >= 0) continue;
-    if (selection.band[j] < 0 && (full.X.col(j) - selection.centre).squaredNorm() > candidate_radius * candidate_radius)
-      continue;  // beyond the reach of any selected point
-    index_t nearest = -1;
-    double d2 = 0;
-    tree.index().knnSearch(full.X.col(j).data(), 1, &nearest, &d2);
+    const index_t nearest = nearest_of[j];
+    const double d2 = nearest_d2[j];
+    if (nearest < 0) continue;
     if (selection.band[j] >= 0) {
       absorbed_by[j] = nearest;  // inside the bands: absorbed by, and following, its nearest selected point
       a.follows[j] = nearest;
@@ -81,28 +90,29 @@ ActiveSet build_active_set(const Model& full, const Selection& selection, const 
     const KdTree active_tree(cloud.X);
     std::vector<std::pair<index_t, double>> found;
     nanoflann::SearchParams search;
-    search.sorted = true;
+    search.sorted = false;
+    std::vector<index_t> knn_index(static_cast<std::size_t>(params.min_neighbours) + 1);
+    std::vector<double> knn_d2(knn_index.size());
     for (index_t k = 0; k < a.n_selected; ++k) {
-      found.clear();
-      active_tree.index().radiusSearch(cloud.X.col(k).data(), reach * reach, found, search);
-      // found is sorted by distance and includes the point itself; a point never needs more neighbours
-      // than it had in the full model (surface points have fewer)
+      // the distance to the needed-th nearest active point (the point itself comes first); a point never
+      // needs more neighbours than it had in the full model (surface points have fewer)
       const std::size_t needed =
           static_cast<std::size_t>(std::min<index_t>(params.min_neighbours, full.neighbours.row_size(a.full_of[k]))) + 1;
-      if (found.size() < needed) {
+      const std::size_t got = active_tree.index().knnSearch(cloud.X.col(k).data(), needed, knn_index.data(), knn_d2.data());
+      if (got < needed || knn_d2[needed - 1] >= reach * reach) {
         support[k] = reach;
       } else {
-        const double r = std::sqrt(found[needed - 1].second);
+        const double r = std::sqrt(knn_d2[needed - 1]);
         double hk = h;
         while (hk <= r * (1 + 1e-9) && hk < reach) hk = std::min(reach, hk + 0.25 * h);
         support[k] = hk;
       }
       a.widened += support[k] > h * (1 + 1e-12);
       // the frozen points this one reaches are the ring that holds the active set
-      for (const auto& [j, d2] : found) {
-        if (d2 >= support[k] * support[k]) break;
+      found.clear();
+      active_tree.index().radiusSearch(cloud.X.col(k).data(), support[k] * support[k], found, search);
+      for (const auto& [j, d2] : found)
         if (j >= a.n_selected) ring_needed[j] = 1;
-      }
     }
     // ... and their own neighbours, so that the ring points next to the active set have the whole
     // neighbourhood (M_i, d_ij) they have in the object; these outer ones are passive (no stencil)
@@ -186,13 +196,21 @@ void ActiveSet::prolong_state(const State& active, State& full) const {
     full.u.col(full_of[k]) = active.u.col(k);
     full.velocity.col(full_of[k]) = active.velocity.col(k);
   }
+  // first-order MLS from the followed point: exact for any affine field. Each selected point's gradients
+  // once (a point has several followers), into buffers kept for the next call
+  gradient_cache_.resize(2 * static_cast<std::size_t>(n_selected));
+  tbb::parallel_for(tbb::blocked_range<index_t>(0, n_selected, 256), [&](const tbb::blocked_range<index_t>& range) {
+    for (index_t k = range.begin(); k != range.end(); ++k) {
+      gradient_cache_[2 * k] = displacement_gradient(model, active.u, k);
+      gradient_cache_[2 * k + 1] = displacement_gradient(model, active.velocity, k);
+    }
+  });
   for (index_t j = 0; j < static_cast<index_t>(follows.size()); ++j) {
     const index_t k = follows[j];
     if (k < 0) continue;
-    // first-order MLS from the followed point: exact for any affine field
     const Vec3 dX = follow_offset.col(j);
-    full.u.col(j) = active.u.col(k) + displacement_gradient(model, active.u, k) * dX;
-    full.velocity.col(j) = active.velocity.col(k) + displacement_gradient(model, active.velocity, k) * dX;
+    full.u.col(j) = active.u.col(k) + gradient_cache_[2 * k] * dX;
+    full.velocity.col(j) = active.velocity.col(k) + gradient_cache_[2 * k + 1] * dX;
   }
   full.time = active.time;
 }

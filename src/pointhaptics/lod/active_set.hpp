@@ -31,8 +31,12 @@ struct ActiveSet {
   /// The active state from the full one (selected and frozen points copy theirs).
   State restrict_state(const State& full) const;
   /// Write the active state back: active points (selected and ring) copy, absorbed points follow by
-  /// first-order MLS, unsimulated points keep theirs.
+  /// first-order MLS, unsimulated points keep theirs. No allocation after the first call; not for two
+  /// threads at once (it keeps the selected points' gradients in a buffer).
   void prolong_state(const State& active, State& full) const;
+
+ private:
+  mutable std::vector<Mat3> gradient_cache_;
 };
 
 /// Throws Error if nothing is selected.

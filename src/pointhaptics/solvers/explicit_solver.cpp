@@ -31,7 +31,7 @@ double estimated_stable_time_step(const Model& model, double safety) {
   return safety * a / std::sqrt(modulus / rho);
 }
 
-double stable_time_step(const Model& model, double safety) {
+double stable_time_step(const Model& model, double safety, int lanczos_steps) {
   // Lanczos on M^-1/2 K M^-1/2 over the free points at rest: its largest Ritz value approaches the
   // largest omega^2 from below, and symplectic Euler is stable for h < 2 / omega_max
   const Eigen::Index n = 3 * static_cast<Eigen::Index>(model.n_points);
@@ -49,7 +49,7 @@ double stable_time_step(const Model& model, double safety) {
   for (Eigen::Index k = 0; k < n; ++k) q[k] = scale[k] > 0 ? noise(rng) : 0.0;
   q.normalize();
   Points in(3, model.n_points), out(3, model.n_points);
-  const int steps = static_cast<int>(std::min<Eigen::Index>(40, n));
+  const int steps = static_cast<int>(std::min<Eigen::Index>(std::max(2, lanczos_steps), n));
   Eigen::VectorXd alpha = Eigen::VectorXd::Zero(steps), beta = Eigen::VectorXd::Zero(steps);
   int done = 0;
   double b = 0;
