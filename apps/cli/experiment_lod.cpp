@@ -264,13 +264,13 @@ int run_propagation_experiment(const LodExperimentOptions& options) {
 
 namespace {
 
-// "k1,k2;P:K;P:K" (units of h; P = 0: the whole object)
+// "k1,k2[,min_neighbours];P:K;P:K" (units of h; P = 0: the whole object)
 LodParams parse_config(const std::string& text, double whole) {
   LodParams p;
   std::size_t at = text.find(';');
   const std::string head = text.substr(0, at);
-  if (std::sscanf(head.c_str(), "%lf,%lf", &p.k1, &p.k2) != 2)
-    throw Error(fmt::format("lod-error: --config \"{}\": expected \"k1,k2;P:K;...\"", text));
+  if (std::sscanf(head.c_str(), "%lf,%lf,%d", &p.k1, &p.k2, &p.min_neighbours) < 2)
+    throw Error(fmt::format("lod-error: --config \"{}\": expected \"k1,k2[,min_neighbours];P:K;...\"", text));
   while (at != std::string::npos) {
     const std::size_t next = text.find(';', at + 1);
     const std::string level = text.substr(at + 1, next == std::string::npos ? std::string::npos : next - at - 1);
@@ -281,14 +281,13 @@ LodParams parse_config(const std::string& text, double whole) {
     p.levels.push_back(l);
     at = next;
   }
-  if (const char* mn = std::getenv("PH_MINNB")) p.min_neighbours = std::atoi(mn);
-  if (const char* mw = std::getenv("PH_MAXW")) p.max_widening = std::atof(mw);
   validate(p);
   return p;
 }
 
 std::string describe(const LodParams& p, double whole) {
   std::string s = fmt::format("T_r1 = {}h, T_r2 = {}h", p.k1, p.k2);
+  if (p.min_neighbours != LodParams{}.min_neighbours) s += fmt::format(", {} neighbours", p.min_neighbours);
   for (const LodLevel& l : p.levels)
     s += l.distance >= whole ? fmt::format("; whole object at K = {}", l.K) : fmt::format("; to {}h at K = {}", l.distance, l.K);
   return s;

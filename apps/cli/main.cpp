@@ -61,7 +61,7 @@ void print_summary(ph::Simulation& sim, const ph::RunSummary& s, double setup_s)
     for (size_t b = 0; b < s.lod.band_count.size(); ++b)
       bands += fmt::format("{}{}/{}", b ? ", " : "", s.lod.band_selected[b], s.lod.band_count[b]);
     fmt::print("levels of detail {} of {} points simulated ({} held around them, {} with wider supports); selected per "
-               "band {}; {} selections, the last {:.2f} ms + {:.2f} ms to build, the longest {:.2f} ms\n",
+               "band {}; {} selections, the last {:.2f} ms + {:.2f} ms to build; a re-selection held the simulation for {:.2f} ms at most\n",
                s.lod.selected, m.n_points, s.lod.frozen, s.lod.widened, bands, s.lod.selections, s.lod.selection_ms,
                s.lod.build_ms, s.lod.max_reselect_ms);
   }
@@ -191,8 +191,8 @@ int main(int argc, char** argv) {
   lod_error_cmd->add_option("--load", lod_error.load, "pull: 0.01 N at the pole | indent: the pole pushed 1 mm in")
       ->check(CLI::IsMember({"pull", "indent"}));
   lod_error_cmd->add_option("--config", lod_error.levels,
-                            "One configuration instead of the sweep, both schemes: \"k1,k2;P1:K1;P2:K2\" (units of h; "
-                            "P = 0: the whole object)");
+                            "One configuration instead of the sweep, both schemes: \"k1,k2[,min_neighbours];P1:K1;P2:K2\" "
+                            "(units of h; P = 0: the whole object)");
 
   CLI11_PARSE(app, argc, argv);
   try {

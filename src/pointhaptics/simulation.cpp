@@ -175,11 +175,12 @@ std::vector<index_t> Simulation::take_over(LodBuild build, bool built_here) {
   ws_ = Workspace(model_, n_threads_);
   prepare_solver(build.stable_dt);
   l.full_state_current = false;
+  const bool first = l.selections == 0;  // made by enable_lod(), before any step: set-up, not a stall
   ++l.selections;
   const double stall = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   l.last_build_ms = build.ms - l.selection.milliseconds;
   // the time this thread was held: the swap, and the build too when it was made here
-  l.max_reselect_ms = std::max(l.max_reselect_ms, stall + (built_here ? build.ms : 0.0));
+  if (!first) l.max_reselect_ms = std::max(l.max_reselect_ms, stall + (built_here ? build.ms : 0.0));
   return new_index;
 }
 

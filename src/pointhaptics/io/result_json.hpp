@@ -19,7 +19,8 @@ struct LodSummary {
   long long selections = 0;             ///< selections made (the first and the re-selections)
   double selection_ms = 0;              ///< the last selection, ms
   double build_ms = 0;                  ///< the last active model's build (neighbours, M_i, stable step), ms
-  double max_reselect_ms = 0;           ///< the longest selection + build, ms
+  double max_reselect_ms = 0;           ///< the longest a re-selection held the simulation thread, ms (the whole
+                                        ///< build when made in place, the take-over when built on a worker)
 };
 
 /// What a run reports besides the points: solver outcome, energies, timing, support reactions.
