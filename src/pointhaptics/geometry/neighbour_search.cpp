@@ -20,10 +20,10 @@ Csr rows_to_csr(const std::vector<std::vector<index_t>>& rows) {
   return Csr{std::move(offset), std::move(index)};
 }
 
-// The k-d tree search shared by both supports: candidates within `reach` (slightly widened), then
-// support(i, j) decides with the one support predicate.
-template <class Support>
-Csr search_neighbours(const Points& X, double reach, Support&& support) {
+// The k-d tree search shared by both supports: row i holds the points j != i within radius(i) of
+// point i (unsorted).
+template <class Radius>
+std::vector<std::vector<index_t>> search_rows(const Points& X, Radius&& radius) {
   const index_t n = static_cast<index_t>(X.cols());
   const KdTree tree(X);
   std::vector<std::vector<index_t>> rows(n);
@@ -34,20 +34,27 @@ Csr search_neighbours(const Points& X, double reach, Support&& support) {
     for (index_t i = range.begin(); i != range.end(); ++i) {
       found.clear();
       const Vec3 q = X.col(i);
-      tree.index().radiusSearch(q.data(), reach * reach * (1.0 + 1e-6), found, params);
-      auto& row = rows[i];
+      const double r = radius(i);
+      tree.index().radiusSearch(q.data(), r * r * (1.0 + 1e-6), found, params);
       for (const auto& [j, r2] : found)
-        if (j != i && within_support((X.col(j) - q).squaredNorm(), support(i, static_cast<index_t>(j)))) row.push_back(j);
-      std::sort(row.begin(), row.end());
+        if (static_cast<index_t>(j) != i && within_support((X.col(j) - q).squaredNorm(), r)) rows[i].push_back(j);
     }
   });
-  return rows_to_csr(rows);
+  return rows;
+}
+
+void sort_rows(std::vector<std::vector<index_t>>& rows) {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows.size(), 256), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t i = range.begin(); i != range.end(); ++i) std::sort(rows[i].begin(), rows[i].end());
+  });
 }
 
 }  // namespace
 
 Csr radius_neighbours(const Points& X, double h) {
-  return search_neighbours(X, h, [h](index_t, index_t) { return h; });
+  std::vector<std::vector<index_t>> rows = search_rows(X, [h](index_t) { return h; });
+  sort_rows(rows);
+  return rows_to_csr(rows);
 }
 
 Csr radius_neighbours(const Points& X, const Eigen::VectorXd& support) {
@@ -56,32 +63,13 @@ Csr radius_neighbours(const Points& X, const Eigen::VectorXd& support) {
   // symmetric: i and j are neighbours when either one's support reaches the other. Each point searches
   // its own support only (searching the largest one from every point would cost (h_max / h_i)^3 more
   // candidates in a dense core); a pair only the wider side reaches is added to the other side's row after
-  const KdTree tree(X);
-  std::vector<std::vector<index_t>> rows(n);
-  tbb::parallel_for(tbb::blocked_range<index_t>(0, n, 256), [&](const tbb::blocked_range<index_t>& range) {
-    std::vector<std::pair<index_t, double>> found;
-    nanoflann::SearchParams params;
-    params.sorted = false;
-    for (index_t i = range.begin(); i != range.end(); ++i) {
-      found.clear();
-      const Vec3 q = X.col(i);
-      tree.index().radiusSearch(q.data(), support[i] * support[i] * (1.0 + 1e-6), found, params);
-      for (const auto& [j, r2] : found)
-        if (static_cast<index_t>(j) != i && within_support((X.col(j) - q).squaredNorm(), support[i])) rows[i].push_back(j);
-    }
-  });
-  // the pairs (i, j) that i's support reaches and j's does not: j's row lacks i
+  std::vector<std::vector<index_t>> rows = search_rows(X, [&support](index_t i) { return support[i]; });
   std::vector<std::vector<index_t>> extra(n);
   for (index_t i = 0; i < n; ++i)
     for (index_t j : rows[i])
       if (!within_support((X.col(j) - X.col(i)).squaredNorm(), support[j])) extra[j].push_back(i);
-  tbb::parallel_for(tbb::blocked_range<index_t>(0, n, 256), [&](const tbb::blocked_range<index_t>& range) {
-    for (index_t i = range.begin(); i != range.end(); ++i) {
-      auto& row = rows[i];
-      row.insert(row.end(), extra[i].begin(), extra[i].end());
-      std::sort(row.begin(), row.end());
-    }
-  });
+  for (index_t i = 0; i < n; ++i) rows[i].insert(rows[i].end(), extra[i].begin(), extra[i].end());
+  sort_rows(rows);
   return rows_to_csr(rows);
 }
 
