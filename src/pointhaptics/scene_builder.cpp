@@ -51,6 +51,10 @@ Model build_scene_model(const Scene& scene) {
     for (index_t i : group.points) model.fixed[i] = 1;
     model.fixed_groups.push_back(std::move(group));
   }
+  // points a point-cloud file marks as held: held at zero displacement (no [[fixed]] table, so no
+  // reaction entry; give them a [[fixed]] box for one)
+  for (index_t i = 0; i < static_cast<index_t>(cloud.held.size()); ++i)
+    if (cloud.held[static_cast<std::size_t>(i)]) model.fixed[i] = 1;
 
   // constant external loads
   for (size_t k = 0; k < scene.loads.size(); ++k) {

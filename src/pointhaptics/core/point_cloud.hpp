@@ -12,6 +12,7 @@ struct PointCloud {
   std::vector<unsigned char> surface; ///< 1 where the point lies on the body's surface  (n)
   double spacing = 0;                 ///< nominal sample spacing, m
   Eigen::VectorXd support;            ///< optional per-point kernel support h_i, m (empty: the kernel's one h)
+  std::vector<unsigned char> held;    ///< optional, from a file: 1 where the point is held  (n, or empty)
 
   index_t size() const { return static_cast<index_t>(X.cols()); }
 };

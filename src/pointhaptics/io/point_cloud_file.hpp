@@ -1,15 +1,28 @@
 #pragma once
-/// @file Reading point clouds from text files (.xyz, .csv): one point per line, x y z in metres.
+/// @file Reading point clouds: PLY (ASCII, binary little and big endian) and text (.xyz, .csv), with
+/// optional per-point attributes, checked before anything is simulated.
 #include <pointhaptics/core/point_cloud.hpp>
 
 #include <string>
+#include <string_view>
 
 namespace pointhaptics {
 
-/// Read an .xyz (whitespace-separated) or .csv (comma-separated) cloud; lines starting with '#' and a
-/// non-numeric header line are skipped. Each point gets volume spacing^3. Throws Error naming the file
-/// and line for a missing file, a malformed line, a non-finite coordinate or an empty cloud; other
-/// formats (.ply, meshes, volume images) are refused with a clear message.
+/// Read a point cloud file by its extension:
+/// - `.ply`: the `vertex` element's x, y, z (any PLY number type), and optionally `fixed` (non-zero: the
+///   point is held) and `volume` (m^3); other properties and elements are ignored, a file with faces is a
+///   surface mesh and refused here;
+/// - `.xyz`, `.txt` (whitespace-separated) and `.csv` (comma-separated): one point per line, x y z and
+///   optionally fixed and volume, in that order or as a header line names them (`x,y,z,volume,fixed`);
+///   lines starting with '#' are comments.
+/// Points without a volume get spacing^3. Throws Error naming the file (and line or vertex) for a missing
+/// file, a malformed or truncated one, a count the file cannot hold, a non-finite or implausible
+/// coordinate (|x| > 1e6 m: wrong endianness or units), a non-positive volume, duplicate points, and a
+/// degenerate cloud (fewer than 4 points, or all on a plane or a line: no solid to simulate).
 PointCloud read_point_cloud(const std::string& path, double spacing);
+
+/// The same from the file's bytes; `format` is the extension (".ply", ".xyz", ".csv", ".txt") and `name`
+/// names it in messages. For tests and fuzzing.
+PointCloud parse_point_cloud(std::string_view data, std::string_view format, const std::string& name, double spacing);
 
 }  // namespace pointhaptics
