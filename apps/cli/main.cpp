@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 
 #include <chrono>
+#include <optional>
 #include <cstdio>
 
 namespace ph = pointhaptics;
@@ -23,6 +24,8 @@ struct RunOptions {
   std::string scene;
   std::string json;
   std::string force_log;
+  std::string vtk;
+  int vtk_every = 0;
   bool deterministic = false;
   bool quiet = false;
   int threads = 0;
@@ -75,6 +78,11 @@ int run_command(const RunOptions& opt) {
   ph::Simulation sim(ph::build_scene_model(scene), scene.solver, opt.threads);
   if (scene.lod.present) sim.enable_lod(scene.lod.params, ph::scene_lod_contact(scene, sim.model()));
   const double setup_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::optional<ph::VtkSeries> vtk;
+  if (!opt.vtk.empty()) {
+    vtk.emplace(opt.vtk);
+    ph::add_vtk_frame(*vtk, sim);  // the initial state
+  }
   ph::InteractiveResult interactive;
   if (scene.probe.present) {
     // with a probe: the haptic loop at 1 kHz and the simulation, in real time unless asked otherwise
@@ -86,8 +94,18 @@ int run_command(const RunOptions& opt) {
     if (!opt.force_log.empty()) ph::write_haptic_log(opt.force_log, interactive.log);
   } else {
     ph::cli::ProgressBar bar(!opt.quiet);
-    sim.run(scene.solver.duration, [&](double f) { bar.update(f); });
+    // frames: every vtk_every steps (default: about 50 over the run), and the last state
+    const long long n_steps = scene.solver.kind == ph::SolverKind::STATIC
+                                  ? 1
+                                  : std::max<long long>(1, std::llround(std::ceil(scene.solver.duration / scene.solver.dt - 1e-9)));
+    const long long every = opt.vtk_every > 0 ? opt.vtk_every : std::max<long long>(1, n_steps / 50);
+    long long step = 0;
+    sim.run(scene.solver.duration, [&](double f) {
+      bar.update(f);
+      if (vtk && ++step % every == 0 && step < n_steps) ph::add_vtk_frame(*vtk, sim);
+    });
   }
+  if (vtk) ph::add_vtk_frame(*vtk, sim);  // the last state (an interactive run writes only the first and the last)
   ph::RunSummary summary = sim.summary();
   if (scene.probe.present) {
     summary.haptic_ticks = interactive.haptic.ticks;
@@ -133,6 +151,9 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--json", run.json, "Write the result JSON to FILE");
   run_cmd->add_flag("--quiet,-q", run.quiet, "Print nothing but errors");
   run_cmd->add_option("--force-log", run.force_log, "With a [probe]: write the haptic log (CSV, one row per tick) to FILE");
+  run_cmd->add_option("--vtk", run.vtk, "Write a ParaView time series (DIR/frame.pvd and DIR/frame_*.vtp)");
+  run_cmd->add_option("--vtk-every", run.vtk_every, "Steps between VTK frames (default: about 50 frames per run)")
+      ->check(CLI::PositiveNumber);
   run_cmd->add_flag("--deterministic", run.deterministic,
                     "With a [probe]: interleave haptic ticks and simulation steps on one thread in simulated time");
   run_cmd->add_option("--threads", run.threads, "Threads for the force evaluation (0: all)")->check(CLI::NonNegativeNumber);

@@ -10,3 +10,4 @@
 #include <pointhaptics/haptics/haptic_log.hpp>
 #include <pointhaptics/interactive.hpp>
 #include <pointhaptics/simulation.hpp>
+#include <pointhaptics/vtk_output.hpp>

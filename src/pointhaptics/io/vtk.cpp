@@ -1,0 +1,78 @@
+#include <pointhaptics/io/vtk.hpp>
+
+#include <pointhaptics/core/error.hpp>
+
+#include <fmt/format.h>
+#include <fmt/os.h>
+
+#include <filesystem>
+
+namespace pointhaptics {
+
+void write_vtp(const std::string& path, const Points& points, const std::vector<VtkArray>& arrays) {
+  const Eigen::Index n = points.cols();
+  for (const VtkArray& a : arrays)
+    if (a.components < 1 || static_cast<Eigen::Index>(a.values.size()) != a.components * n)
+      throw Error(fmt::format("{}: array \"{}\" has {} values for {} points of {} components", path, a.name, a.values.size(), n,
+                              a.components));
+  try {
+    auto out = fmt::output_file(path);
+    out.print("<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\">\n<PolyData>\n");
+    out.print("<Piece NumberOfPoints=\"{}\" NumberOfVerts=\"{}\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n", n, n);
+    out.print("<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n");
+    for (Eigen::Index i = 0; i < n; ++i) out.print("{:.9g} {:.9g} {:.9g}\n", points(0, i), points(1, i), points(2, i));
+    out.print("</DataArray>\n</Points>\n");
+    // every point a vertex cell, so that ParaView draws it without a glyph filter
+    out.print("<Verts>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n");
+    for (Eigen::Index i = 0; i < n; ++i) out.print("{}\n", i);
+    out.print("</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n");
+    for (Eigen::Index i = 0; i < n; ++i) out.print("{}\n", i + 1);
+    out.print("</DataArray>\n</Verts>\n<PointData>\n");
+    for (const VtkArray& a : arrays) {
+      out.print("<DataArray type=\"{}\" Name=\"{}\" NumberOfComponents=\"{}\" format=\"ascii\">\n", a.integer ? "UInt8" : "Float64",
+                a.name, a.components);
+      for (Eigen::Index i = 0; i < n; ++i) {
+        for (int c = 0; c < a.components; ++c) {
+          const double v = a.values[static_cast<std::size_t>(i * a.components + c)];
+          if (c) out.print(" ");
+          if (a.integer) out.print("{}", static_cast<int>(v));
+          else out.print("{:.9g}", v);
+        }
+        out.print("\n");
+      }
+      out.print("</DataArray>\n");
+    }
+    out.print("</PointData>\n</Piece>\n</PolyData>\n</VTKFile>\n");
+  } catch (const std::system_error& e) {
+    throw Error(fmt::format("{}: cannot write the VTK file ({})", path, e.what()));
+  }
+}
+
+VtkSeries::VtkSeries(std::string folder, std::string base) : folder_(std::move(folder)), base_(std::move(base)) {
+  std::error_code ec;
+  std::filesystem::create_directories(folder_, ec);
+  if (ec) throw Error(fmt::format("{}: cannot create the VTK output folder ({})", folder_, ec.message()));
+  pvd_ = (std::filesystem::path(folder_) / (base_ + ".pvd")).string();
+}
+
+std::string VtkSeries::add(double time, const Points& points, const std::vector<VtkArray>& arrays) {
+  const std::string name = fmt::format("{}_{:06d}.vtp", base_, entries_.size());
+  const std::string path = (std::filesystem::path(folder_) / name).string();
+  write_vtp(path, points, arrays);
+  entries_.emplace_back(time, name);
+  write_collection();
+  return path;
+}
+
+void VtkSeries::write_collection() const {
+  try {
+    auto out = fmt::output_file(pvd_);
+    out.print("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"1.0\" byte_order=\"LittleEndian\">\n<Collection>\n");
+    for (const auto& [t, file] : entries_) out.print("<DataSet timestep=\"{:.9g}\" group=\"\" part=\"0\" file=\"{}\"/>\n", t, file);
+    out.print("</Collection>\n</VTKFile>\n");
+  } catch (const std::system_error& e) {
+    throw Error(fmt::format("{}: cannot write the VTK collection ({})", pvd_, e.what()));
+  }
+}
+
+}  // namespace pointhaptics

@@ -1,0 +1,33 @@
+#include <pointhaptics/vtk_output.hpp>
+
+#include <pointhaptics/mechanics/point_fields.hpp>
+
+namespace pointhaptics {
+
+std::vector<VtkArray> vtk_arrays(Simulation& sim) {
+  const Model& m = sim.full_model();
+  const State& s = sim.full_state();
+  const index_t n = m.n_points;
+  const PointFields f = point_fields(m, s.u);
+  std::vector<VtkArray> arrays;
+  arrays.push_back({"displacement", 3, std::vector<double>(s.u.data(), s.u.data() + 3 * n), false});
+  arrays.push_back({"cauchy_stress", 9, std::vector<double>(f.cauchy_stress.data(), f.cauchy_stress.data() + 9 * n), false});
+  arrays.push_back({"von_mises", 1, std::vector<double>(f.von_mises.data(), f.von_mises.data() + n), false});
+  arrays.push_back({"strain_energy_density", 1, std::vector<double>(f.energy_density.data(), f.energy_density.data() + n), false});
+  VtkArray active{"active", 1, std::vector<double>(static_cast<std::size_t>(n), sim.lod_enabled() ? 0.0 : 1.0), true};
+  if (const ActiveSet* a = sim.active_set())
+    for (index_t k = 0; k < a->n_selected; ++k) active.values[static_cast<std::size_t>(a->full_of[k])] = 1.0;
+  arrays.push_back(std::move(active));
+  VtkArray fixed{"fixed", 1, std::vector<double>(static_cast<std::size_t>(n)), true};
+  for (index_t i = 0; i < n; ++i) fixed.values[static_cast<std::size_t>(i)] = m.fixed[i] ? 1.0 : 0.0;
+  arrays.push_back(std::move(fixed));
+  return arrays;
+}
+
+void add_vtk_frame(VtkSeries& series, Simulation& sim) {
+  std::vector<VtkArray> arrays = vtk_arrays(sim);
+  const Points x = sim.full_model().X + sim.full_state().u;
+  series.add(sim.full_state().time, x, arrays);
+}
+
+}  // namespace pointhaptics

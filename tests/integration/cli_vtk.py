@@ -1,0 +1,64 @@
+#!/usr/bin/env python3
+"""End to end: `pointhaptics run --vtk DIR` writes a ParaView time series: a .pvd collection whose frames
+exist, each a VTK XML PolyData file with one vertex per point and the point data arrays of the contract,
+with finite values; the last frame's displacements are the result JSON's; with levels of detail the
+`active` flags count the simulated points."""
+import json
+import math
+import os
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+
+exe, scenes, out = sys.argv[1], sys.argv[2], sys.argv[3]
+ARRAYS = {"displacement": 3, "cauchy_stress": 9, "von_mises": 1, "strain_energy_density": 1, "active": 1, "fixed": 1}
+
+
+def read_frame(path):
+    piece = ET.parse(path).getroot().find("PolyData/Piece")
+    n = int(piece.get("NumberOfPoints"))
+    assert int(piece.get("NumberOfVerts")) == n, path
+    points = [float(v) for v in piece.find("Points/DataArray").text.split()]
+    assert len(points) == 3 * n, path
+    arrays = {}
+    for a in piece.find("PointData"):
+        values = [float(v) for v in a.text.split()]
+        comps = int(a.get("NumberOfComponents"))
+        assert len(values) == comps * n, (path, a.get("Name"))
+        assert all(math.isfinite(v) for v in values), (path, a.get("Name"))
+        arrays[a.get("Name")] = (comps, values)
+    for name, comps in ARRAYS.items():
+        assert name in arrays and arrays[name][0] == comps, (path, name)
+    conn = [int(v) for v in piece.find("Verts/DataArray[@Name='connectivity']").text.split()]
+    assert conn == list(range(n)), path
+    return n, points, arrays
+
+
+def check(scene, extra, name):
+    folder = os.path.join(out, name)
+    result = os.path.join(out, name + ".json")
+    subprocess.run([exe, "run", os.path.join(scenes, scene), "--quiet", "--vtk", folder, "--json", result] + extra, check=True)
+    series = ET.parse(os.path.join(folder, "frame.pvd")).getroot().findall("Collection/DataSet")
+    assert len(series) >= 2, len(series)
+    times = [float(d.get("timestep")) for d in series]
+    assert times == sorted(times), times
+    for d in series:
+        assert os.path.exists(os.path.join(folder, d.get("file"))), d.get("file")
+    n, points, arrays = read_frame(os.path.join(folder, series[-1].get("file")))
+    doc = json.load(open(result))
+    u = [c for p in doc["points"]["displacement"] for c in p]
+    assert len(u) == 3 * n
+    assert max(abs(a - b) for a, b in zip(u, arrays["displacement"][1])) <= 1e-8 * max(1e-12, max(map(abs, u))) + 1e-15
+    x = [c for p in doc["points"]["reference"] for c in p]
+    assert max(abs(p - (a + b)) for p, a, b in zip(points, x, u)) < 1e-9  # points are the current positions
+    return doc, arrays, len(series)
+
+
+doc, arrays, frames = check("beam_fixed_both_ends.toml", ["--vtk-every", "100"], "beam")
+assert frames == 1 + (doc["solver"]["steps"] - 1) // 100 + 1, frames  # the start, every 100 steps but the last, the end
+assert sum(arrays["fixed"][1]) == sum(doc["points"]["fixed"])
+assert max(arrays["von_mises"][1]) > 0
+doc, arrays, frames = check("half_sphere_lod.toml", ["--deterministic"], "lod")
+assert frames == 2, frames  # interactive runs: the first and the last state
+assert sum(arrays["active"][1]) == doc["lod"]["selected"], (sum(arrays["active"][1]), doc["lod"]["selected"])
+print("vtk output: ok")
