@@ -254,7 +254,10 @@ RawCloud parse_ply(std::string_view data, const std::string& name) {
   // the vertex element, and the elements before it (skipped)
   std::size_t vertex_index = elements.size();
   for (std::size_t e = 0; e < elements.size(); ++e)
-    if (elements[e].name == "vertex") vertex_index = e;
+    if (elements[e].name == "vertex") {
+      if (vertex_index != elements.size()) throw Error(fmt::format("{}: the PLY header declares two vertex elements", name));
+      vertex_index = e;
+    }
   if (vertex_index == elements.size()) throw Error(fmt::format("{}: the PLY file has no vertex element", name));
   for (const PlyElement& e : elements)
     if (e.name == "face" && e.count > 0)
@@ -316,7 +319,21 @@ RawCloud parse_ply(std::string_view data, const std::string& name) {
   const bool swap = (format == Format::BIG) != (std::endian::native == std::endian::big);
   const auto* bytes = reinterpret_cast<const unsigned char*>(data.data());
   std::size_t at = pos;
-  for (std::size_t e = 0; e < vertex_index; ++e)
+  for (std::size_t e = 0; e < vertex_index; ++e) {
+    // fixed-size items are skipped at once (a huge count must not loop); items with lists one by one,
+    // each of which takes at least a byte, so the loop ends with the data
+    bool has_list = false;
+    std::uint64_t item = 0;
+    for (const PlyProperty& p : elements[e].properties) {
+      has_list = has_list || p.list;
+      item += ply_size(p.type);
+    }
+    if (!has_list) {
+      if (item > 0 && elements[e].count > (data.size() - at) / item)
+        throw Error(fmt::format("{}: truncated in element \"{}\" ({} items declared)", name, elements[e].name, elements[e].count));
+      at += static_cast<std::size_t>(elements[e].count * item);
+      continue;
+    }
     for (std::uint64_t k = 0; k < elements[e].count; ++k)
       for (const PlyProperty& p : elements[e].properties) {
         std::uint64_t n = 1;
@@ -330,12 +347,13 @@ RawCloud parse_ply(std::string_view data, const std::string& name) {
         if (n > (data.size() - at) / ply_size(p.type)) throw Error(fmt::format("{}: truncated in element \"{}\"", name, elements[e].name));
         at += n * ply_size(p.type);
       }
+  }
   std::size_t stride = 0;
   for (const PlyProperty& p : vertex.properties) {
     if (p.list) throw Error(fmt::format("{}: list properties in vertices are not supported", name));
     stride += ply_size(p.type);
   }
-  if (vertex.count > (data.size() - at) / stride)
+  if (stride == 0 || vertex.count > (data.size() - at) / stride)
     throw Error(fmt::format("{}: declares {} vertices of {} bytes but holds only {} bytes (truncated, or a wrong count)", name,
                             vertex.count, stride, data.size() - at));
   reserve(vertex.count);
