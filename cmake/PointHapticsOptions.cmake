@@ -2,5 +2,6 @@
 option(PH_BUILD_TESTS "Build the GoogleTest suite" ${PROJECT_IS_TOP_LEVEL})
 option(PH_BUILD_APPS "Build the pointhaptics command line and the benchmark suite" ${PROJECT_IS_TOP_LEVEL})
 option(PH_NATIVE "Optimise for the building machine's CPU (-march=native)" OFF)
+option(PH_BUILD_PYTHON "Build the Python bindings (pybind11, NumPy)" ${PROJECT_IS_TOP_LEVEL})
 option(PH_BUILD_FUZZERS "Build the libFuzzer targets (clang, with PH_SANITIZE including fuzzer-no-link)" OFF)
 set(PH_SANITIZE "" CACHE STRING "Sanitizers to build with: address,undefined | thread | empty")

@@ -1,0 +1,100 @@
+"""Tests of the Python bindings: scenes and arrays in, NumPy views and copies out, the GIL released during
+long runs, the probe, and errors as pointhaptics.Error."""
+import os
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import pointhaptics as ph
+
+SCENES = os.environ.get("PH_SCENES", os.path.join(os.path.dirname(__file__), "..", "..", "scenes"))
+
+
+def scene(name):
+    return os.path.join(SCENES, name)
+
+
+def test_a_scene_runs_and_its_arrays_are_views_of_the_simulation():
+    sim = ph.Simulation.from_scene(scene("cantilever_static.toml"), threads=1)
+    u = sim.displacement
+    assert u.shape == (sim.n_points, 3) and u.dtype == np.float64
+    assert not u.flags.owndata and not u.flags.writeable  # a view, read-only
+    assert np.all(u == 0)
+    sim.step()  # the static solve
+    # the same view now shows the solution: the tip sags (the beam is loaded downwards at x = 0.15)
+    tip = sim.reference[:, 0] > 0.15 - 1e-9
+    assert u[tip, 1].mean() < -0.01
+    assert sim.summary()["converged"]
+    np.testing.assert_allclose(sim.positions, sim.reference + u)
+    assert sim.fixed.sum() == 25
+    e = sim.energy()
+    assert e["strain"] > 0 and e["kinetic"] == 0
+    with pytest.raises(ValueError):
+        u[0, 0] = 1.0  # read-only
+
+
+def test_a_model_from_arrays_matches_forces_and_energy():
+    # a 6 x 3 x 3 bar, 1 cm spacing, held at x = 0, pulled along x at the far end
+    g = np.stack(np.meshgrid(np.arange(6), np.arange(3), np.arange(3), indexing="ij"), axis=-1).reshape(-1, 3) * 0.01
+    fixed = g[:, 0] == 0
+    forces = np.zeros_like(g)
+    forces[g[:, 0] == 0.05, 0] = 0.01
+    sim = ph.Simulation.from_points(g, spacing=0.01, fixed=fixed, forces=forces, young=1e5, solver="static", threads=1)
+    assert sim.n_points == 54
+    sim.step()
+    u = sim.displacement
+    assert np.all(u[fixed] == 0)
+    assert u[g[:, 0] == 0.05, 0].mean() > 0  # stretched
+    # at equilibrium the internal forces balance the external ones on the free points
+    f = sim.forces
+    np.testing.assert_allclose(f[~fixed] + forces[~fixed], 0, atol=1e-8 * np.abs(forces).max())
+
+
+def test_long_runs_release_the_gil():
+    sim = ph.Simulation.from_scene(scene("beam_fixed_both_ends.toml"), threads=1)
+    ticks = []
+    done = threading.Event()
+
+    def count():
+        while not done.is_set():
+            ticks.append(time.perf_counter())
+            time.sleep(0.001)
+
+    t = threading.Thread(target=count)
+    t.start()
+    start = time.perf_counter()
+    sim.run(1.0)
+    end = time.perf_counter()
+    done.set()
+    t.join()
+    inside = [x for x in ticks if start < x < end]
+    # the other Python thread kept running while the simulation stepped
+    assert end - start > 0.02 and len(inside) >= 5, (end - start, len(inside))
+    assert abs(sim.time - 1.0) < 1e-9
+
+
+def test_the_probe_pushes_and_the_log_comes_back():
+    sim = ph.Simulation.from_scene(scene("beam_fixed_both_ends.toml"), threads=1)
+    # press 2.5 cm down from two radii above the middle of the top face, hold
+    r = sim.probe([[0, 0, 0, 0, 0], [0.5, 0, -0.025, 0, 0], [1.0, 0, -0.025, 0, 0]], radius=0.01, duration=1.0)
+    log = r["log"]
+    assert log.shape == (1000, 8)
+    assert r["max_contacts"] > 0 and r["max_force"] > 0.05
+    assert log[-1, 5] > 0  # the object pushes the device up
+    assert sim.displacement[:, 1].min() < -0.002
+
+
+def test_bad_input_is_a_named_error():
+    with pytest.raises(ph.Error, match="no-such.toml"):
+        ph.Simulation.from_scene("no-such.toml")
+    with pytest.raises(ph.Error, match="expected an \\(n, 3\\) array"):
+        ph.Simulation.from_points(np.zeros((4, 2)), spacing=0.01)
+    with pytest.raises(ph.Error, match="not finite"):
+        ph.Simulation.from_points(np.array([[0, 0, 0], [np.nan, 0, 0]]), spacing=0.01)
+    with pytest.raises(ph.Error, match="unknown kind"):
+        ph.Simulation.from_points(np.eye(3), spacing=0.01, solver="magic")
+    sim = ph.Simulation.from_scene(scene("beam_fixed_both_ends.toml"), threads=1)
+    with pytest.raises(ph.Error, match="duration"):
+        sim.run(-1)
