@@ -2,10 +2,15 @@
 
 #include <pointhaptics/core/error.hpp>
 #include <pointhaptics/geometry/sampling.hpp>
+#include <pointhaptics/io/mesh_file.hpp>
 #include <pointhaptics/io/point_cloud_file.hpp>
 #include <pointhaptics/mechanics/model_builder.hpp>
 
 #include <fmt/format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
 
 namespace pointhaptics {
 
@@ -15,7 +20,14 @@ PointCloud sample_object(const Scene& scene) {
     case ShapeKind::BOX: return sample_box(o.origin, o.size, o.spacing);
     case ShapeKind::SPHERE: return sample_sphere(o.origin, o.radius, o.spacing);
     case ShapeKind::HALF_SPHERE: return sample_half_sphere(o.origin, o.radius, o.spacing);
-    case ShapeKind::FILE: return read_point_cloud(o.file, o.spacing);
+    case ShapeKind::FILE: {
+      // point clouds as they are; surface meshes (and PLY files with faces) volume-sampled at the spacing
+      std::string ext = std::filesystem::path(o.file).extension().string();
+      std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+      const bool cloud = ext == ".xyz" || ext == ".csv" || ext == ".txt" || (ext == ".ply" && !ply_has_faces(o.file));
+      if (cloud) return read_point_cloud(o.file, o.spacing);
+      return sample_mesh_volume(read_mesh(o.file), o.spacing, o.file);
+    }
   }
   throw Error("object: unknown shape");
 }

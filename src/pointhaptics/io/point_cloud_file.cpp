@@ -261,7 +261,7 @@ RawCloud parse_ply(std::string_view data, const std::string& name) {
   if (vertex_index == elements.size()) throw Error(fmt::format("{}: the PLY file has no vertex element", name));
   for (const PlyElement& e : elements)
     if (e.name == "face" && e.count > 0)
-      throw Error(fmt::format("{}: a surface mesh ({} faces), not a point cloud; meshes are not read in this version", name,
+      throw Error(fmt::format("{}: a surface mesh ({} faces), not a point cloud (a scene volume-samples it as a mesh)", name,
                               e.count));
   const PlyElement& vertex = elements[vertex_index];
   int ix = -1, iy = -1, iz = -1, ifixed = -1, ivolume = -1;
