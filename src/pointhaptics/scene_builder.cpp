@@ -4,12 +4,14 @@
 #include <pointhaptics/geometry/sampling.hpp>
 #include <pointhaptics/io/mesh_file.hpp>
 #include <pointhaptics/io/point_cloud_file.hpp>
+#include <pointhaptics/io/volume_file.hpp>
 #include <pointhaptics/mechanics/model_builder.hpp>
 
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <filesystem>
 
 namespace pointhaptics {
@@ -24,6 +26,12 @@ PointCloud sample_object(const Scene& scene) {
       // point clouds as they are; surface meshes (and PLY files with faces) volume-sampled at the spacing
       std::string ext = std::filesystem::path(o.file).extension().string();
       std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+      if (is_volume_file(o.file)) {
+        if (!std::isfinite(o.threshold_low))
+          throw Error(fmt::format("{}:{}: object.threshold: a volume image needs threshold = [low, high] (the intensities "
+                                  "to sample)", scene.path, o.line));
+        return sample_volume(read_volume(o.file), o.threshold_low, o.threshold_high, o.spacing, o.file);
+      }
       const bool cloud = ext == ".xyz" || ext == ".csv" || ext == ".txt" || (ext == ".ply" && !ply_has_faces(o.file));
       if (cloud) return read_point_cloud(o.file, o.spacing);
       return sample_mesh_volume(read_mesh(o.file), o.spacing, o.file);

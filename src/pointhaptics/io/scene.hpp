@@ -24,6 +24,8 @@ struct ObjectSpec {
   double radius = 0.05;                ///< sphere, half_sphere, m
   double spacing = 0.0075;             ///< sample spacing, m
   std::string file;                    ///< shape = file: path, resolved against the scene file's folder
+  double threshold_low = NAN, threshold_high = NAN;  ///< volume images: the intensity window sampled
+  int line = 0;                        ///< of the [object] table, for messages
 };
 
 struct FixedSpec {

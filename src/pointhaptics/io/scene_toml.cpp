@@ -176,7 +176,15 @@ void read_object(TableReader& r, ObjectSpec& o, const Context& ctx) {
     std::filesystem::path p(o.file);
     if (p.is_relative()) p = std::filesystem::path(ctx.base_dir) / p;
     o.file = p.lexically_normal().string();
+    if (const toml::node* node = r.find("threshold")) {
+      const toml::array* a = node->as_array();
+      if (!a || a->size() != 2) r.fail_at(*node, "threshold", "expected [low, high] (image intensities)");
+      o.threshold_low = r.as_number(*a->get(0), "threshold");
+      o.threshold_high = r.as_number(*a->get(1), "threshold");
+      if (!(o.threshold_low <= o.threshold_high)) r.fail_at(*node, "threshold", "low must not exceed high");
+    }
   }
+  o.line = r.line();
 }
 
 void read_material(TableReader& r, MaterialParams& m) {
