@@ -25,6 +25,7 @@ struct RunOptions {
   std::string json;
   std::string force_log;
   std::string vtk;
+  std::string csv;
   int vtk_every = 0;
   bool deterministic = false;
   bool quiet = false;
@@ -106,6 +107,7 @@ int run_command(const RunOptions& opt) {
     });
   }
   if (vtk) ph::add_vtk_frame(*vtk, sim);  // the last state (an interactive run writes only the first and the last)
+  if (!opt.csv.empty()) ph::write_points_csv(opt.csv, sim);
   ph::RunSummary summary = sim.summary();
   if (scene.probe.present) {
     summary.haptic_ticks = interactive.haptic.ticks;
@@ -152,6 +154,7 @@ int main(int argc, char** argv) {
   run_cmd->add_flag("--quiet,-q", run.quiet, "Print nothing but errors");
   run_cmd->add_option("--force-log", run.force_log, "With a [probe]: write the haptic log (CSV, one row per tick) to FILE");
   run_cmd->add_option("--vtk", run.vtk, "Write a ParaView time series (DIR/frame.pvd and DIR/frame_*.vtp)");
+  run_cmd->add_option("--csv", run.csv, "Write the final state as CSV, one row per point (x, y, z, u, stress, energy, flags)");
   run_cmd->add_option("--vtk-every", run.vtk_every, "Steps between VTK frames (default: about 50 frames per run)")
       ->check(CLI::PositiveNumber);
   run_cmd->add_flag("--deterministic", run.deterministic,

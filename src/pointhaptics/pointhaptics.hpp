@@ -11,3 +11,4 @@
 #include <pointhaptics/interactive.hpp>
 #include <pointhaptics/simulation.hpp>
 #include <pointhaptics/vtk_output.hpp>
+#include <pointhaptics/csv_output.hpp>

@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
-"""End to end: `pointhaptics run --vtk DIR` writes a ParaView time series: a .pvd collection whose frames
+"""End to end: `pointhaptics run --vtk DIR --csv FILE` writes a ParaView time series: a .pvd collection whose frames
 exist, each a VTK XML PolyData file with one vertex per point and the point data arrays of the contract,
 with finite values; the last frame's displacements are the result JSON's; with levels of detail the
 `active` flags count the simulated points."""
+import csv
 import json
 import math
 import os
@@ -34,10 +35,24 @@ def read_frame(path):
     return n, points, arrays
 
 
+def read_with_vtk(path):
+    """VTK's own XML reader (the one ParaView uses for .vtp) on a frame: the points and arrays it finds."""
+    import vtk  # python3-vtk9, installed by scripts/setup
+    reader = vtk.vtkXMLPolyDataReader()
+    reader.SetFileName(path)
+    reader.Update()
+    out = reader.GetOutput()
+    pd = out.GetPointData()
+    arrays = {pd.GetArrayName(i): pd.GetArray(i).GetNumberOfComponents() for i in range(pd.GetNumberOfArrays())}
+    return out.GetNumberOfPoints(), out.GetNumberOfVerts(), arrays, pd.GetArray("displacement")
+
+
 def check(scene, extra, name):
     folder = os.path.join(out, name)
     result = os.path.join(out, name + ".json")
-    subprocess.run([exe, "run", os.path.join(scenes, scene), "--quiet", "--vtk", folder, "--json", result] + extra, check=True)
+    table = os.path.join(out, name + ".csv")
+    subprocess.run([exe, "run", os.path.join(scenes, scene), "--quiet", "--vtk", folder, "--json", result, "--csv", table] + extra,
+                   check=True)
     series = ET.parse(os.path.join(folder, "frame.pvd")).getroot().findall("Collection/DataSet")
     assert len(series) >= 2, len(series)
     times = [float(d.get("timestep")) for d in series]
@@ -45,10 +60,19 @@ def check(scene, extra, name):
     for d in series:
         assert os.path.exists(os.path.join(folder, d.get("file"))), d.get("file")
     n, points, arrays = read_frame(os.path.join(folder, series[-1].get("file")))
+    vn, verts, varrays, disp = read_with_vtk(os.path.join(folder, series[-1].get("file")))
+    assert vn == n and verts == n, (vn, verts, n)
+    assert varrays == ARRAYS, varrays
+    assert max(abs(disp.GetComponent(i, c) - arrays["displacement"][1][3 * i + c]) for i in range(n) for c in range(3)) < 1e-12
     doc = json.load(open(result))
     u = [c for p in doc["points"]["displacement"] for c in p]
     assert len(u) == 3 * n
     assert max(abs(a - b) for a, b in zip(u, arrays["displacement"][1])) <= 1e-8 * max(1e-12, max(map(abs, u))) + 1e-15
+    rows = list(csv.DictReader(open(table)))
+    assert len(rows) == n and list(rows[0]) == ["index", "x", "y", "z", "ux", "uy", "uz", "von_mises", "strain_energy_density",
+                                                 "active", "fixed"], list(rows[0])
+    assert max(abs(float(r[k]) - u[3 * i + c]) for i, r in enumerate(rows) for c, k in enumerate(("ux", "uy", "uz"))) < 1e-8 * max(map(abs, u))
+    assert [int(r["active"]) for r in rows] == [int(v) for v in arrays["active"][1]]
     x = [c for p in doc["points"]["reference"] for c in p]
     assert max(abs(p - (a + b)) for p, a, b in zip(points, x, u)) < 1e-9  # points are the current positions
     return doc, arrays, len(series)

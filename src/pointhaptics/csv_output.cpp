@@ -1,0 +1,37 @@
+#include <pointhaptics/csv_output.hpp>
+
+#include <pointhaptics/core/error.hpp>
+#include <pointhaptics/vtk_output.hpp>
+
+#include <fmt/format.h>
+#include <fmt/os.h>
+
+namespace pointhaptics {
+
+void write_points_csv(const std::string& path, Simulation& sim) {
+  const std::vector<VtkArray> arrays = vtk_arrays(sim);  // the same fields as the ParaView frames
+  auto field = [&](const std::string& name) -> const std::vector<double>& {
+    for (const VtkArray& a : arrays)
+      if (a.name == name) return a.values;
+    throw Error("csv output: no field " + name);
+  };
+  const std::vector<double>& vm = field("von_mises");
+  const std::vector<double>& w = field("strain_energy_density");
+  const std::vector<double>& active = field("active");
+  const std::vector<double>& fixed = field("fixed");
+  const Model& m = sim.full_model();
+  const State& s = sim.full_state();
+  try {
+    auto out = fmt::output_file(path);
+    out.print("index,x,y,z,ux,uy,uz,von_mises,strain_energy_density,active,fixed\n");
+    for (index_t i = 0; i < m.n_points; ++i) {
+      const std::size_t k = static_cast<std::size_t>(i);
+      out.print("{},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{},{}\n", i, m.X(0, i), m.X(1, i), m.X(2, i), s.u(0, i),
+                s.u(1, i), s.u(2, i), vm[k], w[k], static_cast<int>(active[k]), static_cast<int>(fixed[k]));
+    }
+  } catch (const std::system_error& e) {
+    throw Error(fmt::format("{}: cannot write the CSV file ({})", path, e.what()));
+  }
+}
+
+}  // namespace pointhaptics
