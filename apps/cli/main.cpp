@@ -8,6 +8,9 @@
 #include <pointhaptics/pointhaptics.hpp>
 
 #include "bench_suite.hpp"
+#ifdef PH_HAVE_VIEWER
+#include "viewer.hpp"
+#endif
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -161,6 +164,26 @@ int main(int argc, char** argv) {
                     "With a [probe]: interleave haptic ticks and simulation steps on one thread in simulated time");
   run_cmd->add_option("--threads", run.threads, "Threads for the force evaluation (0: all)")->check(CLI::NonNegativeNumber);
 
+#ifdef PH_HAVE_VIEWER
+  ph::viewer::ViewerOptions view;
+  CLI::App* view_cmd = app.add_subcommand("view", "Open the interactive viewer (mouse or device probe); --screenshot renders headless");
+  view_cmd->add_option("scene", view.scene, "Scene file (TOML); default: the seed's beam held at both ends, with a probe");
+  view_cmd->add_option("--screenshot", view.screenshot,
+                       "Write a PNG and exit: without --run-for, one frame rendered without a window (EGL); with it, the "
+                       "window's last frame");
+  view_cmd->add_option("--time", view.time, "Headless: simulated seconds before the frame (deterministic; the scene's "
+                                            "scripted probe moves if it has one)")->check(CLI::NonNegativeNumber);
+  view_cmd->add_option("--run-for", view.run_for, "Close the window after this many seconds")->check(CLI::PositiveNumber);
+  view_cmd->add_option("--info", view.info, "With --screenshot: write the frame's camera, viewport and probe as JSON");
+  view_cmd->add_option("--width", view.width, "Window or image width in pixels (default 1280)")->check(CLI::Range(16, 8192));
+  view_cmd->add_option("--height", view.height, "Window or image height in pixels (default 800)")->check(CLI::Range(16, 8192));
+  view_cmd->add_option("--probe", view.probe, "What drives the probe: auto (a device if present, else the mouse), mouse, "
+                                              "script (the scene's trajectory), device")
+      ->check(CLI::IsMember({"auto", "mouse", "script", "device"}));
+  view_cmd->add_flag("--no-panels", [&view](std::int64_t) { view.panels = false; }, "Only the 3-D view");
+  view_cmd->add_option("--threads", view.threads, "Threads for the force evaluation (0: all)")->check(CLI::NonNegativeNumber);
+#endif
+
   ph::bench::BenchOptions bench;
   CLI::App* bench_cmd = app.add_subcommand("bench", "Run the performance suite (forces and explicit steps) and print a table");
   bench_cmd->add_option("--json", bench.json_path, "Write the results as JSON to FILE");
@@ -221,6 +244,12 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   try {
     if (*run_cmd) return run_command(run);
+#ifdef PH_HAVE_VIEWER
+    if (*view_cmd) {
+      if (!view.info.empty() && view.screenshot.empty()) throw ph::Error("view: --info needs --screenshot");
+      return view.screenshot.empty() || view.run_for > 0 ? ph::viewer::run_window(view) : ph::viewer::render_screenshot(view);
+    }
+#endif
     if (*bench_cmd) return ph::bench::run_bench_suite(bench);
     if (*cantilever_cmd) return ph::experiments::run_cantilever_experiment(cantilever);
     if (*beam_cmd) return ph::experiments::run_beam_experiment(beam);

@@ -71,6 +71,31 @@ class ContactForces : public DynamicForces {
   Points scratch;
 };
 
+// What a viewer shows of the step just made.
+void publish_display(Simulation& sim, const ContactForces& contact, const HapticFrame& haptic, long long step,
+                     TripleBuffer<DisplayFrame>& display) {
+  DisplayFrame& d = display.back();
+  d.time = sim.state().time;
+  d.step = step;
+  d.u = sim.full_state().u;  // same size every time: no allocation
+  d.probe = contact.probe;
+  d.device = haptic.device;
+  d.force = haptic.force;
+  d.haptic_ticks = haptic.tick;
+  d.contacts = contact.last.contacts;
+  const ActiveSet* active = sim.active_set();
+  d.simulated = active ? active->n_selected : sim.model().n_points;
+  d.grabbed.clear();
+  for (const index_t i : contact.contact.grabbed()) d.grabbed.push_back(active ? active->full_of[i] : i);
+  if (active && d.lod_selections != sim.lod_selections()) {  // a new active set (rare): each slot catches up once
+    const Selection& selection = *sim.lod_selection();
+    d.lod_band.assign(sim.full_model().n_points, -1);
+    for (const index_t i : selection.selected) d.lod_band[i] = selection.band[i];
+    d.lod_selections = sim.lod_selections();
+  }
+  display.publish();
+}
+
 // One simulation step with the latest probe; then the local model (and the display frame) is published.
 int simulation_step(Simulation& sim, ContactForces& contact, HapticLoop& loop, TripleBuffer<DisplayFrame>* display,
                     long long step, bool real_time) {
@@ -94,14 +119,7 @@ int simulation_step(Simulation& sim, ContactForces& contact, HapticLoop& loop, T
                        real_time);
     if (!new_index.empty()) contact.remap(sim.model(), new_index);
   }
-  if (display) {
-    DisplayFrame& d = display->back();
-    d.time = sim.state().time;
-    d.step = step;
-    d.u = sim.full_state().u;  // same size every time: no allocation
-    d.probe = contact.probe;
-    display->publish();
-  }
+  if (display) publish_display(sim, contact, frame, step, *display);
   return contact.last.contacts;
 }
 
@@ -159,8 +177,10 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
     Simulation& sim;
     ~Detach() { sim.set_dynamic_forces(nullptr); }
   } detach{sim};
-  const auto ticks = static_cast<std::size_t>(std::ceil(options.duration * options.haptic_rate)) + 16;
-  HapticLoop loop(device, options.mapping, gains, options.rules, options.haptic_rate, options.log ? ticks : 0);
+  if (options.log && !std::isfinite(options.duration)) throw Error("interactive run: a force log needs a finite duration");
+  const auto ticks = options.log ? static_cast<std::size_t>(std::ceil(options.duration * options.haptic_rate)) + 16 : 0;
+  HapticLoop loop(device, options.mapping, gains, options.rules, options.haptic_rate, ticks);
+  const auto stopped = [&options] { return options.stop && options.stop->load(std::memory_order_acquire); };
   InteractiveResult result;
   const auto start = std::chrono::steady_clock::now();
   const double t0 = sim.state().time;
@@ -168,7 +188,7 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
     loop.start();
     for (;;) {
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      if (wall >= options.duration || loop.device_failed()) break;
+      if (wall >= options.duration || loop.device_failed() || stopped()) break;
       if (sim.state().time - t0 > wall) {  // ahead of the wall clock: wait for it
         std::this_thread::sleep_for(std::chrono::duration<double>(sim.state().time - t0 - wall));
         continue;
@@ -179,8 +199,9 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
     loop.stop();
   } else {
     const double h = 1.0 / options.haptic_rate;
+    if (!std::isfinite(options.duration)) throw Error("interactive run: a deterministic run needs a finite duration");
     const auto n_ticks = static_cast<long long>(std::llround(options.duration * options.haptic_rate));
-    for (long long k = 1; k <= n_ticks; ++k) {
+    for (long long k = 1; k <= n_ticks && !stopped(); ++k) {
       const double t = k * h;
       if (!loop.tick(t, h)) break;
       while (sim.state().time - t0 < t - 1e-12) {

@@ -4,6 +4,7 @@
 #include <pointhaptics/haptics/device.hpp>
 #include <pointhaptics/simulation.hpp>
 
+#include <atomic>
 #include <memory>
 
 namespace pointhaptics {
@@ -14,6 +15,16 @@ struct DisplayFrame {
   long long step = 0;
   Points u;             ///< displacements, m (3 x n)
   Vec3 probe = Vec3::Constant(NAN);
+  Vec3 device = Vec3::Constant(NAN);  ///< scene position of the device point, m
+  Vec3 force = Vec3::Zero();          ///< force the haptic loop rendered last, N
+  int contacts = 0;                   ///< points the probe touches or holds
+  long long haptic_ticks = 0;         ///< haptic ticks so far (a rate meter for the reader)
+  std::vector<index_t> grabbed;       ///< held by the probe (indices of the whole object)
+  /// Levels of detail: per point of the object the band of a simulated (selected) point, -1 for the
+  /// others; empty without levels of detail. Rewritten only when lod_selections changes.
+  std::vector<std::int8_t> lod_band;
+  long long lod_selections = 0;
+  index_t simulated = 0;              ///< points simulated (the active set with levels of detail)
 };
 
 struct InteractiveOptions {
@@ -29,6 +40,8 @@ struct InteractiveOptions {
   /// viewer thread, calls update() and reads front()). Its frames must be sized for the object's points
   /// (all of them, with levels of detail too).
   TripleBuffer<DisplayFrame>* display = nullptr;
+  /// If set, the run also ends (at the next step) once this becomes true: a viewer's window closed.
+  const std::atomic<bool>* stop = nullptr;
 };
 
 struct InteractiveResult {

@@ -106,6 +106,10 @@ void Simulation::set_state(const State& state) {
 const Model& Simulation::full_model() const { return lod_ ? lod_->full : model_; }
 const ActiveSet* Simulation::active_set() const { return lod_ ? &lod_->active : nullptr; }
 
+const Selection* Simulation::lod_selection() const { return lod_ ? &lod_->selection : nullptr; }
+
+long long Simulation::lod_selections() const { return lod_ ? lod_->selections : 0; }
+
 const State& Simulation::full_state() {
   if (!lod_) return state_;
   if (!lod_->full_state_current) {

@@ -58,6 +58,10 @@ class Simulation {
   /// their selected point by first-order MLS, the rest keep their last displacement).
   const State& full_state();
   const ActiveSet* active_set() const;
+  /// The selection the active set was built from (nullptr without levels of detail).
+  const Selection* lod_selection() const;
+  /// Selections made so far (0 without levels of detail): a new one means a new active set.
+  long long lod_selections() const;
   /// Replace the state (same model); used by tests and by replay.
   void set_state(const State& state);
   const SolverSpec& solver() const { return solver_; }

@@ -45,7 +45,10 @@ ContactModel ProbeContact::apply(const Model& model, const Points& u, const Vec3
   out.p0 = probe;
   if (!probe.allFinite()) return out;
   const double k = params_.stiffness;
-  if (params_.mode == ProbeMode::GRAB) {
+  grabbing_ = params_.mode == ProbeMode::GRAB || (params_.mode == ProbeMode::PUSH_GRAB && button);
+  if (grabbing_) {
+    touched_.clear();
+    normals_.clear();
     if (button && !was_pressed_) {
       // press: grab the points under the probe, keeping their offsets
       x_ = model.X + u;
@@ -73,6 +76,8 @@ ContactModel ProbeContact::apply(const Model& model, const Points& u, const Vec3
     return out;
   }
   // push: sphere-sphere overlap (seed Fig. 5)
+  grabbed_.clear();
+  was_pressed_ = false;
   touched_.clear();
   normals_.clear();
   if (!same_u || !positions_valid_ || x_.cols() != model.n_points) {
@@ -102,7 +107,7 @@ ContactModel ProbeContact::apply(const Model& model, const Points& u, const Vec3
 
 void ProbeContact::add_stiffness(Eigen::Matrix<double, 9, Eigen::Dynamic>& springs) const {
   const double k = params_.stiffness;
-  if (params_.mode == ProbeMode::GRAB) {
+  if (grabbing_) {
     for (index_t i : grabbed_) Eigen::Map<Mat3>(springs.col(i).data()).diagonal().array() += k;
     return;
   }

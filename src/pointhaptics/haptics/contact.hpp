@@ -8,7 +8,8 @@
 
 namespace pointhaptics {
 
-enum class ProbeMode { PUSH, GRAB };
+/// PUSH_GRAB: pushes while the button is up and grabs while it is held (a viewer's mouse probe).
+enum class ProbeMode { PUSH, GRAB, PUSH_GRAB };
 
 struct ProbeParams {
   double radius = 0.005;        ///< probe sphere, m
@@ -63,6 +64,7 @@ class ProbeContact {
   std::vector<index_t> touched_;  // points pushed by the last apply(), with their normals
   std::vector<Vec3> normals_;
   bool was_pressed_ = false;
+  bool grabbing_ = false;         // the last apply() grabbed (or held nothing, in grab mode)
   bool positions_valid_ = false;  // x_ and grid_ hold the positions of the last apply()
 };
 

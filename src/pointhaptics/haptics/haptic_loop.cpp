@@ -60,6 +60,7 @@ bool HapticLoop::tick(double t, double dt) {
     frame.device = d;
     frame.button = (state.buttons & 1u) != 0;
     frame.force = f;
+    frame.tick = ticks_ + 1;
     frames_.publish();
     if (log_.size() < log_.capacity()) log_.push_back({t, state.position, state.velocity, state.buttons, f});
     max_force_ = std::max(max_force_, f.norm());

@@ -27,6 +27,7 @@ struct HapticFrame {
   Vec3 device = Vec3::Constant(NAN); ///< scene position of the device point the coupling pulls toward
   bool button = false;
   Vec3 force = Vec3::Zero();         ///< force commanded to the device, N
+  long long tick = 0;                ///< ticks so far, this one included (a reader's rate meter)
 };
 
 /// One row of the haptic log (the format replay reads): time, device position and velocity, buttons, force.

@@ -1,0 +1,26 @@
+#pragma once
+/// @file Colours of the viewer: displacement magnitude on a perceptually uniform scale (viridis), the
+/// marks (held, grabbed) and the level-of-detail bands (seed Fig. 6).
+#include <array>
+#include <cstdint>
+
+namespace pointhaptics::viewer {
+
+using Rgb = std::array<float, 3>;  ///< components in [0, 1]
+
+/// Viridis at s in [0, 1] (clamped; NaN gives the low end).
+Rgb viridis(double s);
+
+inline constexpr Rgb held_colour{0.85f, 0.12f, 0.10f};     ///< fixed points: red
+inline constexpr Rgb grabbed_colour{0.15f, 0.85f, 0.25f};  ///< grabbed by the probe: green
+inline constexpr Rgb probe_colour{0.95f, 0.75f, 0.20f};    ///< the probe: amber
+inline constexpr Rgb unselected_colour{0.62f, 0.64f, 0.68f};  ///< not simulated (levels of detail)
+
+/// A level-of-detail band (0: T_r1, 1: T_r2, 1 + i: level i), darkest near the contact; -1: not
+/// simulated.
+Rgb band_colour(int band);
+
+/// Pack into the 0xAABBGGRR order of ImGui's IM_COL32.
+std::uint32_t pack_rgba(const Rgb& c, float alpha = 1.0f);
+
+}  // namespace pointhaptics::viewer

@@ -1,0 +1,132 @@
+#include "scene_view.hpp"
+
+#include <pointhaptics/core/error.hpp>
+
+#include <fmt/format.h>
+#include <imgui.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+
+namespace pointhaptics::viewer {
+
+Viewport scene_viewport(double width, double height, bool panels) {
+  if (!panels) return {0, 0, std::max(width, 1.0), std::max(height, 1.0)};
+  return {panel_width, 0, std::max(width - panel_width, 1.0), std::max(height, 1.0)};
+}
+
+namespace {
+
+Sphere sphere(const Vec3& p, const Rgb& c, double radius) {
+  return {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()), c[0], c[1], c[2],
+          static_cast<float>(radius)};
+}
+
+Rgb paler(const Rgb& c) { return {0.35f * c[0] + 0.65f * 0.55f, 0.35f * c[1] + 0.65f * 0.57f, 0.35f * c[2] + 0.65f * 0.6f}; }
+
+}  // namespace
+
+void build_spheres(const Prepared& p, const DisplayFrame& f, SceneView& view) {
+  const Eigen::Index n = p.reference.cols();
+  view.spheres.clear();
+  view.spheres.reserve(static_cast<std::size_t>(n) + 2);
+  view.grabbed.assign(static_cast<std::size_t>(n), 0);
+  for (const index_t i : f.grabbed)
+    if (i >= 0 && i < n) view.grabbed[static_cast<std::size_t>(i)] = 1;
+  const bool displacement_ok = f.u.cols() == n && f.u.allFinite();
+  if (view.auto_scale && displacement_ok && n > 0) {
+    // rise at once, fall slowly, so the colours do not flicker
+    const auto largest = static_cast<float>(f.u.colwise().norm().maxCoeff());
+    view.scale_max = std::max({largest, 0.97f * view.scale_max, 1e-6f});
+  }
+  const bool bands = f.lod_band.size() == static_cast<std::size_t>(n);
+  const double radius = p.point_radius * view.point_scale;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const Vec3 u = displacement_ok ? Vec3(f.u.col(i)) : Vec3::Zero();
+    Rgb c;
+    if (p.fixed[k]) {
+      c = held_colour;
+    } else if (view.grabbed[k]) {
+      c = grabbed_colour;
+    } else if (view.colour_by == ColourBy::LOD_BAND && bands) {
+      c = band_colour(f.lod_band[k]);
+    } else {
+      c = viridis(u.norm() / view.scale_max);
+      if (bands && f.lod_band[k] < 0) c = paler(c);
+    }
+    view.spheres.push_back(sphere(p.reference.col(i) + u, c, radius));
+  }
+  const double probe_radius = p.options.probe.radius;
+  if (f.probe.allFinite()) view.spheres.push_back(sphere(f.probe, probe_colour, probe_radius));
+  if (f.device.allFinite() && f.probe.allFinite() && (f.device - f.probe).norm() > 0.3 * probe_radius)
+    view.spheres.push_back(sphere(f.device, {0.8f, 0.8f, 0.85f}, 0.25 * probe_radius));
+}
+
+void draw_overlay(const Prepared& p, const DisplayFrame& f, const SceneView& view, const Viewport& vp) {
+  ImDrawList* draw = ImGui::GetForegroundDrawList();
+  const ImU32 text = IM_COL32(230, 230, 235, 255);
+  // colour bar at the right edge of the view
+  const float x1 = static_cast<float>(vp.x + vp.width) - 24.0f, x0 = x1 - 16.0f;
+  const float y0 = static_cast<float>(vp.y) + 40.0f, y1 = static_cast<float>(vp.y + vp.height) - 40.0f;
+  if (view.colour_by == ColourBy::DISPLACEMENT && y1 > y0 + 40) {
+    constexpr int steps = 32;
+    for (int s = 0; s < steps; ++s) {
+      const float a = y1 - (y1 - y0) * static_cast<float>(s) / steps, b = y1 - (y1 - y0) * static_cast<float>(s + 1) / steps;
+      draw->AddRectFilled(ImVec2(x0, b), ImVec2(x1, a), pack_rgba(viridis((s + 0.5) / steps)));
+    }
+    draw->AddRect(ImVec2(x0, y0), ImVec2(x1, y1), IM_COL32(200, 200, 205, 255));
+    const std::string top = fmt::format("{:.3g} mm", 1e3 * view.scale_max);
+    const float w = ImGui::CalcTextSize(top.c_str()).x;
+    draw->AddText(ImVec2(x1 - w, y0 - 20), text, top.c_str());
+    draw->AddText(ImVec2(x1 - ImGui::CalcTextSize("0").x, y1 + 4), text, "0");
+    draw->AddText(ImVec2(x0 - 4 - ImGui::CalcTextSize("|u|").x, 0.5f * (y0 + y1)), text, "|u|");
+  } else if (view.colour_by == ColourBy::LOD_BAND && y1 > y0 + 40) {
+    const char* names[] = {"T_r1", "T_r2", "level 1", "level 2", "level 3", "level 4+", "not simulated"};
+    for (int b = 0; b < 7; ++b) {
+      const float y = y0 + 22.0f * static_cast<float>(b);
+      const Rgb c = band_colour(b < 6 ? b : -1);
+      draw->AddRectFilled(ImVec2(x1 - 14, y), ImVec2(x1, y + 14), pack_rgba(c));
+      draw->AddText(ImVec2(x1 - 20 - ImGui::CalcTextSize(names[b]).x, y), text, names[b]);
+    }
+  }
+  const std::string caption = fmt::format("t = {:.2f} s   |F| = {:.2f} N   {} contacts   {} of {} points simulated", f.time,
+                                          f.force.norm(), f.contacts, f.simulated, p.reference.cols());
+  draw->AddText(ImVec2(static_cast<float>(vp.x) + 12, static_cast<float>(vp.y) + 10), text, caption.c_str());
+}
+
+void write_frame_info(const std::string& path, const Prepared& p, const DisplayFrame& f, const SceneView& view,
+                      const Viewport& vp, int fb_width, int fb_height, double haptic_rate_hz) {
+  using nlohmann::json;
+  const auto vec = [](const Vec3& v) { return json::array({v.x(), v.y(), v.z()}); };
+  const OrbitCamera& c = view.camera;
+  json j;
+  j["image"] = {{"width", fb_width}, {"height", fb_height}};
+  j["viewport"] = {vp.x, vp.y, vp.width, vp.height};
+  j["camera"] = {{"eye", vec(c.eye())}, {"target", vec(c.target)}, {"up", vec(c.up())}, {"fov_y", c.fov_y},
+                 {"near", c.near_plane()}, {"far", c.far_plane()}};
+  j["probe"] = {{"position", f.probe.allFinite() ? vec(f.probe) : json(nullptr)}, {"radius", p.options.probe.radius},
+                {"colour", {probe_colour[0], probe_colour[1], probe_colour[2]}}};
+  j["points"] = p.reference.cols();
+  j["point_radius"] = p.point_radius * view.point_scale;
+  const Points x = p.reference + (f.u.cols() == p.reference.cols() ? f.u : Points::Zero(3, p.reference.cols()));
+  j["object"] = {{"min", vec(x.rowwise().minCoeff())}, {"max", vec(x.rowwise().maxCoeff())}};
+  json samples = json::array();  // a few deformed points, for tests to project
+  const Eigen::Index stride = std::max<Eigen::Index>(1, x.cols() / 300);
+  for (Eigen::Index i = 0; i < x.cols(); i += stride) samples.push_back(vec(x.col(i)));
+  j["sample_points"] = std::move(samples);
+  j["displacement_max"] = f.u.cols() ? f.u.colwise().norm().maxCoeff() : 0.0;
+  j["colour_scale_max"] = view.scale_max;
+  j["time"] = f.time;
+  j["steps"] = f.step;
+  j["contacts"] = f.contacts;
+  j["force"] = vec(f.force);
+  j["haptic_rate_hz"] = haptic_rate_hz;
+  std::ofstream out(path);
+  if (!out) throw Error(fmt::format("{}: cannot write the frame info", path));
+  out << j.dump(2) << '\n';
+}
+
+}  // namespace pointhaptics::viewer

@@ -1,0 +1,159 @@
+#include "viewer_session.hpp"
+
+#include <pointhaptics/haptics/devices/openhaptics_device.hpp>
+#include <pointhaptics/scene_builder.hpp>
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <limits>
+
+namespace pointhaptics::viewer {
+
+ProbeSource probe_source_of(const std::string& name) {
+  if (name == "auto") return ProbeSource::AUTO;
+  if (name == "mouse") return ProbeSource::MOUSE;
+  if (name == "script") return ProbeSource::SCRIPT;
+  if (name == "device") return ProbeSource::DEVICE;
+  throw Error(fmt::format("--probe {}: expected auto, mouse, script or device", name));
+}
+
+namespace {
+
+std::unique_ptr<Device> make_device(const Scene& scene, ProbeSource source, const DeviceSpecs& mouse_specs,
+                                    MouseDevice*& mouse, std::string& name) {
+  if (source == ProbeSource::SCRIPT) {
+    if (scene.probe.keyframes.empty() && scene.probe.trajectory.empty() && scene.device.kind != "replay")
+      throw Error(fmt::format("{}: --probe script needs [probe] keyframes or a trajectory, or a replay device", scene.path));
+    name = scene.device.kind == "replay" ? "replay of " + scene.device.log : "scripted hand";
+    return make_scene_device(scene);
+  }
+  if (source == ProbeSource::AUTO || source == ProbeSource::DEVICE) {
+    try {
+      auto device = std::make_unique<OpenHapticsDevice>(scene.device.library);
+      name = "OpenHaptics device";
+      return device;
+    } catch (const Error& e) {
+      if (source == ProbeSource::DEVICE) throw;
+    }
+  }
+  auto device = std::make_unique<MouseDevice>(mouse_specs);
+  mouse = device.get();
+  name = "mouse";
+  return device;
+}
+
+}  // namespace
+
+std::unique_ptr<Prepared> prepare(const Scene& scene_in, ProbeSource source, int threads) {
+  auto p = std::make_unique<Prepared>();
+  p->scene = scene_in;
+  Scene& scene = p->scene;
+  if (scene.solver.kind == SolverKind::STATIC) {
+    // a probe needs dynamics: the static scene is shown under implicit dynamics, which settles to the same
+    // equilibrium
+    scene.solver.kind = SolverKind::IMPLICIT;
+    scene.solver.dt = 2e-3;
+    p->note = "static solver shown with implicit dynamics (dt = 2 ms)";
+  }
+  Model model = build_scene_model(scene);
+  p->reference = model.X;
+  p->fixed = model.fixed;
+  p->point_radius = 0.5 * model.spacing;
+  p->lo = model.X.rowwise().minCoeff();
+  p->hi = model.X.rowwise().maxCoeff();
+  p->simulation = std::make_unique<Simulation>(std::move(model), scene.solver, threads);
+  if (scene.lod.present) p->simulation->enable_lod(scene.lod.params, scene_lod_contact(scene, p->simulation->full_model()));
+  p->options = scene_interactive_options(scene, p->simulation->full_model());
+  // the mouse pushes, and grabs while its button is held; a scene's grab mode grabs only
+  if (!scene.probe.grab) p->options.probe.mode = ProbeMode::PUSH_GRAB;
+  p->options.duration = std::numeric_limits<double>::infinity();
+  p->options.log = false;
+  p->options.real_time = true;
+  // the mouse moves a hand anywhere in the scene: the workspace is the scene's
+  DeviceSpecs mouse_specs = known_device_specs(scene.device.specs == "custom" ? "touch" : scene.device.specs);
+  mouse_specs.name = "mouse";
+  p->device = make_device(scene, source, mouse_specs, p->mouse, p->device_name);
+  DisplayFrame initial;
+  initial.u = Points::Zero(3, p->reference.cols());
+  initial.probe = p->options.mapping.origin;
+  initial.device = p->options.mapping.origin;
+  initial.simulated = p->simulation->model().n_points;
+  p->display = std::make_unique<TripleBuffer<DisplayFrame>>(initial);
+  return p;
+}
+
+DisplayFrame simulate_frame(Prepared& p, double time) {
+  DisplayFrame frame = p.display->front();
+  if (!(time > 0)) return frame;
+  InteractiveOptions o = p.options;
+  o.real_time = false;
+  o.duration = time;
+  o.display = p.display.get();
+  run_interactive(*p.simulation, *p.device, o);
+  p.display->update();
+  return p.display->front();
+}
+
+ViewerSession::ViewerSession(std::unique_ptr<Prepared> prepared, ProbeSource source, int threads)
+    : prepared_(std::move(prepared)), source_(source), threads_(threads) {}
+
+ViewerSession::~ViewerSession() {
+  stop();
+  if (pending_.valid()) pending_.wait();
+}
+
+void ViewerSession::start() {
+  stop();
+  stop_.store(false);
+  finished_.store(false);
+  run_error_.clear();
+  thread_ = std::thread([this] {
+    try {
+      InteractiveOptions o = prepared_->options;
+      o.display = prepared_->display.get();
+      o.stop = &stop_;
+      const InteractiveResult r = run_interactive(*prepared_->simulation, *prepared_->device, o);
+      if (r.haptic.device_failed) run_error_ = "the device failed: " + r.haptic.device_error;
+    } catch (const std::exception& e) {
+      run_error_ = e.what();
+    }
+    finished_.store(true, std::memory_order_release);
+  });
+}
+
+void ViewerSession::stop() {
+  stop_.store(true, std::memory_order_release);
+  if (thread_.joinable()) thread_.join();
+  if (!run_error_.empty()) error_ = run_error_;
+}
+
+void ViewerSession::rebuild(const Scene& scene) {
+  if (pending_.valid()) return;  // one at a time; the panel shows that one is in flight
+  pending_ = std::async(std::launch::async, [scene, source = source_, threads = threads_] { return prepare(scene, source, threads); });
+}
+
+bool ViewerSession::poll() {
+  prepared_->display->update();
+  if (finished_.load(std::memory_order_acquire) && thread_.joinable()) stop();  // collect the error
+  if (!pending_.valid() || pending_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return false;
+  std::unique_ptr<Prepared> next;
+  try {
+    next = pending_.get();
+  } catch (const std::exception& e) {
+    error_ = e.what();
+    return false;
+  }
+  stop();
+  prepared_ = std::move(next);
+  error_.clear();
+  start();
+  return true;
+}
+
+Vec3 ViewerSession::device_of_scene(const Vec3& scene) const {
+  const WorkspaceMapping& m = prepared_->options.mapping;
+  return (scene - m.origin) / m.scale;
+}
+
+}  // namespace pointhaptics::viewer

@@ -1,0 +1,78 @@
+#pragma once
+/// @file What the viewer shows and drives: a scene's simulation stepping on its own thread in real time
+/// with the 1 kHz haptic loop on another, a probe driven by the mouse (or a real device, or the scene's
+/// script), and rebuilds from edited parameters on a worker thread while the old run goes on.
+#include <pointhaptics/haptics/devices/mouse_device.hpp>
+#include <pointhaptics/interactive.hpp>
+
+#include <atomic>
+#include <future>
+#include <memory>
+#include <string>
+#include <thread>
+
+namespace pointhaptics::viewer {
+
+/// What drives the probe. AUTO: a haptic device if one answers (OpenHaptics), else the mouse.
+enum class ProbeSource { AUTO, MOUSE, SCRIPT, DEVICE };
+/// Parses "auto", "mouse", "script", "device"; throws Error naming the value otherwise.
+ProbeSource probe_source_of(const std::string& name);
+
+/// Everything of one build: the simulation, its device, and what the viewer keeps of the object
+/// (read-only on the viewer's thread while the simulation runs).
+struct Prepared {
+  Scene scene;
+  std::unique_ptr<Simulation> simulation;
+  std::unique_ptr<Device> device;
+  MouseDevice* mouse = nullptr;  ///< the device, when the mouse drives it
+  std::string device_name;       ///< what drives the probe, for the panel
+  InteractiveOptions options;
+  Points reference;              ///< the object's points, m
+  std::vector<unsigned char> fixed;
+  double point_radius = 0;       ///< spheres drawn for points, m
+  Vec3 lo, hi;                   ///< bounding box of the reference configuration
+  std::string note;              ///< what was changed to run the scene here (a static solver), else empty
+  std::unique_ptr<TripleBuffer<DisplayFrame>> display;
+};
+
+/// Build a scene for viewing; throws Error for a scene that cannot be built.
+std::unique_ptr<Prepared> prepare(const Scene& scene, ProbeSource source, int threads);
+
+/// The display frame after `time` s of the scene, simulated deterministically (no threads, no wall
+/// clock) with the scene's scripted probe if it has one, else with the probe resting at its origin.
+DisplayFrame simulate_frame(Prepared& prepared, double time);
+
+class ViewerSession {
+ public:
+  ViewerSession(std::unique_ptr<Prepared> prepared, ProbeSource source, int threads);
+  ~ViewerSession();  ///< stops the run
+
+  /// Start the real-time run on a thread (the haptic loop starts its own).
+  void start();
+  void stop();
+  /// Build `scene` on a worker thread; poll() swaps it in and restarts when it is ready.
+  void rebuild(const Scene& scene);
+  /// Viewer thread, once a frame: true if a rebuild took over (a new object: new point count).
+  bool poll();
+  bool rebuilding() const { return pending_.valid(); }
+
+  Prepared& current() { return *prepared_; }
+  /// The latest frame the simulation published (updated by poll()).
+  const DisplayFrame& frame() const { return prepared_->display->front(); }
+  /// The run or the last rebuild failed: the message (the old run goes on after a failed rebuild).
+  const std::string& error() const { return error_; }
+  bool running() const { return thread_.joinable() && !finished_.load(std::memory_order_acquire); }
+  /// Device frame of a scene point (the inverse of the workspace mapping), for the mouse.
+  Vec3 device_of_scene(const Vec3& scene) const;
+
+ private:
+  std::unique_ptr<Prepared> prepared_;
+  ProbeSource source_;
+  int threads_;
+  std::thread thread_;
+  std::atomic<bool> stop_{false}, finished_{false};
+  std::future<std::unique_ptr<Prepared>> pending_;
+  std::string error_, run_error_;
+};
+
+}  // namespace pointhaptics::viewer
