@@ -9,6 +9,8 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
+#include <limits>
 #include <thread>
 
 namespace pointhaptics {
@@ -132,6 +134,51 @@ TEST(Interactive, GrabPullsThePointUpAndLetsItGo) {
   o.duration = 2.5;      // released at 2 s: it springs back
   run_interactive(sim, device, o);
   EXPECT_LT(sim.state().u.cwiseAbs().maxCoeff(), 1e-3);
+}
+
+TEST(Interactive, DisplayFramesCarryTheForceTheGrabbedPointsAndTheHapticTicks) {
+  Simulation sim = seed_beam();
+  VirtualDevice device(Trajectory({{0.0, Vec3(0, -0.02, 0), false},
+                                   {0.1, Vec3(0, -0.02, 0), true},
+                                   {0.5, Vec3(0, 0.01, 0), true}}),
+                       known_device_specs("touch"));
+  InteractiveOptions o = options(0.5, ProbeMode::PUSH_GRAB);
+  DisplayFrame blank;
+  blank.u = Points::Zero(3, sim.model().n_points);
+  TripleBuffer<DisplayFrame> display(blank);
+  o.display = &display;
+  run_interactive(sim, device, o);
+  ASSERT_TRUE(display.update());
+  const DisplayFrame& f = display.front();
+  EXPECT_NEAR(f.time, 0.5, 1e-9);
+  EXPECT_EQ(f.haptic_ticks, 500);
+  EXPECT_FALSE(f.grabbed.empty());
+  EXPECT_EQ(f.contacts, static_cast<int>(f.grabbed.size()));
+  for (const index_t i : f.grabbed) EXPECT_GT(f.u(1, i), 1e-3);  // pulled up
+  EXPECT_GT(f.force.norm(), 0.0);
+  EXPECT_TRUE(f.device.allFinite());
+  EXPECT_EQ(f.simulated, sim.model().n_points);
+  EXPECT_TRUE(f.lod_band.empty());
+}
+
+TEST(Interactive, AStopFlagEndsAnEndlessRealTimeRun) {
+  Simulation sim = seed_beam();
+  VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), false}}), known_device_specs("touch"));
+  InteractiveOptions o = options(std::numeric_limits<double>::infinity());
+  o.real_time = true;
+  o.log = false;
+  std::atomic<bool> stop{false};
+  o.stop = &stop;
+  std::thread stopper([&stop] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    stop = true;
+  });
+  const InteractiveResult r = run_interactive(sim, device, o);
+  stopper.join();
+  EXPECT_GT(r.simulation_steps, 0);
+  EXPECT_LT(r.simulation_wall_s, 30.0);  // ended by the flag, not by a duration
+  o.log = true;  // a log of an endless run cannot be reserved
+  EXPECT_THROW(run_interactive(sim, device, o), Error);
 }
 
 class FailingDevice : public VirtualDevice {

@@ -24,6 +24,8 @@ Sphere sphere(const Vec3& p, const Rgb& c, double radius) {
           static_cast<float>(radius)};
 }
 
+Rgb probe_colour_of(const SceneView& view) { return view.colour_by == ColourBy::LOD_BAND ? probe_colour_on_bands : probe_colour; }
+
 Rgb paler(const Rgb& c) { return {0.35f * c[0] + 0.65f * 0.55f, 0.35f * c[1] + 0.65f * 0.57f, 0.35f * c[2] + 0.65f * 0.6f}; }
 
 }  // namespace
@@ -60,7 +62,7 @@ void build_spheres(const Prepared& p, const DisplayFrame& f, SceneView& view) {
     view.spheres.push_back(sphere(p.reference.col(i) + u, c, radius));
   }
   const double probe_radius = p.options.probe.radius;
-  if (f.probe.allFinite()) view.spheres.push_back(sphere(f.probe, probe_colour, probe_radius));
+  if (f.probe.allFinite()) view.spheres.push_back(sphere(f.probe, probe_colour_of(view), probe_radius));
   if (f.device.allFinite() && f.probe.allFinite() && (f.device - f.probe).norm() > 0.3 * probe_radius)
     view.spheres.push_back(sphere(f.device, {0.8f, 0.8f, 0.85f}, 0.25 * probe_radius));
 }
@@ -108,7 +110,7 @@ void write_frame_info(const std::string& path, const Prepared& p, const DisplayF
   j["camera"] = {{"eye", vec(c.eye())}, {"target", vec(c.target)}, {"up", vec(c.up())}, {"fov_y", c.fov_y},
                  {"near", c.near_plane()}, {"far", c.far_plane()}};
   j["probe"] = {{"position", f.probe.allFinite() ? vec(f.probe) : json(nullptr)}, {"radius", p.options.probe.radius},
-                {"colour", {probe_colour[0], probe_colour[1], probe_colour[2]}}};
+                {"colour", probe_colour_of(view)}};
   j["points"] = p.reference.cols();
   j["point_radius"] = p.point_radius * view.point_scale;
   const Points x = p.reference + (f.u.cols() == p.reference.cols() ? f.u : Points::Zero(3, p.reference.cols()));

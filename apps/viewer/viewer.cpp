@@ -99,6 +99,7 @@ int render_screenshot(const ViewerOptions& o) {
   if (!ImGui_ImplOpenGL3_Init("#version 330")) throw Error("viewer: Dear ImGui's OpenGL 3 renderer did not start");
   PointRenderer renderer;
   SceneView view;
+  view.colour_by = o.colour == "band" ? ColourBy::LOD_BAND : ColourBy::DISPLACEMENT;
   view.camera.frame(prepared->lo, prepared->hi);
   build_spheres(*prepared, frame, view);
   const Viewport vp = scene_viewport(o.width, o.height, o.panels);
@@ -141,6 +142,7 @@ int run_window(const ViewerOptions& o) {
 
   PointRenderer renderer;
   SceneView view;
+  view.colour_by = o.colour == "band" ? ColourBy::LOD_BAND : ColourBy::DISPLACEMENT;
   view.camera.frame(session.current().lo, session.current().hi);
   PanelState state{session.current().scene, false, {}};
   LiveStats live;

@@ -14,6 +14,7 @@ struct ViewerOptions {
   std::string probe = "auto";   ///< auto | mouse | script | device
   int threads = 0;
   bool panels = true;           ///< draw the panels (left column)
+  std::string colour = "displacement";  ///< displacement | band (levels of detail, seed Fig. 6)
 };
 
 /// The default scene file: scenes/beam_probe.toml from the source tree, else the installed copy.

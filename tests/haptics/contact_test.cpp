@@ -80,6 +80,41 @@ TEST(ProbeContact, GrabbedPointsFollowTheProbeWhileTheButtonIsHeld) {
   EXPECT_EQ(f.norm(), 0.0);
 }
 
+TEST(ProbeContact, PushGrabPushesWithTheButtonUpAndGrabsWhileItIsHeld) {
+  const Model model = block();
+  ProbeParams p;
+  p.radius = 0.008;
+  p.mode = ProbeMode::PUSH_GRAB;
+  ProbeContact contact(model, p);
+  const Points u = Points::Zero(3, model.n_points);
+  Points f = Points::Zero(3, model.n_points);
+  const Vec3 probe(0.025, 0.03 + 0.008, 0.025);
+  const ContactModel pushed = contact.apply(model, u, probe, false, 0.0, f);
+  ASSERT_GT(pushed.contacts, 0);
+  EXPECT_FALSE(pushed.grabbing);
+  EXPECT_GT(pushed.f0.y(), 0.0);  // pushed: the object pushes back up
+  EXPECT_FALSE(contact.touched().empty());
+  f.setZero();
+  const ContactModel press = contact.apply(model, u, probe, true, 0.001, f);
+  ASSERT_GT(press.contacts, 0);
+  EXPECT_TRUE(press.grabbing);
+  EXPECT_TRUE(contact.touched().empty());
+  EXPECT_LE(f.norm(), 1e-15);  // relaxed at the press
+  f.setZero();
+  const ContactModel lifted = contact.apply(model, u, probe + Vec3(0, 0.003, 0), true, 0.002, f);
+  EXPECT_EQ(lifted.contacts, press.contacts);
+  EXPECT_LT(lifted.f0.y(), 0.0);  // the grabbed points pull the probe back down
+  Eigen::Matrix<double, 9, Eigen::Dynamic> springs = Eigen::Matrix<double, 9, Eigen::Dynamic>::Zero(9, model.n_points);
+  contact.add_stiffness(springs);
+  EXPECT_NEAR(springs.col(contact.grabbed().front())(0), p.stiffness > 0 ? p.stiffness : model.material.young * s, 1e-9);
+  // released above the surface: neither grabbed nor touched
+  f.setZero();
+  const ContactModel released = contact.apply(model, u, probe + Vec3(0, 0.003, 0), false, 0.003, f);
+  EXPECT_EQ(released.contacts, 0);
+  EXPECT_TRUE(contact.grabbed().empty());
+  EXPECT_EQ(f.norm(), 0.0);
+}
+
 TEST(ProbeContact, NonFiniteProbeMeansNoContact) {
   const Model model = block();
   ProbeContact contact(model, ProbeParams{});
