@@ -1,0 +1,126 @@
+// Tests for the viewer's session: a scene prepared for viewing (the probe source, a static scene shown with
+// dynamics), the deterministic frame of headless screenshots, the real-time run the mouse drives, and
+// rebuilds from edited parameters (taken over while running; a bad one reported, the old run going on).
+#include "viewer_session.hpp"
+
+#include <pointhaptics/io/scene_toml.hpp>
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <thread>
+
+namespace pointhaptics::viewer {
+namespace {
+
+const char* beam = R"(
+[object]
+shape = "box"
+size = [0.135, 0.03, 0.03]
+spacing = 0.015
+[material]
+young = 1e4
+poisson = 0.4
+density = 1000.0
+damping = 5.0
+[[fixed]]
+box = { min = [-1.0, -1.0, -1.0], max = [0.0, 1.0, 1.0] }
+[[fixed]]
+box = { min = [0.135, -1.0, -1.0], max = [1.0, 1.0, 1.0] }
+[solver]
+kind = "explicit"
+dt = 1e-3
+[probe]
+radius = 0.01
+keyframes = [[0.0, 0.0, 0.0, 0.0], [1.0, 0.0, -0.04, 0.0]]
+)";
+
+// wait (at most 20 s) until `done` holds, polling the session as the viewer's frame loop does
+template <class Done>
+bool poll_until(ViewerSession& session, Done done) {
+  for (int k = 0; k < 2000; ++k) {
+    const bool took_over = session.poll();
+    if (done(took_over)) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return false;
+}
+
+TEST(ViewerSession, ProbeSourcesAreNamedAndScriptsAreNeeded) {
+  EXPECT_EQ(probe_source_of("mouse"), ProbeSource::MOUSE);
+  EXPECT_THROW(probe_source_of("joystick"), Error);
+  Scene scene = parse_scene(beam);
+  auto mouse = prepare(scene, ProbeSource::MOUSE, 1);
+  ASSERT_NE(mouse->mouse, nullptr);
+  EXPECT_EQ(mouse->device_name, "mouse");
+  EXPECT_EQ(mouse->options.probe.mode, ProbeMode::PUSH_GRAB);  // push, and the button grabs
+  EXPECT_EQ(mouse->reference.cols(), 90);
+  EXPECT_NEAR(mouse->point_radius, 0.0075, 1e-12);
+  // no device library here: auto falls back to the mouse
+  scene.device.library = "libHD_missing.so";
+  EXPECT_EQ(prepare(scene, ProbeSource::AUTO, 1)->device_name, "mouse");
+  EXPECT_THROW(prepare(scene, ProbeSource::DEVICE, 1), Error);
+  scene.probe.keyframes.clear();
+  EXPECT_THROW(prepare(scene, ProbeSource::SCRIPT, 1), Error);
+  // a static scene is shown with implicit dynamics, and says so
+  Scene still = parse_scene(beam);
+  still.solver.kind = SolverKind::STATIC;
+  auto shown = prepare(still, ProbeSource::MOUSE, 1);
+  EXPECT_EQ(shown->scene.solver.kind, SolverKind::IMPLICIT);
+  EXPECT_FALSE(shown->note.empty());
+}
+
+TEST(ViewerSession, HeadlessFramesAreDeterministicAndFollowTheScript) {
+  const Scene scene = parse_scene(beam);
+  auto a = prepare(scene, ProbeSource::SCRIPT, 1);
+  auto b = prepare(scene, ProbeSource::SCRIPT, 1);
+  const DisplayFrame start = simulate_frame(*a, 0.0);
+  EXPECT_EQ(start.u.norm(), 0.0);
+  EXPECT_TRUE(start.probe.isApprox(a->options.mapping.origin));
+  const DisplayFrame fa = simulate_frame(*a, 0.8), fb = simulate_frame(*b, 0.8);
+  EXPECT_NEAR(fa.time, 0.8, 1e-9);
+  EXPECT_EQ(fa.u, fb.u);  // bit for bit
+  EXPECT_GT(fa.contacts, 0);
+  EXPECT_LT(fa.probe.y(), start.probe.y() - 0.01);  // the scripted hand brought it down
+  EXPECT_LT(fa.u.row(1).minCoeff(), -1e-3);         // and pressed the beam
+}
+
+TEST(ViewerSession, TheMouseDrivesARealTimeRunAndEditsRebuildIt) {
+  const Scene scene = parse_scene(beam);
+  ViewerSession session(prepare(scene, ProbeSource::MOUSE, 1), ProbeSource::MOUSE, 1);
+  session.start();
+  EXPECT_TRUE(session.running());
+  // the hand aims 2.5 cm below the probe's origin: into the beam's top face
+  const Vec3 target = session.current().options.mapping.origin + Vec3(0, -0.025, 0);
+  session.current().mouse->set_target(session.device_of_scene(target), 0u);
+  EXPECT_TRUE(poll_until(session, [&](bool) { return session.frame().contacts > 0 && session.frame().time > 0.3; }));
+  EXPECT_LT(session.frame().u.row(1).minCoeff(), -1e-3);
+  EXPECT_GT(session.frame().haptic_ticks, 0);
+
+  // an edit: stiffer, and the explicit solver swapped for the implicit one; the run goes on meanwhile
+  Scene stiffer = session.current().scene;
+  stiffer.material.young = 1e5;
+  stiffer.solver.kind = SolverKind::IMPLICIT;
+  session.rebuild(stiffer);
+  EXPECT_TRUE(poll_until(session, [](bool took_over) { return took_over; }));
+  EXPECT_DOUBLE_EQ(session.current().scene.material.young, 1e5);
+  EXPECT_EQ(session.current().simulation->solver().kind, SolverKind::IMPLICIT);
+  EXPECT_TRUE(session.running());
+  EXPECT_TRUE(session.error().empty());
+  session.current().mouse->set_target(Vec3::Zero(), 0u);
+  EXPECT_TRUE(poll_until(session, [&](bool) { return session.frame().time > 0.2; }));
+
+  // a bad edit is reported and the current run goes on
+  Scene bad = session.current().scene;
+  bad.object.spacing = -1;
+  session.rebuild(bad);
+  EXPECT_TRUE(poll_until(session, [&](bool) { return !session.error().empty(); }));
+  EXPECT_FALSE(session.rebuilding());
+  EXPECT_TRUE(session.running());
+  EXPECT_DOUBLE_EQ(session.current().scene.material.young, 1e5);
+  session.stop();
+  EXPECT_FALSE(session.running());
+}
+
+}  // namespace
+}  // namespace pointhaptics::viewer
