@@ -183,6 +183,8 @@ int main(int argc, char** argv) {
   view_cmd->add_option("--colour", view.colour, "Colour points by displacement or by level-of-detail band (seed Fig. 6)")
       ->check(CLI::IsMember({"displacement", "band"}));
   view_cmd->add_flag("--no-panels", [&view](std::int64_t) { view.panels = false; }, "Only the 3-D view");
+  view_cmd->add_option("--frames", view.frames, "Headless: draw this many frames and report the time per frame")
+      ->check(CLI::Range(1, 100000));
   view_cmd->add_option("--threads", view.threads, "Threads for the force evaluation (0: all)")->check(CLI::NonNegativeNumber);
 #endif
 

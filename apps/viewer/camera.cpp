@@ -9,7 +9,7 @@ namespace pointhaptics::viewer {
 void OrbitCamera::frame(const Vec3& lo, const Vec3& hi) {
   target = 0.5 * (lo + hi);
   const double radius = std::max(0.5 * (hi - lo).norm(), 1e-6);
-  distance = 1.15 * radius / std::sin(0.5 * fov_y);
+  distance = 1.05 * radius / std::sin(0.5 * fov_y);
 }
 
 Vec3 OrbitCamera::forward() const {

@@ -101,17 +101,27 @@ int render_screenshot(const ViewerOptions& o) {
   SceneView view;
   view.colour_by = o.colour == "band" ? ColourBy::LOD_BAND : ColourBy::DISPLACEMENT;
   view.camera.frame(prepared->lo, prepared->hi);
-  build_spheres(*prepared, frame, view);
   const Viewport vp = scene_viewport(o.width, o.height, o.panels);
   PanelState state{prepared->scene, false, {}};
   LiveStats live;
-  begin_headless_imgui_frame(o.width, o.height);
-  if (o.panels) draw_panels(nullptr, *prepared, frame, view, state, live, o.width, o.height);
-  draw_overlay(*prepared, frame, view, vp);
-  ImGui::Render();
-  renderer.draw(view.spheres, view.camera, vp, o.width, o.height);
-  ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-  glFinish();
+  // a frame as the window makes it: spheres from the frame, panels, drawing; the last one is kept
+  const auto start = std::chrono::steady_clock::now();
+  for (int k = 0; k < std::max(o.frames, 1); ++k) {
+    if (k > 0) view.camera.yaw += 0.01;
+    build_spheres(*prepared, frame, view);
+    begin_headless_imgui_frame(o.width, o.height);
+    if (o.panels) draw_panels(nullptr, *prepared, frame, view, state, live, o.width, o.height);
+    draw_overlay(*prepared, frame, view, vp);
+    ImGui::Render();
+    renderer.draw(view.spheres, view.camera, vp, o.width, o.height);
+    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+    glFinish();
+  }
+  if (o.frames > 1) {
+    const double ms = 1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() / o.frames;
+    fmt::print("{} frames of {} points at {} x {}: {:.2f} ms per frame ({:.0f} frames/s)\n", o.frames,
+               prepared->reference.cols(), o.width, o.height, ms, 1e3 / ms);
+  }
   write_png(o.screenshot, o.width, o.height, read_pixels(o.width, o.height));
   if (!o.info.empty()) write_frame_info(o.info, *prepared, frame, view, vp, o.width, o.height, 0.0);
   ImGui_ImplOpenGL3_Shutdown();

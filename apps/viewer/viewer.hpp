@@ -13,6 +13,7 @@ struct ViewerOptions {
   int width = 1280, height = 800;
   std::string probe = "auto";   ///< auto | mouse | script | device
   int threads = 0;
+  int frames = 1;               ///< headless: draw this many frames (the camera turning) and report the time per frame
   bool panels = true;           ///< draw the panels (left column)
   std::string colour = "displacement";  ///< displacement | band (levels of detail, seed Fig. 6)
 };
