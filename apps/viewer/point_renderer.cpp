@@ -54,17 +54,23 @@ void main() {
 }
 )";
 
+// The status of a shader or program step, and its log when it failed (glGetShaderiv and glGetShaderInfoLog,
+// or their program versions).
+template <class GetStatus, class GetLog>
+void check(unsigned object, unsigned what, GetStatus get_status, GetLog get_log, const char* step) {
+  GLint ok = 0;
+  get_status(object, what, &ok);
+  if (ok) return;
+  char log[2048] = {};
+  get_log(object, static_cast<GLsizei>(sizeof log), nullptr, log);
+  throw Error(fmt::format("viewer: the shaders failed to {}: {}", step, log));
+}
+
 unsigned compile(unsigned kind, const char* source) {
   const unsigned shader = glCreateShader(kind);
   glShaderSource(shader, 1, &source, nullptr);
   glCompileShader(shader);
-  GLint ok = 0;
-  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-  if (!ok) {
-    char log[2048] = {};
-    glGetShaderInfoLog(shader, sizeof log, nullptr, log);
-    throw Error(fmt::format("viewer: a shader failed to compile: {}", log));
-  }
+  check(shader, GL_COMPILE_STATUS, glGetShaderiv, glGetShaderInfoLog, "compile");
   return shader;
 }
 
@@ -78,13 +84,7 @@ PointRenderer::PointRenderer() {
   glLinkProgram(program_);
   glDeleteShader(vs);
   glDeleteShader(fs);
-  GLint ok = 0;
-  glGetProgramiv(program_, GL_LINK_STATUS, &ok);
-  if (!ok) {
-    char log[2048] = {};
-    glGetProgramInfoLog(program_, sizeof log, nullptr, log);
-    throw Error(fmt::format("viewer: the shaders failed to link: {}", log));
-  }
+  check(program_, GL_LINK_STATUS, glGetProgramiv, glGetProgramInfoLog, "link");
   view_ = glGetUniformLocation(program_, "view");
   projection_ = glGetUniformLocation(program_, "projection");
   pixels_per_unit_ = glGetUniformLocation(program_, "pixels_per_unit");

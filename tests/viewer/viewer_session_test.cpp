@@ -13,27 +13,8 @@
 namespace pointhaptics::viewer {
 namespace {
 
-const char* beam = R"(
-[object]
-shape = "box"
-size = [0.135, 0.03, 0.03]
-spacing = 0.015
-[material]
-young = 1e4
-poisson = 0.4
-density = 1000.0
-damping = 5.0
-[[fixed]]
-box = { min = [-1.0, -1.0, -1.0], max = [0.0, 1.0, 1.0] }
-[[fixed]]
-box = { min = [0.135, -1.0, -1.0], max = [1.0, 1.0, 1.0] }
-[solver]
-kind = "explicit"
-dt = 1e-3
-[probe]
-radius = 0.01
-keyframes = [[0.0, 0.0, 0.0, 0.0], [1.0, 0.0, -0.04, 0.0]]
-)";
+// the default scene: the seed's beam held at both ends, a scripted hand pressing its middle
+Scene beam_scene() { return read_scene_file(PH_SCENES_DIR "/beam_probe.toml"); }
 
 // wait (at most 20 s) until `done` holds, polling the session as the viewer's frame loop does
 template <class Done>
@@ -49,7 +30,7 @@ bool poll_until(ViewerSession& session, Done done) {
 TEST(ViewerSession, ProbeSourcesAreNamedAndScriptsAreNeeded) {
   EXPECT_EQ(probe_source_of("mouse"), ProbeSource::MOUSE);
   EXPECT_THROW(probe_source_of("joystick"), Error);
-  Scene scene = parse_scene(beam);
+  Scene scene = beam_scene();
   auto mouse = prepare(scene, ProbeSource::MOUSE, 1);
   ASSERT_NE(mouse->mouse, nullptr);
   EXPECT_EQ(mouse->device_name, "mouse");
@@ -63,7 +44,7 @@ TEST(ViewerSession, ProbeSourcesAreNamedAndScriptsAreNeeded) {
   scene.probe.keyframes.clear();
   EXPECT_THROW(prepare(scene, ProbeSource::SCRIPT, 1), Error);
   // a static scene is shown with implicit dynamics, and says so
-  Scene still = parse_scene(beam);
+  Scene still = beam_scene();
   still.solver.kind = SolverKind::STATIC;
   auto shown = prepare(still, ProbeSource::MOUSE, 1);
   EXPECT_EQ(shown->scene.solver.kind, SolverKind::IMPLICIT);
@@ -71,7 +52,7 @@ TEST(ViewerSession, ProbeSourcesAreNamedAndScriptsAreNeeded) {
 }
 
 TEST(ViewerSession, HeadlessFramesAreDeterministicAndFollowTheScript) {
-  const Scene scene = parse_scene(beam);
+  const Scene scene = beam_scene();
   auto a = prepare(scene, ProbeSource::SCRIPT, 1);
   auto b = prepare(scene, ProbeSource::SCRIPT, 1);
   const DisplayFrame start = simulate_frame(*a, 0.0);
@@ -86,7 +67,7 @@ TEST(ViewerSession, HeadlessFramesAreDeterministicAndFollowTheScript) {
 }
 
 TEST(ViewerSession, TheMouseDrivesARealTimeRunAndEditsRebuildIt) {
-  const Scene scene = parse_scene(beam);
+  const Scene scene = beam_scene();
   ViewerSession session(prepare(scene, ProbeSource::MOUSE, 1), ProbeSource::MOUSE, 1);
   session.start();
   EXPECT_TRUE(session.running());
