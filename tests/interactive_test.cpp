@@ -147,10 +147,12 @@ TEST(Interactive, DisplayFramesCarryTheForceTheGrabbedPointsAndTheHapticTicks) {
   blank.u = Points::Zero(3, sim.model().n_points);
   TripleBuffer<DisplayFrame> display(blank);
   o.display = &display;
+  o.display_period = 0.3;  // one frame at the first step, one at 0.3 s, and the last step's
   run_interactive(sim, device, o);
   ASSERT_TRUE(display.update());
   const DisplayFrame& f = display.front();
   EXPECT_NEAR(f.time, 0.5, 1e-9);
+  EXPECT_EQ(f.step, 499);
   EXPECT_EQ(f.haptic_ticks, 500);
   EXPECT_FALSE(f.grabbed.empty());
   EXPECT_EQ(f.contacts, static_cast<int>(f.grabbed.size()));

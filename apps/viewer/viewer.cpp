@@ -21,6 +21,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <thread>
 
 #ifndef PH_SCENES_SOURCE_DIR
 #define PH_SCENES_SOURCE_DIR ""
@@ -161,7 +162,7 @@ int run_window(const ViewerOptions& o) {
 
   const auto start = std::chrono::steady_clock::now();
   const auto wall = [&start] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
-  double last_frame = 0, last_x = 0, last_y = 0;
+  double last_x = 0, last_y = 0;
   int frames = 0;
   double fps_t0 = 0;
   KeyEdges keys;
@@ -253,9 +254,11 @@ int run_window(const ViewerOptions& o) {
       session.rebuild(state.edit);
     }
     if (last) break;
-    last_frame = t;
+    // at most 60 frames a second (a display's vsync does this too; Xvfb has none): the cores left over
+    // are the simulation's
+    const double spare = 1.0 / 60.0 - (wall() - t);
+    if (spare > 0) std::this_thread::sleep_for(std::chrono::duration<double>(spare));
   }
-  (void)last_frame;
   session.stop();
   if (!session.error().empty()) fmt::print(stderr, "view: {}\n", session.error());
   return 0;

@@ -70,6 +70,7 @@ std::unique_ptr<Prepared> prepare(const Scene& scene_in, ProbeSource source, int
   p->options.duration = std::numeric_limits<double>::infinity();
   p->options.log = false;
   p->options.real_time = true;
+  p->options.display_period = 1.0 / 120.0;  // twice the frame rate: fresh frames without copying every step
   // the mouse moves a hand anywhere in the scene: the workspace is the scene's
   DeviceSpecs mouse_specs = known_device_specs(scene.device.specs == "custom" ? "touch" : scene.device.specs);
   mouse_specs.name = "mouse";

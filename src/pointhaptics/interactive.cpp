@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include <chrono>
+#include <limits>
 #include <cmath>
 #include <thread>
 
@@ -97,8 +98,7 @@ void publish_display(Simulation& sim, const ContactForces& contact, const Haptic
 }
 
 // One simulation step with the latest probe; then the local model (and the display frame) is published.
-int simulation_step(Simulation& sim, ContactForces& contact, HapticLoop& loop, TripleBuffer<DisplayFrame>* display,
-                    long long step, bool real_time) {
+int simulation_step(Simulation& sim, ContactForces& contact, HapticLoop& loop, bool real_time) {
   loop.frames().update();
   const HapticFrame& frame = loop.frames().front();
   contact.device = frame.device;
@@ -119,7 +119,6 @@ int simulation_step(Simulation& sim, ContactForces& contact, HapticLoop& loop, T
                        real_time);
     if (!new_index.empty()) contact.remap(sim.model(), new_index);
   }
-  if (display) publish_display(sim, contact, frame, step, *display);
   return contact.last.contacts;
 }
 
@@ -184,6 +183,19 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
   InteractiveResult result;
   const auto start = std::chrono::steady_clock::now();
   const double t0 = sim.state().time;
+  // display frames: at most one per display_period (of wall time in real time, else of simulated time),
+  // and the last step's
+  double last_display = -std::numeric_limits<double>::infinity();
+  long long last_display_step = -1;
+  const auto display = [&](bool last) {
+    if (!options.display || result.simulation_steps == 0 || last_display_step == result.simulation_steps) return;
+    const double t = options.real_time ? std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
+                                       : sim.state().time;
+    if (!last && t - last_display < options.display_period) return;
+    last_display = t;
+    last_display_step = result.simulation_steps;
+    publish_display(sim, contact, loop.frames().front(), result.simulation_steps - 1, *options.display);
+  };
   if (options.real_time) {
     loop.start();
     for (;;) {
@@ -193,8 +205,9 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
         std::this_thread::sleep_for(std::chrono::duration<double>(sim.state().time - t0 - wall));
         continue;
       }
-      result.max_contacts = std::max(result.max_contacts, simulation_step(sim, contact, loop, options.display, result.simulation_steps, options.real_time));
+      result.max_contacts = std::max(result.max_contacts, simulation_step(sim, contact, loop, options.real_time));
       ++result.simulation_steps;
+      display(false);
     }
     loop.stop();
   } else {
@@ -206,11 +219,13 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
       if (!loop.tick(t, h)) break;
       while (sim.state().time - t0 < t - 1e-12) {
         result.max_contacts =
-            std::max(result.max_contacts, simulation_step(sim, contact, loop, options.display, result.simulation_steps, options.real_time));
+            std::max(result.max_contacts, simulation_step(sim, contact, loop, options.real_time));
         ++result.simulation_steps;
+        display(false);
       }
     }
   }
+  display(true);
   result.simulation_wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   result.haptic = loop.stats();
   result.log = loop.log();

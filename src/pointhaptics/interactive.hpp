@@ -40,6 +40,10 @@ struct InteractiveOptions {
   /// viewer thread, calls update() and reads front()). Its frames must be sized for the object's points
   /// (all of them, with levels of detail too).
   TripleBuffer<DisplayFrame>* display = nullptr;
+  /// Publish a display frame at most once per this many seconds (of wall time in real time, of simulated
+  /// time otherwise; 0: after every step), and after the last step. Each frame carries the whole object's displacements (with levels of detail, the
+  /// absorbed points followed by MLS): a viewer wants about 100 a second, not one per step.
+  double display_period = 0;
   /// If set, the run also ends (at the next step) once this becomes true: a viewer's window closed.
   const std::atomic<bool>* stop = nullptr;
 };
