@@ -41,6 +41,12 @@ TEST(ViewerSession, ProbeSourcesAreNamedAndScriptsAreNeeded) {
   scene.device.library = "libHD_missing.so";
   EXPECT_EQ(prepare(scene, ProbeSource::AUTO, 1)->device_name, "mouse");
   EXPECT_THROW(prepare(scene, ProbeSource::DEVICE, 1), Error);
+  // a device that answers (a stand-in libHD built with the tests) drives the probe instead of the mouse
+  scene.device.library = PH_FAKE_HD_PATH;
+  auto device = prepare(scene, ProbeSource::AUTO, 1);
+  EXPECT_EQ(device->device_name, "OpenHaptics device");
+  EXPECT_EQ(device->mouse, nullptr);
+  device.reset();  // releases the device
   scene.probe.keyframes.clear();
   EXPECT_THROW(prepare(scene, ProbeSource::SCRIPT, 1), Error);
   // a static scene is shown with implicit dynamics, and says so
