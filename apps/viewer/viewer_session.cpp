@@ -56,6 +56,9 @@ std::unique_ptr<Prepared> prepare(const Scene& scene_in, ProbeSource source, int
     scene.solver.dt = 2e-3;
     p->note = "static solver shown with implicit dynamics (dt = 2 ms)";
   }
+  // the viewer always has a probe (the scene's [probe] values, else the defaults): levels of detail start
+  // under it
+  scene.probe.present = true;
   Model model = build_scene_model(scene);
   p->reference = model.X;
   p->fixed = model.fixed;

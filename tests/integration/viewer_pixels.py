@@ -137,6 +137,23 @@ if mode == "headless":
     i0 = check_picture(png0, info0, expect_contact=False)
     assert i0["contacts"] == 0 and i0["displacement_max"] == 0, i0
     assert i1["probe"]["position"][1] < i0["probe"]["position"][1] - 0.005, "the scripted probe did not come down"
+    # levels of detail coloured by band (seed Fig. 6): the bands' warm colours around the probe, grey (not
+    # simulated) points over most of the object
+    lod = os.path.join(scenes, "half_sphere_lod.toml")
+    pngb, infob = os.path.join(out, "bands.png"), os.path.join(out, "bands.json")
+    run([lod, "--screenshot", pngb, "--info", infob, "--time", "0.3", "--colour", "band", *size], env=env)
+    ib = json.load(open(infob))
+    img = np.asarray(Image.open(pngb).convert("RGB")).astype(float)
+    (pc,), _, ppm = project(ib, np.array(ib["probe"]["position"], float))
+    ys, xs = np.mgrid[0:img.shape[0], 0:img.shape[1]]
+    near = (xs - pc[0]) ** 2 + (ys - pc[1]) ** 2 < (6 * ib["probe"]["radius"] * ppm[0]) ** 2
+    r, g, b = img[..., 0], img[..., 1], img[..., 2]
+    warm = (r > g + 40) & (g > b) & (r > 90)  # T_r1 .. level colours: dark red to pale orange
+    grey = (np.abs(r - g) < 12) & (np.abs(g - b) < 20) & (r > 60)
+    vx, vy, vw, vh = ib["viewport"]
+    inview = (xs >= vx + 0) & (ys >= vy + 30)
+    assert warm[near].mean() > 0.05, f"{pngb}: no band colours around the probe ({warm[near].mean():.3f})"
+    assert grey[inview].sum() > 5 * warm[inview & near].sum(), f"{pngb}: too few unsimulated (grey) points"
     # errors are named, not crashes
     r = subprocess.run([exe, "view", os.path.join(out, "missing.toml"), "--screenshot", png0], capture_output=True,
                        text=True, env=env)

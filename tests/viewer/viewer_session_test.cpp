@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <thread>
 
@@ -49,6 +50,18 @@ TEST(ViewerSession, ProbeSourcesAreNamedAndScriptsAreNeeded) {
   device.reset();  // releases the device
   scene.probe.keyframes.clear();
   EXPECT_THROW(prepare(scene, ProbeSource::SCRIPT, 1), Error);
+  // a scene without a probe gets one, and levels of detail switched on in the panel start under it
+  Scene bare = beam_scene();
+  bare.probe = ProbeSpec{};
+  bare.lod.present = true;
+  auto lod = prepare(bare, ProbeSource::MOUSE, 1);
+  ASSERT_TRUE(lod->simulation->lod_enabled());
+  EXPECT_EQ(simulate_frame(*lod, 0.0).lod_band.size(), 0u);  // nothing published before a step
+  const DisplayFrame stepped = simulate_frame(*lod, 0.05);
+  ASSERT_EQ(stepped.lod_band.size(), 90u);
+  EXPECT_LT(stepped.simulated, 90);
+  EXPECT_EQ(static_cast<index_t>(std::count_if(stepped.lod_band.begin(), stepped.lod_band.end(), [](auto b) { return b >= 0; })),
+            stepped.simulated);
   // a static scene is shown with implicit dynamics, and says so
   Scene still = beam_scene();
   still.solver.kind = SolverKind::STATIC;
