@@ -161,7 +161,12 @@ void draw_panels(const ViewerSession* session, const Prepared& p, const DisplayF
   if (ImGui::Button("revert")) state.edit = p.scene;
   if (busy) ImGui::EndDisabled();
   display_panel(view);
-  live_panel(f, live);
+  if (session) {
+    live_panel(f, live);
+  } else if (ImGui::CollapsingHeader("Live", ImGuiTreeNodeFlags_DefaultOpen)) {
+    ImGui::TextWrapped("t = %.2f s, %lld steps, |F| = %.3g N (a headless frame: the live plots run in the window)", f.time,
+                       f.step, f.force.norm());
+  }
   controls_panel();
   if (!state.screenshot_message.empty()) ImGui::TextWrapped("%s", state.screenshot_message.c_str());
   ImGui::PopItemWidth();
