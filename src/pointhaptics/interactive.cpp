@@ -8,8 +8,8 @@
 #include <fmt/format.h>
 
 #include <chrono>
-#include <limits>
 #include <cmath>
+#include <limits>
 #include <thread>
 
 namespace pointhaptics {
@@ -97,7 +97,8 @@ void publish_display(Simulation& sim, const ContactForces& contact, const Haptic
   display.publish();
 }
 
-// One simulation step with the latest probe; then the local model (and the display frame) is published.
+// One simulation step with the latest probe; then the local model is published (run_interactive publishes
+// the display frames, at most one per display_period).
 int simulation_step(Simulation& sim, ContactForces& contact, HapticLoop& loop, bool real_time) {
   loop.frames().update();
   const HapticFrame& frame = loop.frames().front();
