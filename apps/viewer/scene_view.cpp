@@ -94,6 +94,17 @@ void draw_overlay(const Prepared& p, const DisplayFrame& f, const SceneView& vie
       draw->AddText(ImVec2(x1 - 20 - ImGui::CalcTextSize(names[b]).x, y), text, names[b]);
     }
   }
+  // a drop line from the probe to the level of the object's base: where it is in depth, at a glance
+  if (f.probe.allFinite()) {
+    const Eigen::Vector2d top = view.camera.project(f.probe, vp);
+    const Eigen::Vector2d foot = view.camera.project(Vec3(f.probe.x(), p.lo.y(), f.probe.z()), vp);
+    if (top.allFinite() && foot.allFinite()) {
+      const ImU32 line = IM_COL32(230, 230, 235, 90);
+      draw->AddLine(ImVec2(static_cast<float>(top.x()), static_cast<float>(top.y())),
+                    ImVec2(static_cast<float>(foot.x()), static_cast<float>(foot.y())), line, 1.0f);
+      draw->AddCircle(ImVec2(static_cast<float>(foot.x()), static_cast<float>(foot.y())), 4.0f, line);
+    }
+  }
   const std::string caption = fmt::format("t = {:.2f} s   |F| = {:.2f} N   {} contacts   {} of {} points simulated", f.time,
                                           f.force.norm(), f.contacts, f.simulated, p.reference.cols());
   draw->AddText(ImVec2(static_cast<float>(vp.x) + 12, static_cast<float>(vp.y) + 10), text, caption.c_str());
