@@ -20,6 +20,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <thread>
 
@@ -136,6 +137,10 @@ int run_window(const ViewerOptions& o) {
   const ProbeSource source = probe_source_of(o.probe);
   ViewerSession session(prepare(scene, source, o.threads), source, o.threads);
 
+  // Under Mesa's software renderer (llvmpipe) the drawing would otherwise take a thread per core from the
+  // simulation and the haptic loop (on 2 cores: 21 instead of 27 frames/s, and the simulation 1.5x faster).
+  // A user's own setting wins; GPU drivers ignore it.
+  setenv("LP_NUM_THREADS", "1", 0);
   Window window(o.width, o.height, fmt::format("PointHaptics - {}", scene.path));
   MouseProbe mouse;
   glfwSetWindowUserPointer(window.handle(), &mouse);
