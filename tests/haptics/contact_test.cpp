@@ -15,6 +15,21 @@ const double s = 0.01;
 
 Model block() { return build_model(test::jittered_box(6, 4, 6, s, 0.0), MaterialParams{}, KernelParams{}); }
 
+// the block at rest with a probe of the given radius and mode, and a force buffer
+struct ProbeOnBlock {
+  ProbeOnBlock(double radius, ProbeMode mode) : model(block()), contact(model, params(radius, mode)) {}
+  static ProbeParams params(double radius, ProbeMode mode) {
+    ProbeParams p;
+    p.radius = radius;
+    p.mode = mode;
+    return p;
+  }
+  Model model;
+  ProbeContact contact;
+  Points u = Points::Zero(3, model.n_points);
+  Points f = Points::Zero(3, model.n_points);
+};
+
 TEST(ProbeContact, PushMovesTouchedPointsOutAndTheProbeFeelsTheOpposite) {
   const Model model = block();  // top face at y = 0.03
   ProbeParams p;
@@ -53,13 +68,8 @@ TEST(ProbeContact, PushMovesTouchedPointsOutAndTheProbeFeelsTheOpposite) {
 }
 
 TEST(ProbeContact, GrabbedPointsFollowTheProbeWhileTheButtonIsHeld) {
-  const Model model = block();
-  ProbeParams p;
-  p.radius = 0.006;
-  p.mode = ProbeMode::GRAB;
-  ProbeContact contact(model, p);
-  const Points u = Points::Zero(3, model.n_points);
-  Points f = Points::Zero(3, model.n_points);
+  ProbeOnBlock b(0.006, ProbeMode::GRAB);
+  auto& [model, contact, u, f] = b;
   const Vec3 probe(0.02, 0.03, 0.02);
   EXPECT_EQ(contact.apply(model, u, probe, false, 0.0, f).contacts, 0);  // not pressed: nothing
   const ContactModel press = contact.apply(model, u, probe, true, 0.0, f);
@@ -81,13 +91,8 @@ TEST(ProbeContact, GrabbedPointsFollowTheProbeWhileTheButtonIsHeld) {
 }
 
 TEST(ProbeContact, PushGrabPushesWithTheButtonUpAndGrabsWhileItIsHeld) {
-  const Model model = block();
-  ProbeParams p;
-  p.radius = 0.008;
-  p.mode = ProbeMode::PUSH_GRAB;
-  ProbeContact contact(model, p);
-  const Points u = Points::Zero(3, model.n_points);
-  Points f = Points::Zero(3, model.n_points);
+  ProbeOnBlock b(0.008, ProbeMode::PUSH_GRAB);
+  auto& [model, contact, u, f] = b;
   const Vec3 probe(0.025, 0.03 + 0.008, 0.025);
   const ContactModel pushed = contact.apply(model, u, probe, false, 0.0, f);
   ASSERT_GT(pushed.contacts, 0);
@@ -106,7 +111,7 @@ TEST(ProbeContact, PushGrabPushesWithTheButtonUpAndGrabsWhileItIsHeld) {
   EXPECT_LT(lifted.f0.y(), 0.0);  // the grabbed points pull the probe back down
   Eigen::Matrix<double, 9, Eigen::Dynamic> springs = Eigen::Matrix<double, 9, Eigen::Dynamic>::Zero(9, model.n_points);
   contact.add_stiffness(springs);
-  EXPECT_NEAR(springs.col(contact.grabbed().front())(0), p.stiffness > 0 ? p.stiffness : model.material.young * s, 1e-9);
+  EXPECT_NEAR(springs.col(contact.grabbed().front())(0), contact.params().stiffness, 1e-9);
   // released above the surface: neither grabbed nor touched
   f.setZero();
   const ContactModel released = contact.apply(model, u, probe + Vec3(0, 0.003, 0), false, 0.003, f);
