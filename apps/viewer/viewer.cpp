@@ -17,12 +17,12 @@
 #include <fmt/format.h>
 #include <imgui.h>
 
-#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <thread>
+#include <vector>
 
 #ifndef PH_SCENES_SOURCE_DIR
 #define PH_SCENES_SOURCE_DIR ""
@@ -69,23 +69,11 @@ struct MouseProbe {
   Vec3 target = Vec3::Constant(NAN);  ///< scene position the hand aims at
   bool follow = true;
   double scroll = 0;                   ///< wheel clicks since the last frame (from the GLFW callback)
+  std::vector<int> keys;               ///< keys pressed since the last frame (from the callback: a tap
+                                       ///< shorter than a frame is not lost)
 };
 
 MouseProbe* mouse_probe_of(GLFWwindow* w) { return static_cast<MouseProbe*>(glfwGetWindowUserPointer(w)); }
-
-// Keys pressed since the last frame (edges of GLFW's key state; ImGui 1.86 names few keys).
-class KeyEdges {
- public:
-  bool pressed(GLFWwindow* w, int key) {
-    const bool down = glfwGetKey(w, key) == GLFW_PRESS;
-    const bool was = down_[static_cast<std::size_t>(key)];
-    down_[static_cast<std::size_t>(key)] = down;
-    return down && !was;
-  }
-
- private:
-  std::array<bool, GLFW_KEY_LAST + 1> down_{};
-};
 
 }  // namespace
 
@@ -146,6 +134,9 @@ int run_window(const ViewerOptions& o) {
   glfwSetWindowUserPointer(window.handle(), &mouse);
   // installed before ImGui's, which chains to it
   glfwSetScrollCallback(window.handle(), [](GLFWwindow* w, double, double dy) { mouse_probe_of(w)->scroll += dy; });
+  glfwSetKeyCallback(window.handle(), [](GLFWwindow* w, int key, int, int action, int) {
+    if (action == GLFW_PRESS) mouse_probe_of(w)->keys.push_back(key);
+  });
   ImGuiContextGuard imgui;
   ImGui_ImplGlfw_InitForOpenGL(window.handle(), true);
   if (!ImGui_ImplOpenGL3_Init("#version 330")) throw Error("viewer: Dear ImGui's OpenGL 3 renderer did not start");
@@ -170,7 +161,6 @@ int run_window(const ViewerOptions& o) {
   double last_x = 0, last_y = 0;
   int frames = 0;
   double fps_t0 = 0;
-  KeyEdges keys;
   while (!window.should_close()) {
     glfwPollEvents();
     const double t = wall();
@@ -213,13 +203,14 @@ int run_window(const ViewerOptions& o) {
     }
     mouse.scroll = 0;
     bool save_key = false;
-    if (!io.WantCaptureKeyboard) {
-      GLFWwindow* w = window.handle();
-      if (keys.pressed(w, GLFW_KEY_SPACE)) mouse.follow = !mouse.follow;
-      if (keys.pressed(w, GLFW_KEY_R)) view.camera = [&] { OrbitCamera c; c.frame(p.lo, p.hi); return c; }();
-      if (keys.pressed(w, GLFW_KEY_Q) || keys.pressed(w, GLFW_KEY_ESCAPE)) glfwSetWindowShouldClose(w, 1);
-      save_key = keys.pressed(w, GLFW_KEY_S);
+    for (const int key : mouse.keys) {
+      if (io.WantCaptureKeyboard) break;  // typing into a panel
+      if (key == GLFW_KEY_SPACE) mouse.follow = !mouse.follow;
+      if (key == GLFW_KEY_R) view.camera = [&] { OrbitCamera c; c.frame(p.lo, p.hi); return c; }();
+      if (key == GLFW_KEY_Q || key == GLFW_KEY_ESCAPE) glfwSetWindowShouldClose(window.handle(), 1);
+      if (key == GLFW_KEY_S) save_key = true;
     }
+    mouse.keys.clear();
     // the probe follows the cursor in the plane through the hand's target
     if (p.mouse) {
       if (over_view && mouse.follow) {

@@ -9,11 +9,12 @@ usage: viewer_pixels.py EXE SCENES OUT headless|window|mouse
   the 1 kHz haptic loop running, the window's last frame saved;
 - mouse:    the viewer under Xvfb on the default scene (the seed's beam) driven by a real pointer (xdotool):
   the cursor brings the probe down onto the beam, the left button grabs, the cursor lifts the beam; the
-  grabbed points must come up.
+  grabbed points must come up; the S key saves a screenshot.
 
 Each picture is checked against the camera the viewer reports (--info), projected here independently: the
 probe's pixels have the probe's colour, the object's points land on object-coloured pixels, the background
 is background away from the object, the picture is not blank and the panels are drawn."""
+import glob
 import json
 import os
 import shutil
@@ -188,9 +189,11 @@ try:
         origin = np.array(start["probe"]["position"])
         r = start["probe"]["radius"]
         png, info = os.path.join(out, "mouse.png"), os.path.join(out, "mouse.json")
+        for old in glob.glob(os.path.join(out, "pointhaptics-*.png")):
+            os.remove(old)
         viewer = subprocess.Popen([exe, "view", beam, "--probe", "mouse", "--run-for", "7", "--screenshot", png,
                                    "--info", info, *size], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                  text=True)
+                                  text=True, cwd=out)
         time.sleep(2.0)  # the window is up
 
         def move_to(point):
@@ -207,6 +210,7 @@ try:
         time.sleep(0.5)
         move_to(down + np.array([0.0, 0.6 * r, 0.0]))
         move_to(down + np.array([0.0, 1.2 * r, 0.0]))
+        subprocess.run(["xdotool", "key", "s"], env=env, check=True)  # S saves a screenshot in the working folder
         stdout, stderr = viewer.communicate(timeout=60)
         subprocess.run(["xdotool", "mouseup", "1"], env=env)
         assert viewer.returncode == 0, stderr
@@ -214,6 +218,9 @@ try:
         assert i["contacts"] > 0, f"the mouse probe holds nothing: {i}"
         assert i["displacement_max"] > 2e-3, f"the grabbed points did not come up: {i['displacement_max']}"
         check_picture(png, info, expect_contact=True)
+        saved = glob.glob(os.path.join(out, "pointhaptics-*.png"))
+        assert len(saved) == 1, f"the S key saved {saved}"
+        assert Image.open(saved[0]).size == SIZE, Image.open(saved[0]).size
         print(f"mouse under Xvfb: ok ({i['contacts']} points held, lifted {1e3 * i['displacement_max']:.1f} mm)")
 finally:
     xvfb.terminate()
