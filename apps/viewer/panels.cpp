@@ -121,6 +121,7 @@ void display_panel(SceneView& view) {
     if (ImGui::SliderFloat("scale (mm)", &mm, 1e-3f, 100.0f, "%.3g", ImGuiSliderFlags_Logarithmic)) view.scale_max = mm * 1e-3f;
   }
   ImGui::SliderFloat("point size", &view.point_scale, 0.2f, 1.5f, "%.2f");
+  ImGui::Checkbox("interior points (hidden in a solid)", &view.interior);
 }
 
 void live_panel(const DisplayFrame& f, LiveStats& live) {

@@ -45,7 +45,11 @@ void build_spheres(const Prepared& p, const DisplayFrame& f, SceneView& view) {
   }
   const bool bands = f.lod_band.size() == static_cast<std::size_t>(n);
   const double radius = p.point_radius * view.point_scale;
-  for (Eigen::Index i = 0; i < n; ++i) {
+  // the surface shell only, unless asked (a point scaled below full size leaves gaps to see inside by)
+  const bool all = view.interior || view.point_scale < 0.9f;
+  const Eigen::Index count = all ? n : static_cast<Eigen::Index>(p.shell.size());
+  for (Eigen::Index m = 0; m < count; ++m) {
+    const Eigen::Index i = all ? m : p.shell[static_cast<std::size_t>(m)];
     const auto k = static_cast<std::size_t>(i);
     const Vec3 u = displacement_ok ? Vec3(f.u.col(i)) : Vec3::Zero();
     Rgb c;

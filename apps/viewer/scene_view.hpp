@@ -20,6 +20,7 @@ struct SceneView {
   bool auto_scale = true;       ///< the colour bar's top follows the largest displacement
   float scale_max = 1e-3f;      ///< m, the colour bar's top
   float point_scale = 1.0f;     ///< drawn radius / half the spacing
+  bool interior = false;        ///< draw the points hidden inside the object too (Prepared::shell)
   std::vector<Sphere> spheres;  ///< reused every frame
   std::vector<char> grabbed;    ///< per point, reused
 };

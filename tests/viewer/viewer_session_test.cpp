@@ -70,6 +70,28 @@ TEST(ViewerSession, ProbeSourcesAreNamedAndScriptsAreNeeded) {
   EXPECT_FALSE(shown->note.empty());
 }
 
+TEST(ViewerSession, OnlyPointsNearTheSurfaceAreDrawnOfASolid) {
+  Scene cube = beam_scene();
+  cube.object.size = Vec3(0.2, 0.2, 0.2);
+  cube.object.spacing = 0.01;
+  cube.fixed.clear();
+  const auto p = prepare(cube, ProbeSource::MOUSE, 1);
+  const Eigen::Index n = p->reference.cols();
+  ASSERT_EQ(n, 21 * 21 * 21);
+  std::vector<char> drawn(static_cast<std::size_t>(n), 0);
+  for (const index_t i : p->shell) drawn[static_cast<std::size_t>(i)] = 1;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Vec3 x = p->reference.col(i);
+    const double depth = std::min(x.minCoeff(), (Vec3::Constant(0.2) - x).minCoeff());  // to the nearest face
+    if (depth < 0.015) {
+      EXPECT_TRUE(drawn[static_cast<std::size_t>(i)]) << "a point " << depth << " m under the surface";
+    } else if (depth > 0.025) {
+      EXPECT_FALSE(drawn[static_cast<std::size_t>(i)]) << "a hidden point " << depth << " m deep";
+    }
+  }
+  EXPECT_EQ(p->shell.size(), static_cast<std::size_t>(n - 17 * 17 * 17));  // the two outer layers
+}
+
 TEST(ViewerSession, HeadlessFramesAreDeterministicAndFollowTheScript) {
   const Scene scene = beam_scene();
   auto a = prepare(scene, ProbeSource::SCRIPT, 1);
