@@ -4,18 +4,12 @@
 #include <pointhaptics/haptics/devices/virtual_device.hpp>
 #include <pointhaptics/pointhaptics.hpp>
 
+#include "support/tbb_under_tsan.hpp"
+
 #include <gtest/gtest.h>
-#include <oneapi/tbb/global_control.h>
 
 namespace pointhaptics {
 namespace {
-
-#if defined(__SANITIZE_THREAD__)
-// Debian's TBB is not instrumented, so ThreadSanitizer cannot see its joins and reports every result a TBB
-// loop hands back (the model build's neighbour rows) as a race. TBB's own workers are kept out here; the
-// threads under test are ours: the haptic loop and the re-selection worker.
-const tbb::global_control one_tbb_thread(tbb::global_control::max_allowed_parallelism, 1);
-#endif
 
 // a block held at its bottom, 13 x 5 x 7 points
 const char* block = R"(

@@ -5,6 +5,8 @@
 
 #include <pointhaptics/io/scene_toml.hpp>
 
+#include "support/tbb_under_tsan.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
