@@ -73,6 +73,14 @@ struct MouseProbe {
                                        ///< shorter than a frame is not lost)
 };
 
+// The view a window or a screenshot starts with: the colours asked for, the object framed.
+SceneView initial_view(const ViewerOptions& o, const Prepared& prepared) {
+  SceneView view;
+  view.colour_by = o.colour == "band" ? ColourBy::LOD_BAND : ColourBy::DISPLACEMENT;
+  view.camera.frame(prepared.lo, prepared.hi);
+  return view;
+}
+
 MouseProbe* mouse_probe_of(GLFWwindow* w) { return static_cast<MouseProbe*>(glfwGetWindowUserPointer(w)); }
 
 }  // namespace
@@ -88,9 +96,7 @@ int render_screenshot(const ViewerOptions& o) {
   ImGuiContextGuard imgui;
   if (!ImGui_ImplOpenGL3_Init("#version 330")) throw Error("viewer: Dear ImGui's OpenGL 3 renderer did not start");
   PointRenderer renderer;
-  SceneView view;
-  view.colour_by = o.colour == "band" ? ColourBy::LOD_BAND : ColourBy::DISPLACEMENT;
-  view.camera.frame(prepared->lo, prepared->hi);
+  SceneView view = initial_view(o, *prepared);
   const Viewport vp = scene_viewport(o.width, o.height, o.panels);
   PanelState state{prepared->scene, false, {}};
   LiveStats live;
@@ -148,9 +154,7 @@ int run_window(const ViewerOptions& o) {
   } backends;
 
   PointRenderer renderer;
-  SceneView view;
-  view.colour_by = o.colour == "band" ? ColourBy::LOD_BAND : ColourBy::DISPLACEMENT;
-  view.camera.frame(session.current().lo, session.current().hi);
+  SceneView view = initial_view(o, session.current());
   PanelState state{session.current().scene, false, {}};
   LiveStats live;
   session.start();
@@ -206,7 +210,7 @@ int run_window(const ViewerOptions& o) {
     for (const int key : mouse.keys) {
       if (io.WantCaptureKeyboard) break;  // typing into a panel
       if (key == GLFW_KEY_SPACE) mouse.follow = !mouse.follow;
-      if (key == GLFW_KEY_R) view.camera = [&] { OrbitCamera c; c.frame(p.lo, p.hi); return c; }();
+      if (key == GLFW_KEY_R) view.camera = initial_view(o, p).camera;
       if (key == GLFW_KEY_Q || key == GLFW_KEY_ESCAPE) glfwSetWindowShouldClose(window.handle(), 1);
       if (key == GLFW_KEY_S) save_key = true;
     }

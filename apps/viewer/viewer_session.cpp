@@ -46,6 +46,25 @@ std::unique_ptr<Device> make_device(const Scene& scene, ProbeSource source, cons
 
 }  // namespace
 
+std::vector<index_t> visible_shell(const Csr& neighbours) {
+  // the points with a less full neighbourhood than the fullest, and their neighbours: on a lattice the two
+  // outer layers (the second shows through the gaps between the first's spheres)
+  const index_t n = neighbours.n_rows();
+  index_t fullest = 0;
+  for (index_t i = 0; i < n; ++i) fullest = std::max(fullest, neighbours.row_size(i));
+  std::vector<char> seen(static_cast<std::size_t>(n), 0);
+  for (index_t i = 0; i < n; ++i) {
+    if (neighbours.row_size(i) == fullest) continue;
+    seen[static_cast<std::size_t>(i)] = 1;
+    for (index_t e = neighbours.begin(i); e < neighbours.end(i); ++e)
+      seen[static_cast<std::size_t>(neighbours.index[static_cast<std::size_t>(e)])] = 1;
+  }
+  std::vector<index_t> shell;
+  for (index_t i = 0; i < n; ++i)
+    if (seen[static_cast<std::size_t>(i)]) shell.push_back(i);
+  return shell;
+}
+
 std::unique_ptr<Prepared> prepare(const Scene& scene_in, ProbeSource source, int threads) {
   auto p = std::make_unique<Prepared>();
   p->scene = scene_in;
@@ -66,19 +85,7 @@ std::unique_ptr<Prepared> prepare(const Scene& scene_in, ProbeSource source, int
   p->point_radius = 0.5 * model.spacing;
   p->lo = model.X.rowwise().minCoeff();
   p->hi = model.X.rowwise().maxCoeff();
-  // the points with a fuller neighbourhood than the outermost layer's, and their neighbours: on a lattice
-  // the two outer layers (the second shows through the gaps between the first's spheres)
-  index_t fullest = 0;
-  for (index_t i = 0; i < model.n_points; ++i) fullest = std::max(fullest, model.neighbours.row_size(i));
-  std::vector<char> seen(static_cast<std::size_t>(model.n_points), 0);
-  for (index_t i = 0; i < model.n_points; ++i) {
-    if (model.neighbours.row_size(i) == fullest) continue;
-    seen[static_cast<std::size_t>(i)] = 1;
-    for (index_t e = model.neighbours.begin(i); e < model.neighbours.end(i); ++e)
-      seen[static_cast<std::size_t>(model.neighbours.index[static_cast<std::size_t>(e)])] = 1;
-  }
-  for (index_t i = 0; i < model.n_points; ++i)
-    if (seen[static_cast<std::size_t>(i)]) p->shell.push_back(i);
+  p->shell = visible_shell(model.neighbours);
   p->simulation = std::make_unique<Simulation>(std::move(model), scene.solver, threads);
   if (scene.lod.present) p->simulation->enable_lod(scene.lod.params, scene_lod_contact(scene, p->simulation->full_model()));
   p->options = scene_interactive_options(scene, p->simulation->full_model());

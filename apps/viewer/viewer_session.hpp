@@ -39,6 +39,9 @@ struct Prepared {
   std::unique_ptr<TripleBuffer<DisplayFrame>> display;
 };
 
+/// The points of a model that can be seen from outside (Prepared::shell), from its neighbour lists.
+std::vector<index_t> visible_shell(const Csr& neighbours);
+
 /// Build a scene for viewing; throws Error for a scene that cannot be built.
 std::unique_ptr<Prepared> prepare(const Scene& scene, ProbeSource source, int threads);
 
