@@ -38,11 +38,10 @@ Workspace::Workspace(const Model& model, int n_threads) {
   }
   f_int = Points::Zero(3, model.n_points);
   acceleration = Points::Zero(3, model.n_points);
-  gradients = Eigen::Matrix<double, 9, Eigen::Dynamic>::Zero(9, model.n_points);
-  if (n_threads_ > 1) {
-    chunk_forces.assign(n_threads_, Points::Zero(3, model.n_points));
-    pool_ = std::make_unique<ThreadPool>(n_threads_);
-  }
+  padded_u = PaddedPoints::Zero(4, model.n_points);
+  gradients = PaddedGradients::Zero(12, model.n_points);
+  chunk_forces.assign(n_threads_, PaddedPoints::Zero(4, model.n_points));
+  if (n_threads_ > 1) pool_ = std::make_unique<ThreadPool>(n_threads_);
 }
 
 Workspace::~Workspace() = default;

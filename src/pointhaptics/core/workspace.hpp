@@ -7,6 +7,11 @@
 
 namespace pointhaptics {
 
+/// Points with a zero fourth row, so that each point's vector is one SIMD load  (4 x n)
+using PaddedPoints = Eigen::Matrix<double, 4, Eigen::Dynamic>;
+/// A 3x3 matrix per point as its three columns, each padded to 4 doubles  (12 x n)
+using PaddedGradients = Eigen::Matrix<double, 12, Eigen::Dynamic>;
+
 /// Scratch buffers and the thread pool of the force evaluation and the solvers.
 /// Not shared between threads that step different simulations.
 class Workspace {
@@ -29,9 +34,11 @@ class Workspace {
   void for_each_chunk(Fn&& fn);
 
   Points f_int;                     ///< internal elastic forces, N  (3 x n)
-  std::vector<Points> chunk_forces; ///< per-chunk scatter targets, summed into f_int  (n_threads x (3 x n))
   Points acceleration;              ///< scratch of the explicit solver, m/s^2  (3 x n)
-  Eigen::Matrix<double, 9, Eigen::Dynamic> gradients;  ///< G_i of the last stencil pass (row-major 3x3)  (9 x n)
+  // scratch of the stencil loop (mechanics/detail/stencil_loop.hpp)
+  PaddedPoints padded_u;                  ///< the displacement (or increment) the loop reads
+  PaddedGradients gradients;              ///< G_i of the last stencil pass, by columns
+  std::vector<PaddedPoints> chunk_forces; ///< per-chunk scatter targets, summed into the result  (n_threads)
 
  private:
   void run_chunks(void (*call)(void*, int), void* context);
