@@ -15,18 +15,24 @@ enum class TangentMode {
 /// linearise() records F_i and S_i per point; apply() then costs about one force evaluation.
 class Tangent {
  public:
-  /// Linearise at displacement u (parallel, allocates only the first time for a model size).
-  void linearise(const Model& model, const Points& u, TangentMode mode);
+  /// Linearise at displacement u (parallel: on ws's threads when given, else on all of TBB's; allocates
+  /// only the first time for a model size).
+  void linearise(const Model& model, const Points& u, TangentMode mode, Workspace* ws = nullptr);
   /// out = K du, on ws's threads (uses ws.chunk_forces as scratch), no allocation.
   void apply(const Model& model, const Points& du, Workspace& ws, Points& out) const;
-  /// The 3x3 diagonal blocks K_jj (column-major, 9 x n), for a block-Jacobi preconditioner.
-  void diagonal_blocks(const Model& model, Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks) const;
+  /// The 3x3 diagonal blocks K_jj (column-major, 9 x n), for a block-Jacobi preconditioner (parallel as
+  /// linearise; allocates only the first time for a model size; not for two threads at once). The
+  /// hourglass part is the model's precomputed hg_diagonal, which also counts the pairs of passive points'
+  /// stencils: with passive points those blocks are approximate (fine for a preconditioner).
+  void diagonal_blocks(const Model& model, Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks, Workspace* ws = nullptr) const;
   TangentMode mode() const { return mode_; }
 
  private:
   TangentMode mode_ = TangentMode::EXACT;
   Eigen::Matrix<double, 9, Eigen::Dynamic> F_;  ///< F_i at the linearisation point (column-major 3x3)
   Eigen::Matrix<double, 9, Eigen::Dynamic> S_;  ///< S_i, or its positive part (PROJECTED)
+  /// scratch of diagonal_blocks: d(v_i P_i)/dG_i per stencil (9 x 9, column-major)
+  mutable Eigen::Matrix<double, 81, Eigen::Dynamic> stencil_moduli_;
 };
 
 }  // namespace pointhaptics

@@ -42,7 +42,7 @@ double stable_time_step(const Model& model, double safety, int lanczos_steps) {
   if (scale.squaredNorm() == 0) return fallback;
   Workspace ws(model, 1);
   Tangent K;
-  K.linearise(model, Points::Zero(3, model.n_points), TangentMode::EXACT);
+  K.linearise(model, Points::Zero(3, model.n_points), TangentMode::EXACT, &ws);
   std::mt19937 rng(12345);
   std::normal_distribution<double> noise;
   Eigen::VectorXd q(n), q_prev = Eigen::VectorXd::Zero(n);

@@ -60,9 +60,9 @@ double NewtonSolver::residual(const Model& model, const NewtonProblem& problem, 
   return r.norm() / scale;
 }
 
-void NewtonSolver::build_preconditioner(const Model& model, const NewtonProblem& problem) {
+void NewtonSolver::build_preconditioner(const Model& model, const NewtonProblem& problem, Workspace& ws) {
   const double inertia = problem.inertia;
-  tangent_.diagonal_blocks(model, blocks_);
+  tangent_.diagonal_blocks(model, blocks_, &ws);
   for (index_t i = 0; i < model.n_points; ++i) {
     Eigen::Map<Mat3> B(blocks_.col(i).data());
     if (model.fixed[i]) {
@@ -149,10 +149,10 @@ NewtonStats NewtonSolver::solve(const Model& model, const NewtonProblem& problem
     const double eta = std::max(std::min(0.01, rel), 0.5 * settings.tolerance / rel);
     bool descent = false;
     for (TangentMode mode : {TangentMode::EXACT, TangentMode::PROJECTED}) {
-      tangent_.linearise(model, u, mode);
+      tangent_.linearise(model, u, mode, &ws);
       // the block-Jacobi preconditioner is rebuilt at the first iteration of a solve and when the tangent's
       // mode changes; in between it lags (it changes slowly and costs about two tangent products)
-      if (stats.iterations == 1 || mode != preconditioner_mode_) build_preconditioner(model, problem);
+      if (stats.iterations == 1 || mode != preconditioner_mode_) build_preconditioner(model, problem, ws);
       preconditioner_mode_ = mode;
       const bool positive =
           conjugate_gradients(model, problem, r_, eta, settings.max_cg_iterations, ws, dx_, stats.cg_iterations);

@@ -51,7 +51,7 @@ class NewtonSolver {
   double energy(const Model& model, const NewtonProblem& problem, const Points& u) const;
   /// r = -grad Pi at u, zero at held points; returns the relative residual
   double residual(const Model& model, const NewtonProblem& problem, const Points& u, Workspace& ws, Points& r) const;
-  void build_preconditioner(const Model& model, const NewtonProblem& problem);
+  void build_preconditioner(const Model& model, const NewtonProblem& problem, Workspace& ws);
   /// PCG on (K + k M) x = r over the free points to relative tolerance eta; returns false when it meets
   /// a direction of non-positive curvature (an indefinite tangent).
   bool conjugate_gradients(const Model& model, const NewtonProblem& problem, const Points& r, double eta,
