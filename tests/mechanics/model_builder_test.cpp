@@ -45,6 +45,28 @@ TEST(BuildModel, MomentInverseAndSelfTerm) {
   }
 }
 
+TEST(BuildModel, EveryPairKnowsItsReverse) {
+  // also with per-point supports, where i and j are neighbours when either support reaches the other
+  PointCloud cloud = test::jittered_box(5, 4, 4, 0.01, 0.2);
+  for (bool per_point : {false, true}) {
+    if (per_point) {
+      cloud.support.resize(cloud.size());
+      for (index_t i = 0; i < cloud.size(); ++i) cloud.support[i] = (1.5 + 0.1 * (i % 7)) * 0.01;
+    }
+    const Model model = build_model(cloud, MaterialParams{}, KernelParams{});
+    const Csr& nbr = model.neighbours;
+    ASSERT_EQ(model.reverse_pair.size(), static_cast<std::size_t>(nbr.n_entries()));
+    for (index_t i = 0; i < model.n_points; ++i)
+      for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
+        const index_t j = nbr.index[e], back = model.reverse_pair[e];
+        ASSERT_GE(back, nbr.begin(j)) << "pair " << e;
+        ASSERT_LT(back, nbr.end(j)) << "pair " << e;
+        EXPECT_EQ(nbr.index[back], i) << "pair " << e;
+        EXPECT_EQ(model.reverse_pair[back], e) << "pair " << e;
+      }
+  }
+}
+
 TEST(BuildModel, CoplanarNeighbourhoodsAreRegularisedWithoutNaN) {
   // a single layer of points: every M_i is singular in z
   PointCloud cloud = sample_box(Vec3::Zero(), Vec3(0.05, 0.05, 0.01), 0.01);

@@ -33,8 +33,10 @@ struct Model {
   MaterialParams material;
   double lambda = 0, mu = 0;        ///< Lame parameters, Pa
 
-  /// stencils: the neighbours j != i with |X_j - X_i| < h of each point i, as CSR (pairs e = (i, j))
+  /// stencils: the neighbours j != i with |X_j - X_i| < h of each point i, as CSR (pairs e = (i, j)),
+  /// each row sorted; symmetric (j is in i's row when i is in j's)
   Csr neighbours;
+  std::vector<index_t> reverse_pair;  ///< for each pair e = (i, j), the pair (j, i)  (n_pairs)
   // per-pair data, aligned with neighbours.index
   Points d;                         ///< d_ij = M_i^-1 X_ij w_ij, 1/m  (3 x n_pairs), seed Eq. 10-11
   Eigen::VectorXd hg_coef;          ///< k_ij = (alpha E / 2) (v_i w^_ij + v_j w^_ji) / |X_ij|^2, symmetric, N/m  (n_pairs)

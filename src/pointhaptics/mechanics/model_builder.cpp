@@ -116,6 +116,14 @@ Model build_model(const PointCloud& cloud, const MaterialParams& material, const
   model.neighbours = per_point ? radius_neighbours(model.X, cloud.support) : radius_neighbours(model.X, h);
   const Csr& nbr = model.neighbours;
   const index_t n_pairs = nbr.n_entries();
+  model.reverse_pair.resize(n_pairs);
+  tbb::parallel_for(index_t{0}, n, [&](index_t i) {
+    for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
+      const index_t j = nbr.index[e];
+      const index_t* row = nbr.index.data();
+      model.reverse_pair[e] = static_cast<index_t>(std::lower_bound(row + nbr.begin(j), row + nbr.end(j), i) - row);
+    }
+  });
 
   // kernel weights per pair; coincident points would make w (and M_i) meaningless
   Eigen::VectorXd w(n_pairs);

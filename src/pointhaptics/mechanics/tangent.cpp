@@ -6,8 +6,6 @@
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/parallel_for.h>
 
-#include <algorithm>
-
 namespace pointhaptics {
 namespace {
 
@@ -88,44 +86,45 @@ void Tangent::apply(const Model& model, const Points& du, Workspace& ws, Points&
 
 void Tangent::diagonal_blocks(const Model& model, Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks, Workspace* ws) const {
   const double lambda = model.lambda, mu = model.mu, kv = model.material.volume_stiffness;
-  const bool exact = mode_ == TangentMode::EXACT;
   const Csr& nbr = model.neighbours;
   const index_t n = model.n_points, stencil_end = model.stencil_end();
-  blocks.setZero(9, n);
-  // C_i = d(v_i P_i)/dG_i (9 x 9) of every stencil, from the stress increments of the 9 unit gradients
-  stencil_moduli_.resize(81, stencil_end);
+  blocks.resize(9, n);
+  // A unit displacement of point j along e_b changes stencil i's gradient by dG = e_b d^T (d = d_ij, or d_ii
+  // for j = i), and j's force by -v_i dP(dG) d. With dE = sym(F^T dG) and g = F d, h = cof(F) d:
+  //   dG S d = (d^T S d) e_b,  F (lambda tr(dE) I + 2 mu dE) d = (lambda + mu) g_b g + mu |d|^2 F F^T e_b,
+  //   (cof F : dG) cof F d = h_b h,  and d(cof F)[e_b d^T] d = 0 (each row is a cross product with d),
+  // so the block is v_i ((lambda + mu) g g^T + mu |d|^2 F F^T + (d^T S d) I + k_v h h^T), in either mode
+  // (S_ holds the positive part of S when PROJECTED). Per stencil: F F^T and cof F.
+  stencil_factors_.resize(18, stencil_end);
   for_each_point(stencil_end, ws, [&](index_t i) {
-    const Mat3 F = Eigen::Map<const Mat3>(F_.data() + 9 * i), S = Eigen::Map<const Mat3>(S_.data() + 9 * i);
-    for (int col = 0; col < 9; ++col) {
-      Mat3 unit = Mat3::Zero();
-      unit.data()[col] = 1.0;
-      stencil_moduli_.col(i).segment<9>(9 * col) =
-          stress_increment(F, S, unit, model.volume[i], lambda, mu, kv, exact).reshaped();
-    }
+    const Eigen::Map<const Mat3> F(F_.data() + 9 * i);
+    stencil_factors_.col(i).head<9>() = (F * F.transpose()).reshaped();
+    stencil_factors_.col(i).tail<9>() = cofactor(F).reshaped();
   });
-  // stencil i adds to the block of each j it reaches (j = i with d_ii) sum_{k,l} d_k d_l C_i[a + 3k][b + 3l];
+  auto contribution = [&](index_t i, const Vec3& d) {
+    const Eigen::Map<const Mat3> F(F_.data() + 9 * i), S(S_.data() + 9 * i);
+    const Eigen::Map<const Mat3> FFt(stencil_factors_.col(i).data()), cof(stencil_factors_.col(i).data() + 9);
+    const Vec3 g = F * d;
+    Mat3 K = (lambda + mu) * g * g.transpose() + (mu * d.squaredNorm()) * FFt;
+    K.diagonal().array() += d.dot(S * d);
+    if (kv > 0) {
+      const Vec3 h = cof * d;
+      K += kv * h * h.transpose();
+    }
+    return Mat3(model.volume[i] * K);
+  };
   // gathered per j over the stencils that reach it (neighbourhoods are symmetric), so no two threads write
   // one block. The hourglass part is constant and precomputed in the model (model_builder.cpp).
-  auto contribution = [&](index_t i, const double* d) {
-    const Eigen::Map<const Eigen::Matrix<double, 9, 9>> C(stencil_moduli_.col(i).data());
-    Mat3 K = Mat3::Zero();
-    for (int k = 0; k < 3; ++k)
-      for (int l = 0; l < 3; ++l) K += d[k] * d[l] * C.block<3, 3>(3 * k, 3 * l);
-    return K;
-  };
   for_each_point(n, ws, [&](index_t j) {
     Mat3 K = Mat3::Zero();
     if (j < stencil_end) {
-      K = contribution(j, model.d_self.col(j).data());
+      K = contribution(j, model.d_self.col(j));
       if (model.hg_diagonal.size()) K.diagonal().array() += model.hg_diagonal[j];
     }
     for (index_t e = nbr.begin(j); e < nbr.end(j); ++e) {
       const index_t i = nbr.index[e];
       if (i >= stencil_end) continue;
-      // the pair (i, j) in i's row (rows are sorted)
-      const index_t* row = nbr.index.data();
-      const index_t ij = static_cast<index_t>(std::lower_bound(row + nbr.begin(i), row + nbr.end(i), j) - row);
-      K += contribution(i, model.d.col(ij).data());
+      K += contribution(i, model.d.col(model.reverse_pair[e]));  // d_ij of the pair (i, j) in i's row
     }
     blocks.col(j) = K.reshaped();
   });

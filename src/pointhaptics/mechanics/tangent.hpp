@@ -31,8 +31,8 @@ class Tangent {
   TangentMode mode_ = TangentMode::EXACT;
   Eigen::Matrix<double, 9, Eigen::Dynamic> F_;  ///< F_i at the linearisation point (column-major 3x3)
   Eigen::Matrix<double, 9, Eigen::Dynamic> S_;  ///< S_i, or its positive part (PROJECTED)
-  /// scratch of diagonal_blocks: d(v_i P_i)/dG_i per stencil (9 x 9, column-major)
-  mutable Eigen::Matrix<double, 81, Eigen::Dynamic> stencil_moduli_;
+  /// scratch of diagonal_blocks: F_i F_i^T and cof F_i per stencil (column-major 3x3 each)
+  mutable Eigen::Matrix<double, 18, Eigen::Dynamic> stencil_factors_;
 };
 
 }  // namespace pointhaptics
