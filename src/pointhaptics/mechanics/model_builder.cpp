@@ -116,14 +116,21 @@ Model build_model(const PointCloud& cloud, const MaterialParams& material, const
   model.neighbours = per_point ? radius_neighbours(model.X, cloud.support) : radius_neighbours(model.X, h);
   const Csr& nbr = model.neighbours;
   const index_t n_pairs = nbr.n_entries();
+  // each pair's reverse; the forces and the tangent rely on the lists being symmetric (and sorted)
   model.reverse_pair.resize(n_pairs);
+  std::atomic<std::int64_t> one_sided{-1};
   tbb::parallel_for(index_t{0}, n, [&](index_t i) {
     for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
       const index_t j = nbr.index[e];
       const index_t* row = nbr.index.data();
-      model.reverse_pair[e] = static_cast<index_t>(std::lower_bound(row + nbr.begin(j), row + nbr.end(j), i) - row);
+      const index_t back = static_cast<index_t>(std::lower_bound(row + nbr.begin(j), row + nbr.end(j), i) - row);
+      if (back == nbr.end(j) || row[back] != i) one_sided = e;
+      model.reverse_pair[e] = back;
     }
   });
+  if (one_sided >= 0)
+    throw Error(fmt::format("model: neighbour pair {} has no reverse (the neighbour search must be symmetric)",
+                            one_sided.load()));
 
   // kernel weights per pair; coincident points would make w (and M_i) meaningless
   Eigen::VectorXd w(n_pairs);

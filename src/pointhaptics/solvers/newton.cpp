@@ -151,7 +151,7 @@ NewtonStats NewtonSolver::solve(const Model& model, const NewtonProblem& problem
     for (TangentMode mode : {TangentMode::EXACT, TangentMode::PROJECTED}) {
       tangent_.linearise(model, u, mode, &ws);
       // the block-Jacobi preconditioner is rebuilt at the first iteration of a solve and when the tangent's
-      // mode changes; in between it lags (it changes slowly and costs about two tangent products)
+      // mode changes; in between it lags (it changes slowly, and costs a few tangent products)
       if (stats.iterations == 1 || mode != preconditioner_mode_) build_preconditioner(model, problem, ws);
       preconditioner_mode_ = mode;
       const bool positive =
