@@ -49,6 +49,7 @@ py::dict summary_dict(const ph::RunSummary& s) {
   d["kinetic_energy"] = s.kinetic_energy;
   d["steps_per_s"] = s.steps_per_s;
   d["stable_dt"] = s.stable_dt;
+  if (s.solver_kind == "implicit") d["budget_steps"] = s.budget_steps;
   py::list reactions;
   for (const ph::Vec3& r : s.reactions) reactions.append(py::make_tuple(r.x(), r.y(), r.z()));
   d["reactions"] = reactions;

@@ -85,6 +85,28 @@ TEST(Simulation, StaticSolveAgreesWithSettledDynamics) {
   EXPECT_NEAR(tip_deflection(sim), tip_deflection(settled), 2e-4 * tip_deflection(sim));
 }
 
+TEST(Simulation, StepsEndedByTheIterationBudgetAreCountedNotFailures) {
+  // a tolerance no step reaches in one Newton iteration: with a budget the run keeps each iterate
+  Scene scene = parse_scene(cantilever);
+  scene.solver.kind = SolverKind::IMPLICIT;
+  scene.solver.tolerance = 1e-13;
+  scene.solver.iteration_budget = 1;
+  Simulation sim(build_scene_model(scene), scene.solver, 1);
+  sim.run(0.01);
+  const RunSummary s = sim.summary();
+  EXPECT_TRUE(s.converged);
+  EXPECT_EQ(s.steps, 10);
+  EXPECT_EQ(s.budget_steps, 10);
+  EXPECT_EQ(s.iterations, 10);
+  EXPECT_GT(s.residual, 1e-13);
+  EXPECT_NE(result_json(sim.model(), sim.state(), s).find("\"budget_steps\": 10"), std::string::npos);
+  // the same tolerance without a budget: the step fails with a named error
+  scene.solver.iteration_budget = 0;
+  scene.solver.max_iterations = 1;
+  Simulation strict(build_scene_model(scene), scene.solver, 1);
+  EXPECT_THROW(strict.run(0.01), Error);
+}
+
 TEST(Simulation, CantileverSettlesOnTheCalculixDeflection) {
   const Scene scene = parse_scene(cantilever);
   Simulation sim(build_scene_model(scene), scene.solver, 2);

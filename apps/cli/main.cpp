@@ -51,8 +51,11 @@ void print_summary(ph::Simulation& sim, const ph::RunSummary& s, double setup_s)
     fmt::print("solver          static: {} in {} load increments, {} Newton and {} CG iterations, residual {:.3g}\n",
                s.converged ? "converged" : "NOT converged", s.substeps, s.iterations, s.cg_iterations, s.residual);
   else if (s.solver_kind == "implicit")
-    fmt::print("solver          implicit: {} steps of {:.3g} s, {} Newton and {} CG iterations, t = {:.4g} s\n", s.steps,
-               sim.solver().dt, s.iterations, s.cg_iterations, st.time);
+    fmt::print("solver          implicit: {} steps of {:.3g} s, {} Newton and {} CG iterations, t = {:.4g} s{}\n", s.steps,
+               sim.solver().dt, s.iterations, s.cg_iterations, st.time,
+               s.budget_steps > 0 ? fmt::format("; {} steps ended at the iteration budget, last residual {:.3g}",
+                                                s.budget_steps, s.residual)
+                                  : std::string());
   else
     fmt::print("solver          {}: {} steps of {:.3g} s, {} sub-steps (stable sub-step {:.3g} s), t = {:.4g} s\n",
                s.solver_kind, s.steps, sim.solver().dt, s.substeps, s.stable_dt, st.time);

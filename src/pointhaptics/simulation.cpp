@@ -224,7 +224,11 @@ void Simulation::step() {
       iterations_ += stats.iterations;
       cg_iterations_ += stats.cg_iterations;
       residual_ = stats.residual;
-      converged_ = converged_ && stats.residual <= newton_settings().tolerance;
+      // a step the iteration budget ended keeps its iterate, as the scene asked (real time): counted, not a failure
+      if (stats.residual > newton_settings().tolerance) {
+        if (solver_.iteration_budget > 0) ++budget_steps_;
+        else converged_ = false;
+      }
       break;
     }
     case SolverKind::STATIC: {
@@ -265,6 +269,7 @@ RunSummary Simulation::summary() {
   s.substeps = substeps_;
   s.iterations = iterations_;
   s.cg_iterations = cg_iterations_;
+  s.budget_steps = budget_steps_;
   s.stable_dt = stable_dt_;
   compute_internal_forces(model_, state_.u, ws_);
   s.reactions = support_reactions(model_, ws_.f_int);

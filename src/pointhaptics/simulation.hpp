@@ -93,6 +93,7 @@ class Simulation {
   double stable_dt_ = 0;
   long long steps_ = 0, substeps_ = 0, iterations_ = 0, cg_iterations_ = 0;
   bool converged_ = true;
+  long long budget_steps_ = 0;  ///< implicit steps the iteration budget ended above the tolerance
   double residual_ = 0;
   std::string failure_;
   double step_seconds_ = 0;

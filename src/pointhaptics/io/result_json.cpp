@@ -35,6 +35,7 @@ std::string result_json(const Model& model, const State& state, const RunSummary
                    {"residual", s.residual},    {"steps", s.steps},         {"substeps", s.substeps},
                    {"stable_dt", s.stable_dt}, {"cg_iterations", s.cg_iterations}};
   if (!s.failure.empty()) doc["solver"]["failure"] = s.failure;
+  if (s.solver_kind == "implicit") doc["solver"]["budget_steps"] = s.budget_steps;
   doc["energy"] = {{"strain", s.strain_energy}, {"kinetic", s.kinetic_energy}};
   doc["timing"] = {{"wall_s", s.wall_s}, {"step_ms_mean", s.step_ms_mean}, {"steps_per_s", s.steps_per_s}};
   json constraints = json::array();

@@ -35,6 +35,7 @@ struct RunSummary {
   double stable_dt = 0;         ///< explicit: the stable sub-step, s
   long long substeps = 0;       ///< explicit: sub-steps taken in all; static: load increments
   long long cg_iterations = 0;  ///< static, implicit: conjugate-gradient iterations in all
+  long long budget_steps = 0;   ///< implicit with an iteration budget: steps it ended above the tolerance
   std::string failure;          ///< static: why it did not converge (empty when it did)
   std::vector<Vec3> reactions;  ///< per fixed group, N
   // haptic loop (runs with a probe)
