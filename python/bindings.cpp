@@ -11,6 +11,7 @@
 #include <pybind11/stl.h>
 
 #include <memory>
+#include <mutex>
 
 namespace py = pybind11;
 namespace ph = pointhaptics;
@@ -73,11 +74,26 @@ ph::KernelType kernel_type(const std::string& type) {
   throw ph::Error("kernel: unknown type \"" + type + "\" (expected poly6 | spiky | viscosity | quadratic)");
 }
 
-// The simulation with the scene it came from (for its probe), so that Python owns one object.
+// The simulation with the scene it came from (for its probe), so that Python owns one object. Calls that
+// release the GIL run concurrently with other Python threads, so every call on one object takes its mutex:
+// a step and a read, or two steps, from two threads follow each other instead of sharing the state.
 struct PySimulation {
   std::unique_ptr<ph::Simulation> sim;
   ph::Scene scene;
+  std::mutex mutex;
 };
+
+// The object's lock for a call that holds the GIL: waiting for it (a step on another thread may hold it
+// for long) releases the GIL, so that the holder, which never takes the GIL while holding the lock, can
+// finish.
+std::unique_lock<std::mutex> locked(PySimulation& p) {
+  std::unique_lock<std::mutex> lock(p.mutex, std::try_to_lock);
+  if (!lock.owns_lock()) {
+    py::gil_scoped_release release;
+    lock.lock();
+  }
+  return lock;
+}
 
 std::unique_ptr<PySimulation> from_scene(const std::string& path, int threads) {
   auto p = std::make_unique<PySimulation>();
@@ -146,6 +162,7 @@ PYBIND11_MODULE(_pointhaptics, m) {
       .def(
           "step", [](PySimulation& p) {
             py::gil_scoped_release release;
+            const std::lock_guard<std::mutex> lock(p.mutex);
             p.sim->step();
           },
           "One solver step (static: the equilibrium)")
@@ -153,23 +170,38 @@ PYBIND11_MODULE(_pointhaptics, m) {
           "run", [](PySimulation& p, double duration) {
             if (!(duration >= 0)) throw ph::Error("run: duration must be >= 0 (s)");
             py::gil_scoped_release release;
+            const std::lock_guard<std::mutex> lock(p.mutex);
             p.sim->run(duration);
           },
           py::arg("duration"), "Step until `duration` seconds more have passed (static: solve once); releases the GIL")
-      .def_property_readonly("time", [](PySimulation& p) { return p.sim->full_state().time; })
+      .def_property_readonly("time", [](PySimulation& p) {
+        const auto lock = locked(p);
+        return p.sim->full_state().time;
+      })
       .def_property_readonly("n_points", [](PySimulation& p) { return p.sim->full_model().n_points; })
       .def_property_readonly(
           "reference", [](py::object self) { return view(self.cast<PySimulation&>().sim->full_model().X, self); },
           "Reference positions, an (n, 3) read-only view (m)")
       .def_property_readonly(
-          "displacement", [](py::object self) { return view(self.cast<PySimulation&>().sim->full_state().u, self); },
+          "displacement",
+          [](py::object self) {
+            PySimulation& p = self.cast<PySimulation&>();
+            const auto lock = locked(p);
+            return view(p.sim->full_state().u, self);
+          },
           "Displacements, an (n, 3) read-only view into the simulation (m): it changes as the simulation steps")
       .def_property_readonly(
-          "velocity", [](py::object self) { return view(self.cast<PySimulation&>().sim->full_state().velocity, self); },
+          "velocity",
+          [](py::object self) {
+            PySimulation& p = self.cast<PySimulation&>();
+            const auto lock = locked(p);
+            return view(p.sim->full_state().velocity, self);
+          },
           "Velocities, an (n, 3) read-only view (m/s)")
       .def_property_readonly(
           "positions",
           [](PySimulation& p) {
+            const auto lock = locked(p);
             const ph::Points x = p.sim->full_model().X + p.sim->full_state().u;
             return py::array_t<double>({x.cols(), Eigen::Index{3}}, {Eigen::Index{3 * sizeof(double)}, Eigen::Index{sizeof(double)}},
                                        x.data());
@@ -178,6 +210,7 @@ PYBIND11_MODULE(_pointhaptics, m) {
       .def_property_readonly(
           "forces",
           [](PySimulation& p) {
+            const auto lock = locked(p);
             const ph::Model& m = p.sim->model();
             ph::Workspace ws(m, 1);
             ph::compute_internal_forces(m, p.sim->state().u, ws);
@@ -194,6 +227,7 @@ PYBIND11_MODULE(_pointhaptics, m) {
                              })
       .def("energy",
            [](PySimulation& p) {
+             const auto lock = locked(p);
              const ph::EnergyTerms e = ph::strain_energy(p.sim->model(), p.sim->state().u);
              py::dict d;
              d["strain"] = e.total();
@@ -201,7 +235,13 @@ PYBIND11_MODULE(_pointhaptics, m) {
              return d;
            },
            "Strain and kinetic energy (J)")
-      .def("summary", [](PySimulation& p) { return summary_dict(p.sim->summary()); }, "Solver outcome, energies, timing")
+      .def(
+          "summary",
+          [](PySimulation& p) {
+            const auto lock = locked(p);
+            return summary_dict(p.sim->summary());
+          },
+          "Solver outcome, energies, timing")
       .def(
           "probe",
           [](PySimulation& p, const std::vector<std::array<double, 5>>& keyframes, double radius, const std::string& mode,
@@ -221,6 +261,7 @@ PYBIND11_MODULE(_pointhaptics, m) {
             ph::InteractiveResult r;
             {
               py::gil_scoped_release release;
+              const std::lock_guard<std::mutex> lock(p.mutex);
               r = ph::run_interactive(*p.sim, device, o);
             }
             py::array_t<double> log({static_cast<py::ssize_t>(r.log.size()), py::ssize_t{8}});

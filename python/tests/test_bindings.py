@@ -75,6 +75,58 @@ def test_long_runs_release_the_gil():
     assert abs(sim.time - 10.0) < 1e-9
 
 
+def test_calls_from_several_threads_follow_each_other():
+    # issue 21: probe() in one thread while another stepped or read forces crashed the interpreter, and two
+    # threads stepping one simulation gave wrong results; each object now serialises its calls
+    reference = ph.Simulation.from_scene(scene("beam_probe.toml"), threads=1)
+    for _ in range(40):
+        reference.step()
+    sim = ph.Simulation.from_scene(scene("beam_probe.toml"), threads=1)
+    errors = []
+
+    def stepper():
+        try:
+            for _ in range(20):
+                sim.step()
+        except Exception as e:  # noqa: BLE001 - reported below
+            errors.append(e)
+
+    threads = [threading.Thread(target=stepper) for _ in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert not errors
+    # 40 steps in all, whichever thread made them: the same state as 40 steps on one thread
+    assert abs(sim.time - reference.time) < 1e-12
+    np.testing.assert_array_equal(sim.displacement, reference.displacement)
+
+    # the probe on one thread while another steps and reads
+    def prober():
+        try:
+            sim.probe([[0, 0, 0, 0, 0], [0.2, 0, -0.03, 0, 0]], radius=0.01, duration=0.2)
+        except Exception as e:  # noqa: BLE001
+            errors.append(e)
+
+    def reader():
+        try:
+            for _ in range(50):
+                sim.step()
+                assert np.all(np.isfinite(sim.forces))
+                sim.energy()
+                sim.summary()
+        except Exception as e:  # noqa: BLE001
+            errors.append(e)
+
+    threads = [threading.Thread(target=prober), threading.Thread(target=reader)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert not errors, errors
+    assert np.all(np.isfinite(sim.displacement))
+
+
 def test_the_probe_pushes_and_the_log_comes_back():
     sim = ph.Simulation.from_scene(scene("beam_fixed_both_ends.toml"), threads=1)
     # press 2.5 cm down from two radii above the middle of the top face, hold

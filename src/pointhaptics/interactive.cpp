@@ -59,6 +59,7 @@ class ContactForces : public DynamicForces {
     contact.remap(model, new_index);
     scratch = Points::Zero(3, model.n_points);
   }
+  double max_point_stiffness() const override { return contact.params().stiffness; }
   bool add_stiffness(const Model&, const State&, Eigen::Matrix<double, 9, Eigen::Dynamic>& springs) override {
     contact.add_stiffness(springs);
     return last.contacts > 0;

@@ -91,6 +91,7 @@ class Simulation {
   std::unique_ptr<NewtonSolver> newton_;      ///< static
   std::unique_ptr<ImplicitSolver> implicit_;  ///< implicit
   double stable_dt_ = 0;
+  double min_free_mass_ = 0;  ///< kg, for the stable step with contact springs
   long long steps_ = 0, substeps_ = 0, iterations_ = 0, cg_iterations_ = 0;
   bool converged_ = true;
   long long budget_steps_ = 0;  ///< implicit steps the iteration budget ended above the tolerance

@@ -145,6 +145,26 @@ TEST(ActiveSet, AbsorbedPointsFollowAffineFieldsExactly) {
     }
 }
 
+TEST(ActiveSet, PointsNoLongerSimulatedStayWhereTheyWereAndAtRest) {
+  // issue 21: a point kept the velocity it had when it left the active set, and a later selection that
+  // took it in again brought that velocity back (energy from nowhere)
+  const Model full = bar();
+  const ActiveSet a = build_active_set(full, select(full, Vec3(0.09, 0.03, 0.015), levels()));
+  State f = State::at_rest(full);
+  f.u.setConstant(0.001);
+  f.velocity.setConstant(0.5);
+  const State active = a.restrict_state(f);
+  a.prolong_state(active, f);
+  index_t unsimulated = 0;
+  for (index_t j = 0; j < full.n_points; ++j) {
+    if (a.follows[j] >= 0 || a.active_of[j] >= 0) continue;
+    ++unsimulated;
+    ASSERT_EQ(f.velocity.col(j).norm(), 0.0) << "point " << j;
+    ASSERT_EQ(f.u.col(j), Vec3::Constant(0.001)) << "point " << j;
+  }
+  EXPECT_GT(unsimulated, 0);
+}
+
 TEST(ActiveSet, StaticSolveAgreesWithTheFullModelNearTheContact) {
   Model full = bar();
   // a point load at the free end's top edge, the contact

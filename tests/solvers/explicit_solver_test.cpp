@@ -32,7 +32,8 @@ double energy_drift(double amplitude, double dt_fraction) {
     const double s = std::sin(std::numbers::pi * X.x() / 0.135);
     state.u.col(i) = amplitude * s * Vec3(0, 1, 0.5 * (X.y() - 0.015) / 0.015);
   }
-  const double dt = dt_fraction * stable_time_step(model);
+  const double stable = stable_time_step(model);
+  const double dt = dt_fraction * stable;
   const double e0 = strain_energy(model, state.u).total();
   // symplectic Euler keeps velocities at half steps: the energy it conserves at step n pairs the strain
   // energy of u_n with 0.5 m v_(n-1/2) . v_(n+1/2) (exact for every mode of a linear system)
@@ -41,7 +42,8 @@ double energy_drift(double amplitude, double dt_fraction) {
   for (int step = 0; step < 10000; ++step) {
     const bool check = step % 50 == 0;
     const double strain = check ? strain_energy(model, state.u).total() : 0;
-    explicit_step(model, state, ws, dt, dt);
+    // one sub-step of dt every step (the pairing below needs equal steps): dt is within the stable step
+    if (explicit_step(model, state, ws, dt, stable).substeps != 1) ADD_FAILURE() << "sub-stepped at step " << step;
     if (check) {
       const double kinetic =
           0.5 * (v_before.cwiseProduct(state.velocity).colwise().sum().transpose().array() * model.mass.array()).sum();
@@ -118,6 +120,26 @@ TEST(ExplicitSolver, SubStepsKeepALargeStepStable) {
   const ExplicitStepStats stats = explicit_step(model, state, ws, 10 * stable, stable);
   EXPECT_EQ(stats.substeps, 10);
   EXPECT_TRUE(state.u.allFinite());
+}
+
+TEST(ExplicitSolver, AStretchedObjectTakesShorterSubSteps) {
+  // issue 21: the rest-state stable step diverged where a probe stretched soft tissue to |G| ~ 2; the step
+  // now follows the largest stiffening the last force evaluation saw
+  const Model model = free_beam();
+  Workspace ws(model, 1);
+  State state = State::at_rest(model);
+  compute_internal_forces(model, state.u, ws);
+  EXPECT_DOUBLE_EQ(strain_stiffening(model, ws), 1.0);
+  // a uniform stretch by half along x: (3 s^2 - 1) / 2 with s = 1.5
+  state.u.row(0) = 0.5 * model.X.row(0);
+  compute_internal_forces(model, state.u, ws);
+  EXPECT_NEAR(strain_stiffening(model, ws), (3 * 1.5 * 1.5 - 1) / 2, 1e-9);
+  // a step of 0.99 of the rest-state stable step: one sub-step at rest, ceil(0.99 sqrt(2.875)) = 2 stretched
+  const double stable = stable_time_step(model);
+  EXPECT_EQ(explicit_step(model, state, ws, 0.99 * stable, stable).substeps, 2);
+  State rest = State::at_rest(model);
+  compute_internal_forces(model, rest.u, ws);
+  EXPECT_EQ(explicit_step(model, rest, ws, 0.99 * stable, stable).substeps, 1);
 }
 
 TEST(ExplicitSolver, DivergenceIsANamedErrorNotNaN) {

@@ -64,6 +64,10 @@ struct LodParams {
   std::uint64_t seed = 1;        ///< of the random generator, so that runs are reproducible
   LodScheme scheme = LodScheme::RANDOM;
   double reselect = 0.5;         ///< re-select when the contact point moved farther than this (units of h)
+  /// no re-selection sooner than this after the last one (s of simulated time; contact onset excepted): a
+  /// take-over is a small shock, and a slow real-time session that re-selected every few milliseconds
+  /// diverged (issue 21)
+  double reselect_interval = 0.05;
   int min_neighbours = 12;       ///< a selected point's support widens until it reaches this many points
                                  ///< (or as many as it had in the full model, if fewer) ...
   double max_widening = 3.0;     ///< ... but never beyond this multiple of h

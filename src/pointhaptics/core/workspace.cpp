@@ -40,6 +40,7 @@ Workspace::Workspace(const Model& model, int n_threads) {
   acceleration = Points::Zero(3, model.n_points);
   padded_u = PaddedPoints::Zero(4, model.n_points);
   gradients = PaddedGradients::Zero(12, model.n_points);
+  chunk_scalars.assign(static_cast<std::size_t>(n_threads_), 0.0);
   chunk_forces.assign(n_threads_, PaddedPoints::Zero(4, model.n_points));
   if (n_threads_ > 1) pool_ = std::make_unique<ThreadPool>(n_threads_);
 }

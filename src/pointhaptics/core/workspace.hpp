@@ -39,6 +39,7 @@ class Workspace {
   PaddedPoints padded_u;                  ///< the displacement (or increment) the loop reads
   PaddedGradients gradients;              ///< G_i of the last stencil pass, by columns
   std::vector<PaddedPoints> chunk_forces; ///< per-chunk scatter targets, summed into the result  (n_threads)
+  std::vector<double> chunk_scalars;      ///< one value per chunk for reductions without atomics  (n_threads)
 
  private:
   void run_chunks(void (*call)(void*, int), void* context);

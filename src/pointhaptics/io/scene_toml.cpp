@@ -340,6 +340,8 @@ void read_lod(TableReader& r, LodSpec& l) {
   p.seed = static_cast<std::uint64_t>(seed_value);
   p.scheme = r.choice("scheme", "random", {"random", "dither"}) == "random" ? LodScheme::RANDOM : LodScheme::DITHER;
   p.reselect = r.number("reselect", p.reselect, positive, "must be > 0 (units of h)");
+  p.reselect_interval = r.number("reselect_interval", p.reselect_interval, [](double x) { return x >= 0 && x <= 1e3; },
+                                 "must lie in [0, 1000] (s)");
   const toml::node* mn = r.find("min_neighbours");
   const long long min_neighbours = r.integer("min_neighbours", p.min_neighbours);
   if (min_neighbours < 1 || min_neighbours > 1000) r.fail_at(*mn, "min_neighbours", "must lie in [1, 1000]");

@@ -207,7 +207,12 @@ void ActiveSet::prolong_state(const State& active, State& full) const {
   });
   for (index_t j = 0; j < static_cast<index_t>(follows.size()); ++j) {
     const index_t k = follows[j];
-    if (k < 0) continue;
+    if (k < 0) {
+      // not simulated: it stays where it was left, at rest. A velocity kept from when it was last simulated
+      // would come back when a later selection takes it in again: energy from nowhere (issue 21)
+      if (active_of[j] < 0) full.velocity.col(j).setZero();
+      continue;
+    }
     const Vec3 dX = follow_offset.col(j);
     full.u.col(j) = active.u.col(k) + gradient_cache_[2 * k] * dX;
     full.velocity.col(j) = active.velocity.col(k) + gradient_cache_[2 * k + 1] * dX;

@@ -31,7 +31,7 @@ struct ActiveSet {
   /// The active state from the full one (selected and frozen points copy theirs).
   State restrict_state(const State& full) const;
   /// Write the active state back: active points (selected and ring) copy, absorbed points follow by
-  /// first-order MLS, unsimulated points keep theirs. No allocation after the first call; not for two
+  /// first-order MLS, unsimulated points keep their displacement and are at rest (zero velocity). No allocation after the first call; not for two
   /// threads at once (it keeps the selected points' gradients in a buffer).
   void prolong_state(const State& active, State& full) const;
 

@@ -2,6 +2,10 @@
 /// @file Per-point kinematics and constitutive law: G_i (seed Eq. 10), F_i, Green strain (Eq. 2), SVK stress.
 #include <pointhaptics/core/model.hpp>
 
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+
 namespace pointhaptics {
 
 /// Displacement gradient G_i = sum_j (u_j - u_i) d_ij^T (seed Eq. 10); row a is the gradient of u_a.
@@ -21,6 +25,20 @@ inline Mat3 green_strain(const Mat3& G) { return 0.5 * (G + G.transpose() + G.tr
 /// St. Venant-Kirchhoff second Piola-Kirchhoff stress S = lambda tr(E) I + 2 mu E.
 inline Mat3 svk_stress(const Mat3& E, double lambda, double mu) {
   return lambda * E.trace() * Mat3::Identity() + 2.0 * mu * E;
+}
+
+/// How much stiffer St. Venant-Kirchhoff is at F = I + G than at rest: a bound on |dP/dF| over its rest
+/// value. dP = dF S + F C : sym(F^T dF), so |dP| <= (|S| + s3^2 |C|) |dF| with s3^2 the largest eigenvalue
+/// of F^T F; |S| <= |C| |E|, and the principal Green strains lie in [(s1^2 - 1) / 2, (s3^2 - 1) / 2]. The
+/// ratio is at most s3^2 + max(s3^2 - 1, 1 - s1^2) / 2: (3 s^2 - 1) / 2 in pure stretch, the uniaxial
+/// tangent; 1 at rest. The explicit stable step shrinks by its square root (issue 21: a probe pressed deep
+/// into soft tissue stretched the points under it to |G| ~ 2, and the rest-state step diverged).
+inline double svk_stiffening(const Mat3& G) {
+  const Mat3 C = (Mat3::Identity() + G).transpose() * (Mat3::Identity() + G);
+  Eigen::SelfAdjointEigenSolver<Mat3> eigen;
+  eigen.computeDirect(C, Eigen::EigenvaluesOnly);
+  const double s1 = eigen.eigenvalues()[0], s3 = eigen.eigenvalues()[2];
+  return std::max(1.0, s3 + 0.5 * std::max(s3 - 1.0, 1.0 - s1));
 }
 
 /// Cofactor matrix cof F = det(F) F^-T; its rows are (r1 x r2, r2 x r0, r0 x r1) for rows r_a of F.

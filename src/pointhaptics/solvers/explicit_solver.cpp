@@ -2,6 +2,7 @@
 
 #include <pointhaptics/core/error.hpp>
 #include <pointhaptics/geometry/neighbour_search.hpp>
+#include <pointhaptics/mechanics/deformation.hpp>
 #include <pointhaptics/mechanics/forces.hpp>
 #include <pointhaptics/mechanics/tangent.hpp>
 
@@ -78,13 +79,50 @@ double stable_time_step(const Model& model, double safety, int lanczos_steps) {
   return safety * 2.0 / std::sqrt(omega2);
 }
 
+double stable_time_step_with_springs(double stable_dt, double spring_stiffness, double min_mass, double safety) {
+  if (!(spring_stiffness > 0) || !(min_mass > 0) || !std::isfinite(min_mass)) return stable_dt;
+  const double omega = 2 * safety / stable_dt;
+  return 2 * safety / std::sqrt(omega * omega + spring_stiffness / min_mass);
+}
+
+double min_free_mass(const Model& model) {
+  double m = std::numeric_limits<double>::infinity();
+  for (index_t i = 0; i < model.n_points; ++i)
+    if (!model.fixed[i]) m = std::min(m, model.mass[i]);
+  return m;
+}
+
 Vec3 prescribed_displacement(const FixedGroup& group, double t) {
   const double s = group.ramp > 0 ? std::clamp(t / group.ramp, 0.0, 1.0) : 1.0;
   return s * group.displacement;
 }
 
+namespace {
+const double covered_stiffening = 1.25;  // stiffening the safety factor of stable_time_step() absorbs
+}  // namespace
+
+double strain_stiffening(const Model& model, Workspace& ws) {
+  double* chunk_max = ws.chunk_scalars.data();
+  ws.for_each_chunk([&](int chunk) {
+    double m = 1;
+    const index_t end = std::min(ws.chunk_end(chunk), model.stencil_end());
+    for (index_t i = ws.chunk_begin(chunk); i < end; ++i) {
+      Mat3 G;
+      for (int c = 0; c < 3; ++c) G.col(c) = ws.gradients.block<3, 1>(4 * c, i);
+      m = std::max(m, svk_stiffening(G));
+    }
+    chunk_max[chunk] = m;
+  });
+  double m = 1;
+  for (int c = 0; c < ws.n_threads(); ++c) m = std::max(m, chunk_max[c]);
+  return std::isfinite(m) ? m : 1.0;
+}
+
 ExplicitStepStats explicit_step(const Model& model, State& state, Workspace& ws, double dt, double stable_dt,
                                 DynamicForces* extra) {
+  // the rest-state step, shortened where the last force evaluation found the material stretched beyond
+  // what its safety factor covers (0.8 leaves omega^2 a margin of 1.56; a quarter is kept for stiffening)
+  stable_dt *= std::min(1.0, std::sqrt(covered_stiffening / strain_stiffening(model, ws)));
   const int n_sub = std::max(1, static_cast<int>(std::ceil(dt / stable_dt * (1 - 1e-12))));
   const double h = dt / n_sub;
   const double c = model.material.damping;

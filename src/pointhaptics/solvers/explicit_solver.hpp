@@ -17,6 +17,19 @@ double stable_time_step(const Model& model, double safety = 0.8, int lanczos_ste
 /// speed sqrt((lambda + 2 mu + k_v + alpha E) / rho) of the densest point. Used when Lanczos cannot run.
 double estimated_stable_time_step(const Model& model, double safety = 0.7);
 
+/// The stable step once springs of up to `spring_stiffness` (N/m, the largest eigenvalue of one point's
+/// 3x3 spring block) act on points of mass at least `min_mass` (kg): omega_max^2 of M^-1 (K + S) is at
+/// most omega_K^2 + spring_stiffness / min_mass (Weyl), so the step shrinks to safety x 2 / sqrt of that.
+/// `stable_dt` is the springless step stable_time_step() gave with the same safety.
+double stable_time_step_with_springs(double stable_dt, double spring_stiffness, double min_mass, double safety = 0.8);
+
+/// The largest svk_stiffening() over the gradients of the workspace's last force evaluation (1 at rest):
+/// the factor by which the material is stiffer than the rest state the stable step was computed for.
+double strain_stiffening(const Model& model, Workspace& ws);
+
+/// The lightest free point's mass, kg (infinity if none is free).
+double min_free_mass(const Model& model);
+
 /// Prescribed displacement of a fixed group at time t (ramped in linearly over group.ramp).
 Vec3 prescribed_displacement(const FixedGroup& group, double t);
 
@@ -24,7 +37,9 @@ struct ExplicitStepStats {
   int substeps = 0;  ///< sub-steps taken for this step
 };
 
-/// Advance the state by dt with ceil(dt / stable step) equal symplectic Euler sub-steps:
+/// Advance the state by dt with ceil(dt / stable step) equal symplectic Euler sub-steps, the stable step
+/// shortened by sqrt(1.25 / strain_stiffening()) where the material is stretched by more than its safety
+/// factor covers:
 ///   v <- (v + h M^-1 (f_int + f_ext)) / (1 + h c),   u <- u + h v   (c: mass-proportional damping)
 /// Held points follow their prescribed displacement. Throws Error naming the step and point if a
 /// displacement becomes non-finite or grows beyond 100 times the object's size (divergence).
@@ -39,6 +54,9 @@ class DynamicForces {
   /// semi-definite), added into `springs`, for implicit steps; false if there is none to add. Called
   /// after add() at the same state.
   virtual bool add_stiffness(const Model&, const State&, Eigen::Matrix<double, 9, Eigen::Dynamic>&) { return false; }
+  /// The largest stiffness (N/m) these forces can put on one point (an upper bound of the largest
+  /// eigenvalue of its 3x3 block), for the explicit stable step; 0 if they have no springs.
+  virtual double max_point_stiffness() const { return 0; }
 };
 
 /// extra, if given, is evaluated at every sub-step and added to the constant loads.
