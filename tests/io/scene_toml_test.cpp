@@ -2,6 +2,7 @@
 #include <pointhaptics/core/error.hpp>
 #include <pointhaptics/io/scene_toml.hpp>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -145,6 +146,34 @@ TEST(SceneToml, MissingRequiredKeys) {
 TEST(SceneToml, SyntaxErrorNamesTheLine) {
   const std::string e = error_of("density = 1000.0", "density = = 1000.0");
   EXPECT_NE(e.find("bad.toml:" + std::to_string(line_of("density = 1000.0")) + ": TOML syntax error"), std::string::npos) << e;
+}
+
+TEST(SceneToml, DeeplyNestedKeysAreANamedErrorNotACrash) {
+  // issue 21: a dotted key or table header of some ten thousand levels overflowed toml++'s recursion
+  const std::string object = "[object]\nshape = \"box\"\nsize = [0.1, 0.1, 0.1]\nspacing = 0.05\n";
+  std::string chain = "a";
+  for (int k = 0; k < 100000; ++k) chain += ".a";
+  std::string quoted = object;  // a quoted key first, on the line after a header
+  quoted.append("[x]\n\"a\" . ").append(chain).append(" = 1\n");
+  const std::pair<std::string, int> cases[] = {
+      {object + chain + " = 1\n", 5}, {object + "[" + chain + "]\nx = 1\n", 5}, {quoted, 6}};
+  for (const auto& [text, line] : cases) {
+    try {
+      parse_scene(text, "deep.toml");
+      ADD_FAILURE() << "accepted";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("deep.toml:" + std::to_string(line) +
+                                           ": a key or table header nested more than 64 levels deep"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  // dots in values, strings and comments are not keys: many on one line are fine
+  std::string floats = "keyframes = [";
+  for (int k = 0; k < 200; ++k) floats.append(fmt::format("[{}.5, 0.0, 0.5, 0.0], ", k));
+  const std::string fine = object + "# a.b.c.d.e.f.g.h.i.j.k.l.m.n.o.p.q.r.s.t.u.v.w.x.y.z.a.b.c.d.e.f.g.h.i.j.k.l.m.n.o.p.q.r.s.t.u.v.w.x.y.z.a\n"
+                           "[probe]\n" + floats + "]\n";
+  EXPECT_NO_THROW(parse_scene(fine, "fine.toml"));
 }
 
 TEST(SceneToml, ReadsTheLodSection) {

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -28,6 +29,50 @@ struct Context {
   std::string file;
   std::string base_dir;
 };
+
+// toml++ recurses once per level of a dotted key or table header (a.b.c = 1, [a.b.c]), and some ten
+// thousand levels overflow the stack (issue 21: a segfault); no scene needs more than a few. So before
+// parsing, every chain of dot-separated keys (bare or quoted, outside strings and comments) is counted.
+void check_key_nesting(std::string_view text, const std::string& name) {
+  constexpr int max_levels = 64;
+  int line = 1, dots = 0, chain_line = 1;
+  const auto bare = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-'; };
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == '"' || c == '\'') {
+      // a string (a quoted key, or a value): skipped whole, multi-line ones too; the chain goes on
+      const bool multi = text.substr(i, 3) == std::string(3, c);
+      const std::size_t open = multi ? 3 : 1;
+      std::size_t j = i + open;
+      for (; j < text.size(); ++j) {
+        if (c == '"' && text[j] == '\\') {
+          ++j;
+          continue;
+        }
+        if (text[j] == '\n') {
+          if (!multi) break;
+          ++line;
+        }
+        if (multi ? text.substr(j, 3) == std::string(3, c) : text[j] == c) break;
+      }
+      i = j + open - 1;
+      continue;
+    }
+    if (c == '#') {
+      while (i + 1 < text.size() && text[i + 1] != '\n') ++i;
+      continue;
+    }
+    if (c == '.') {
+      if (dots++ == 0) chain_line = line;
+      if (dots > max_levels)
+        throw Error(fmt::format("{}:{}: a key or table header nested more than {} levels deep", name, chain_line, max_levels));
+      continue;
+    }
+    if (bare(c) || c == ' ' || c == '\t') continue;
+    dots = 0;  // '=', ']', ',', a newline ...: the chain ends
+    if (c == '\n') ++line;
+  }
+}
 
 [[noreturn]] void fail(const Context& ctx, const toml::source_region& where, std::string_view key, std::string_view what) {
   throw Error(fmt::format("{}:{}: {}: {}", ctx.file, where.begin.line, key, what));
@@ -371,6 +416,7 @@ void read_array_of_tables(TableReader& root, std::string_view key, Read read) {
 Scene parse_scene(std::string_view text, const std::string& name, const std::string& base_dir) {
   Context ctx{name, base_dir};
   toml::table root;
+  check_key_nesting(text, name);
   try {
     root = toml::parse(text, name);
   } catch (const toml::parse_error& e) {
