@@ -15,9 +15,13 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <atomic>
 #include <chrono>
-#include <optional>
+#include <csignal>
 #include <cstdio>
+#include <optional>
+#include <string>
+#include <vector>
 
 namespace ph = pointhaptics;
 
@@ -79,8 +83,29 @@ void print_summary(ph::Simulation& sim, const ph::RunSummary& s, double setup_s)
              s.step_ms_mean, s.steps_per_s);
 }
 
+// SIGINT or SIGTERM during a run: stop at the next step and write what was reached (issue 21)
+std::atomic<bool> interrupted{false};
+extern "C" void on_interrupt(int) { interrupted.store(true); }
+
+// An output that fails (a full disk) is reported, and the others are still written
+struct OutputErrors {
+  std::vector<std::string> messages;
+  template <class Write>
+  void attempt(Write&& write) {
+    try {
+      write();
+    } catch (const ph::Error& e) {
+      messages.push_back(e.what());
+    }
+  }
+};
+
 int run_command(const RunOptions& opt) {
   const auto start = std::chrono::steady_clock::now();
+  // every output is checked before anything is computed: a long run must not end in "cannot write"
+  if (!opt.json.empty()) ph::check_output_path(opt.json, "--json");
+  if (!opt.csv.empty()) ph::check_output_path(opt.csv, "--csv");
+  if (!opt.force_log.empty()) ph::check_output_path(opt.force_log, "--force-log");
   const ph::Scene scene = ph::read_scene_file(opt.scene);
   ph::Simulation sim(ph::build_scene_model(scene), scene.solver, opt.threads);
   if (scene.lod.present) sim.enable_lod(scene.lod.params, ph::scene_lod_contact(scene, sim.model()));
@@ -90,15 +115,20 @@ int run_command(const RunOptions& opt) {
     vtk.emplace(opt.vtk);
     ph::add_vtk_frame(*vtk, sim);  // the initial state
   }
+  interrupted.store(false);
+  std::signal(SIGINT, on_interrupt);
+  std::signal(SIGTERM, on_interrupt);
   ph::InteractiveResult interactive;
+  OutputErrors errors;
   if (scene.probe.present) {
     // with a probe: the haptic loop at 1 kHz and the simulation, in real time unless asked otherwise
     const std::unique_ptr<ph::Device> device = ph::make_scene_device(scene);
     ph::InteractiveOptions options = ph::scene_interactive_options(scene, sim.full_model());
     options.real_time = !opt.deterministic;
     options.log = !opt.force_log.empty();
+    options.stop = &interrupted;
     interactive = ph::run_interactive(sim, *device, options);
-    if (!opt.force_log.empty()) ph::write_haptic_log(opt.force_log, interactive.log);
+    if (!opt.force_log.empty()) errors.attempt([&] { ph::write_haptic_log(opt.force_log, interactive.log); });
   } else {
     ph::cli::ProgressBar bar(!opt.quiet);
     // frames: every vtk_every steps (default: about 50 over the run), and the last state
@@ -106,22 +136,26 @@ int run_command(const RunOptions& opt) {
                                   ? 1
                                   : std::max<long long>(1, std::llround(std::ceil(scene.solver.duration / scene.solver.dt - 1e-9)));
     const long long every = opt.vtk_every > 0 ? opt.vtk_every : std::max<long long>(1, n_steps / 50);
-    long long step = 0;
-    sim.run(scene.solver.duration, [&](double f) {
-      bar.update(f);
-      if (vtk && ++step % every == 0 && step < n_steps) ph::add_vtk_frame(*vtk, sim);
-    });
+    for (long long step = 1; step <= n_steps && !interrupted.load(); ++step) {
+      sim.step();
+      bar.update(static_cast<double>(step) / static_cast<double>(n_steps));
+      if (vtk && step % every == 0 && step < n_steps) errors.attempt([&] { ph::add_vtk_frame(*vtk, sim); });
+    }
   }
-  if (vtk) ph::add_vtk_frame(*vtk, sim);  // the last state (an interactive run writes only the first and the last)
-  if (!opt.csv.empty()) ph::write_points_csv(opt.csv, sim);
+  std::signal(SIGINT, SIG_DFL);
+  std::signal(SIGTERM, SIG_DFL);
+  // the last state (an interactive run writes only the first and the last)
+  if (vtk) errors.attempt([&] { ph::add_vtk_frame(*vtk, sim); });
+  if (!opt.csv.empty()) errors.attempt([&] { ph::write_points_csv(opt.csv, sim); });
   ph::RunSummary summary = sim.summary();
+  summary.interrupted = interrupted.load();
   if (scene.probe.present) {
     summary.haptic_ticks = interactive.haptic.ticks;
     summary.haptic_rate_hz = interactive.haptic.rate_hz;
     summary.haptic_period_p99_us = interactive.haptic.period_p99_us;
     summary.haptic_max_force_n = interactive.haptic.max_force_n;
   }
-  if (!opt.json.empty()) ph::write_result_json(opt.json, sim.full_model(), sim.full_state(), summary);
+  if (!opt.json.empty()) errors.attempt([&] { ph::write_result_json(opt.json, sim.full_model(), sim.full_state(), summary); });
   if (!opt.quiet) {
     print_summary(sim, summary, setup_s);
     if (scene.probe.present) {
@@ -133,6 +167,13 @@ int run_command(const RunOptions& opt) {
                  interactive.max_contacts, interactive.simulation_steps);
     }
   }
+  for (const std::string& message : errors.messages) fmt::print(stderr, "pointhaptics: error: {}\n", message);
+  if (summary.interrupted) {
+    fmt::print(stderr, "pointhaptics: {}: interrupted at t = {:.6g} s; the outputs hold the state reached\n", opt.scene,
+               sim.state().time);
+    return 130;
+  }
+  if (!errors.messages.empty()) return 1;
   if (scene.probe.present && interactive.haptic.device_failed) {
     fmt::print(stderr, "pointhaptics: {}: the device failed: {} (force set to zero, run stopped)\n", opt.scene,
                interactive.haptic.device_error);

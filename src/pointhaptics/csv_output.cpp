@@ -1,6 +1,7 @@
 #include <pointhaptics/csv_output.hpp>
 
 #include <pointhaptics/core/error.hpp>
+#include <pointhaptics/io/output_file.hpp>
 #include <pointhaptics/vtk_output.hpp>
 
 #include <fmt/format.h>
@@ -21,17 +22,14 @@ void write_points_csv(const std::string& path, Simulation& sim) {
   const std::vector<double>& fixed = field("fixed");
   const Model& m = sim.full_model();
   const State& s = sim.full_state();
-  try {
-    auto out = fmt::output_file(path);
+  write_text_file(path, "--csv", [&](TextOutput& out) {
     out.print("index,x,y,z,ux,uy,uz,von_mises,strain_energy_density,active,fixed\n");
     for (index_t i = 0; i < m.n_points; ++i) {
       const std::size_t k = static_cast<std::size_t>(i);
       out.print("{},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{},{}\n", i, m.X(0, i), m.X(1, i), m.X(2, i), s.u(0, i),
                 s.u(1, i), s.u(2, i), vm[k], w[k], static_cast<int>(active[k]), static_cast<int>(fixed[k]));
     }
-  } catch (const std::system_error& e) {
-    throw Error(fmt::format("{}: cannot write the CSV file ({})", path, e.what()));
-  }
+  });
 }
 
 }  // namespace pointhaptics

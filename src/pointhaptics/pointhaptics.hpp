@@ -3,6 +3,7 @@
 #include <pointhaptics/core/error.hpp>
 #include <pointhaptics/core/model.hpp>
 #include <pointhaptics/core/state.hpp>
+#include <pointhaptics/io/output_file.hpp>
 #include <pointhaptics/io/result_json.hpp>
 #include <pointhaptics/io/scene_toml.hpp>
 #include <pointhaptics/mechanics/energy.hpp>

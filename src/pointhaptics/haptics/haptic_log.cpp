@@ -1,5 +1,7 @@
 #include <pointhaptics/haptics/haptic_log.hpp>
 
+#include <pointhaptics/io/output_file.hpp>
+
 #include <fmt/format.h>
 #include <fmt/os.h>
 
@@ -11,16 +13,13 @@
 namespace pointhaptics {
 
 void write_haptic_log(const std::string& path, const std::vector<HapticLogRow>& rows) {
-  try {
-    auto out = fmt::output_file(path);
+  write_text_file(path, "haptic log", [&](TextOutput& out) {
     out.print("t,x,y,z,vx,vy,vz,buttons,fx,fy,fz\n");
     for (const HapticLogRow& r : rows)
       out.print("{:.6f},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{},{:.9g},{:.9g},{:.9g}\n", r.t, r.position.x(),
                 r.position.y(), r.position.z(), r.velocity.x(), r.velocity.y(), r.velocity.z(), r.buttons, r.force.x(),
                 r.force.y(), r.force.z());
-  } catch (const std::exception& e) {
-    throw Error(fmt::format("{}: cannot write the haptic log ({})", path, e.what()));
-  }
+  });
 }
 
 std::vector<HapticLogRow> read_haptic_log(const std::string& path) {

@@ -1,6 +1,7 @@
 #include <pointhaptics/io/result_json.hpp>
 
 #include <pointhaptics/core/error.hpp>
+#include <pointhaptics/io/output_file.hpp>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -35,6 +36,7 @@ std::string result_json(const Model& model, const State& state, const RunSummary
                    {"residual", s.residual},    {"steps", s.steps},         {"substeps", s.substeps},
                    {"stable_dt", s.stable_dt}, {"cg_iterations", s.cg_iterations}};
   if (!s.failure.empty()) doc["solver"]["failure"] = s.failure;
+  if (s.interrupted) doc["solver"]["interrupted"] = true;
   if (s.solver_kind == "implicit") doc["solver"]["budget_steps"] = s.budget_steps;
   doc["energy"] = {{"strain", s.strain_energy}, {"kinetic", s.kinetic_energy}};
   doc["timing"] = {{"wall_s", s.wall_s}, {"step_ms_mean", s.step_ms_mean}, {"steps_per_s", s.steps_per_s}};
@@ -73,10 +75,8 @@ std::string result_json(const Model& model, const State& state, const RunSummary
 }
 
 void write_result_json(const std::string& path, const Model& model, const State& state, const RunSummary& summary) {
-  std::ofstream out(path);
-  if (!out) throw Error(fmt::format("{}: cannot write the result file", path));
-  out << result_json(model, state, summary) << '\n';
-  if (!out) throw Error(fmt::format("{}: writing the result failed", path));
+  const std::string text = result_json(model, state, summary);
+  write_text_file(path, "result JSON", [&](TextOutput& out) { out.print("{}\n", text); });
 }
 
 }  // namespace pointhaptics

@@ -37,6 +37,7 @@ struct RunSummary {
   long long cg_iterations = 0;  ///< static, implicit: conjugate-gradient iterations in all
   long long budget_steps = 0;   ///< implicit with an iteration budget: steps it ended above the tolerance
   std::string failure;          ///< static: why it did not converge (empty when it did)
+  bool interrupted = false;     ///< the run was stopped (SIGINT, SIGTERM) before its end: the state reached
   std::vector<Vec3> reactions;  ///< per fixed group, N
   // haptic loop (runs with a probe)
   long long haptic_ticks = 0;

@@ -1,6 +1,7 @@
 #include <pointhaptics/io/vtk.hpp>
 
 #include <pointhaptics/core/error.hpp>
+#include <pointhaptics/io/output_file.hpp>
 
 #include <fmt/format.h>
 #include <fmt/os.h>
@@ -15,8 +16,7 @@ void write_vtp(const std::string& path, const Points& points, const std::vector<
     if (a.components < 1 || static_cast<Eigen::Index>(a.values.size()) != a.components * n)
       throw Error(fmt::format("{}: array \"{}\" has {} values for {} points of {} components", path, a.name, a.values.size(), n,
                               a.components));
-  try {
-    auto out = fmt::output_file(path);
+  write_text_file(path, "VTK frame", [&](TextOutput& out) {
     out.print("<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\">\n<PolyData>\n");
     out.print("<Piece NumberOfPoints=\"{}\" NumberOfVerts=\"{}\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n", n, n);
     out.print("<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n");
@@ -43,9 +43,7 @@ void write_vtp(const std::string& path, const Points& points, const std::vector<
       out.print("</DataArray>\n");
     }
     out.print("</PointData>\n</Piece>\n</PolyData>\n</VTKFile>\n");
-  } catch (const std::system_error& e) {
-    throw Error(fmt::format("{}: cannot write the VTK file ({})", path, e.what()));
-  }
+  });
 }
 
 VtkSeries::VtkSeries(std::string folder, std::string base) : folder_(std::move(folder)), base_(std::move(base)) {
@@ -65,14 +63,11 @@ std::string VtkSeries::add(double time, const Points& points, const std::vector<
 }
 
 void VtkSeries::write_collection() const {
-  try {
-    auto out = fmt::output_file(pvd_);
+  write_text_file(pvd_, "VTK collection", [&](TextOutput& out) {
     out.print("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"1.0\" byte_order=\"LittleEndian\">\n<Collection>\n");
     for (const auto& [t, file] : entries_) out.print("<DataSet timestep=\"{:.9g}\" group=\"\" part=\"0\" file=\"{}\"/>\n", t, file);
     out.print("</Collection>\n</VTKFile>\n");
-  } catch (const std::system_error& e) {
-    throw Error(fmt::format("{}: cannot write the VTK collection ({})", pvd_, e.what()));
-  }
+  });
 }
 
 }  // namespace pointhaptics
