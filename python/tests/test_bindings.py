@@ -75,6 +75,21 @@ def test_long_runs_release_the_gil():
     assert abs(sim.time - 10.0) < 1e-9
 
 
+@pytest.mark.parametrize("solver", ["explicit", "implicit", "static"])
+def test_the_displacement_view_follows_every_solver(solver):
+    # issue 14: the implicit and static solvers swapped buffers with the state, so the view went stale
+    g = np.stack(np.meshgrid(np.arange(6), np.arange(3), np.arange(3), indexing="ij"), axis=-1).reshape(-1, 3) * 0.01
+    forces = np.zeros_like(g)
+    forces[g[:, 0] > 0.049, 1] = -0.01
+    sim = ph.Simulation.from_points(g, spacing=0.01, fixed=g[:, 0] < 1e-9, forces=forces, damping=5.0,
+                                    solver=solver, dt=2e-3, threads=1)
+    u = sim.displacement
+    for _ in range(3):
+        sim.step()
+        np.testing.assert_allclose(u, sim.positions - sim.reference, atol=1e-15)
+    assert u[:, 1].min() < -1e-6
+
+
 def test_calls_from_several_threads_follow_each_other():
     # issue 21: probe() in one thread while another stepped or read forces crashed the interpreter, and two
     # threads stepping one simulation gave wrong results; each object now serialises its calls

@@ -79,9 +79,9 @@ void Simulation::prepare_solver(double stable_dt) {
   stable_dt_ = stable_dt > 0 ? stable_dt : stable_time_step(model_);
   min_free_mass_ = min_free_mass(model_);
   extra_forces_ = Points::Zero(3, model_.n_points);
-  newton_.reset();
+  static_.reset();
   implicit_.reset();
-  if (solver_.kind == SolverKind::STATIC) newton_ = std::make_unique<NewtonSolver>(model_);
+  if (solver_.kind == SolverKind::STATIC) static_ = std::make_unique<StaticSolver>(model_);
   if (solver_.kind == SolverKind::IMPLICIT) implicit_ = std::make_unique<ImplicitSolver>(model_);
 }
 
@@ -256,7 +256,7 @@ void Simulation::step() {
       break;
     }
     case SolverKind::STATIC: {
-      const StaticStats stats = solve_static(model_, state_, ws_, *newton_, newton_settings());
+      const StaticStats stats = static_->solve(model_, state_, ws_, newton_settings());
       iterations_ += stats.iterations;
       cg_iterations_ += stats.cg_iterations;
       substeps_ += stats.load_steps;

@@ -8,6 +8,7 @@
 #include <pointhaptics/solvers/explicit_solver.hpp>
 #include <pointhaptics/solvers/implicit_solver.hpp>
 #include <pointhaptics/solvers/newton.hpp>
+#include <pointhaptics/solvers/static_solver.hpp>
 
 #include <functional>
 #include <memory>
@@ -88,7 +89,7 @@ class Simulation {
   Points extra_forces_;
   Eigen::Matrix<double, 9, Eigen::Dynamic> springs_;
   DynamicForces* dynamic_forces_ = nullptr;
-  std::unique_ptr<NewtonSolver> newton_;      ///< static
+  std::unique_ptr<StaticSolver> static_;      ///< static
   std::unique_ptr<ImplicitSolver> implicit_;  ///< implicit
   double stable_dt_ = 0;
   double min_free_mass_ = 0;  ///< kg, for the stable step with contact springs

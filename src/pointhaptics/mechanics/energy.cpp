@@ -10,12 +10,14 @@
 
 namespace pointhaptics {
 
-EnergyTerms strain_energy(const Model& model, const Points& u) {
+EnergyTerms strain_energy(const Model& model, const Points& u, std::vector<Mat3>* scratch) {
   const Csr& nbr = model.neighbours;
   const double kv = model.material.volume_stiffness;
   const bool hourglass = model.material.hourglass > 0;
   // every gradient first: the hourglass term of a pair reads both ends' gradients
-  std::vector<Mat3> gradients(model.n_points);
+  std::vector<Mat3> own;
+  std::vector<Mat3>& gradients = scratch ? *scratch : own;
+  gradients.resize(static_cast<std::size_t>(model.n_points));
   tbb::parallel_for(tbb::blocked_range<index_t>(0, model.n_points, 512), [&](const tbb::blocked_range<index_t>& range) {
     for (index_t i = range.begin(); i != range.end(); ++i) gradients[i] = displacement_gradient(model, u, i);  // seed Eq. 10
   });

@@ -2,6 +2,8 @@
 /// @file The total elastic energy of a displacement field, term by term (independent of the force code).
 #include <pointhaptics/core/model.hpp>
 
+#include <vector>
+
 namespace pointhaptics {
 
 struct EnergyTerms {
@@ -11,8 +13,10 @@ struct EnergyTerms {
   double total() const { return elastic + volume + hourglass; }
 };
 
-/// The strain energy W(u) whose exact negative gradient compute_internal_forces() returns.
-EnergyTerms strain_energy(const Model& model, const Points& u);
+/// The strain energy W(u) whose exact negative gradient compute_internal_forces() returns. `gradients`:
+/// scratch for every point's G_i (resized to n, so a caller that keeps it allocates once); without it the
+/// call allocates its own.
+EnergyTerms strain_energy(const Model& model, const Points& u, std::vector<Mat3>* gradients = nullptr);
 
 /// Kinetic energy 0.5 sum_i m_i |v_i|^2, J.
 double kinetic_energy(const Model& model, const Points& velocity);

@@ -47,7 +47,7 @@ NewtonStats ImplicitSolver::step(const Model& model, State& state, Workspace& ws
                             "iterations); try a smaller dt or a larger solver.max_iterations",
                             state.time, stats.failure, stats.residual, stats.iterations));
   state.velocity = (u_next_ - state.u) / dt;
-  state.u.swap(u_next_);
+  state.u = u_next_;  // copied, not swapped: NumPy views point into the state's buffer
   state.time = t_next;
   return stats;
 }

@@ -19,6 +19,7 @@ NewtonSolver::NewtonSolver(const Model& model) {
   const index_t n = model.n_points;
   for (Points* p : {&r_, &dx_, &trial_, &cg_r_, &cg_z_, &cg_p_, &cg_q_}) p->setZero(3, n);
   blocks_.setZero(9, n);
+  energy_gradients_.resize(static_cast<std::size_t>(n));
 }
 
 void NewtonSolver::mask_held(const Model& model, Points& x) const {
@@ -27,7 +28,7 @@ void NewtonSolver::mask_held(const Model& model, Points& x) const {
 }
 
 double NewtonSolver::energy(const Model& model, const NewtonProblem& problem, const Points& u) const {
-  double pi = strain_energy(model, u).total();
+  double pi = strain_energy(model, u, &energy_gradients_).total();
   for (index_t i = 0; i < model.n_points; ++i) {
     if (model.fixed[i]) continue;
     pi -= problem.load->col(i).dot(u.col(i));
@@ -184,7 +185,7 @@ NewtonStats NewtonSolver::solve(const Model& model, const NewtonProblem& problem
       const bool armijo = !lowers_residual && std::isfinite(pi_trial) && pi_trial <= pi_now - 1e-4 * alpha * slope &&
                           std::abs(pi_trial - pi_now) > 1e-9 * std::max(std::abs(pi_now), 1e-300);
       if (armijo || lowers_residual) {
-        u.swap(trial_);
+        u = trial_;  // copied, not swapped: u is often the state, whose buffer NumPy views point into
         r_.swap(r_trial);
         rel = rel_trial;
         pi = pi_trial;  // NaN when not computed: current_pi() evaluates it if it is ever needed

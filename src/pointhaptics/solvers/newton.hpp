@@ -2,6 +2,8 @@
 /// @file Newton's method with a line search and preconditioned conjugate gradients on the matrix-free
 /// tangent: the core of the static solver and of implicit dynamics.
 #include <pointhaptics/core/workspace.hpp>
+
+#include <vector>
 #include <pointhaptics/mechanics/tangent.hpp>
 
 namespace pointhaptics {
@@ -63,6 +65,7 @@ class NewtonSolver {
   TangentMode preconditioner_mode_ = TangentMode::EXACT;
   Eigen::Matrix<double, 9, Eigen::Dynamic> blocks_;  ///< inverted diagonal blocks of K + k M
   Points r_, dx_, trial_, cg_r_, cg_z_, cg_p_, cg_q_;
+  mutable std::vector<Mat3> energy_gradients_;  ///< scratch of energy(): every G_i  (n)
 };
 
 }  // namespace pointhaptics

@@ -6,10 +6,11 @@
 
 namespace pointhaptics {
 
-StaticStats solve_static(const Model& model, State& state, Workspace& ws, NewtonSolver& newton,
-                         const NewtonSettings& settings) {
+namespace {
+
+StaticStats load_stepping(const Model& model, State& state, Workspace& ws, NewtonSolver& newton, const NewtonSettings& settings,
+                          Points& load, Points& trial) {
   StaticStats stats;
-  Points load(3, model.n_points), trial(3, model.n_points);
   double reached = 0.0, increment = 1.0;
   const double min_increment = 1e-4;
   NewtonProblem problem;
@@ -18,7 +19,8 @@ StaticStats solve_static(const Model& model, State& state, Workspace& ws, Newton
     const double factor = std::min(1.0, reached + increment);
     load = factor * model.f_ext;
     // predictor: the last equilibrium, scaled to the new load factor (exact for a linear response)
-    trial = reached > 0 ? Points(state.u * (factor / reached)) : state.u;
+    if (reached > 0) trial = state.u * (factor / reached);
+    else trial = state.u;
     for (const FixedGroup& group : model.fixed_groups)
       for (index_t i : group.points) trial.col(i) = factor * group.displacement;
     const NewtonStats ns = newton.solve(model, problem, trial, ws, settings);
@@ -44,6 +46,21 @@ StaticStats solve_static(const Model& model, State& state, Workspace& ws, Newton
   stats.converged = reached >= 1.0;
   state.velocity.setZero();
   return stats;
+}
+
+}  // namespace
+
+StaticStats solve_static(const Model& model, State& state, Workspace& ws, NewtonSolver& newton,
+                         const NewtonSettings& settings) {
+  Points load(3, model.n_points), trial(3, model.n_points);
+  return load_stepping(model, state, ws, newton, settings, load, trial);
+}
+
+StaticSolver::StaticSolver(const Model& model)
+    : newton_(model), load_(Points::Zero(3, model.n_points)), trial_(Points::Zero(3, model.n_points)) {}
+
+StaticStats StaticSolver::solve(const Model& model, State& state, Workspace& ws, const NewtonSettings& settings) {
+  return load_stepping(model, state, ws, newton_, settings, load_, trial_);
 }
 
 }  // namespace pointhaptics

@@ -25,4 +25,17 @@ struct StaticStats {
 StaticStats solve_static(const Model& model, State& state, Workspace& ws, NewtonSolver& newton,
                          const NewtonSettings& settings);
 
+/// solve_static() with its Newton solver and load-stepping buffers sized once for the model, so that a
+/// solve allocates nothing.
+class StaticSolver {
+ public:
+  explicit StaticSolver(const Model& model);
+  StaticStats solve(const Model& model, State& state, Workspace& ws, const NewtonSettings& settings);
+
+ private:
+  NewtonSolver newton_;
+  Points load_, trial_;  ///< the load of the increment and Newton's iterate  (3 x n)
+  friend StaticStats solve_static(const Model&, State&, Workspace&, NewtonSolver&, const NewtonSettings&);
+};
+
 }  // namespace pointhaptics
