@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <bit>
 #include <cstdint>
@@ -123,6 +125,24 @@ TEST(PointCloudFile, HeldPointsOfAFileAreHeldInTheScene) {
   const Model m = build_scene_model(scene);
   ASSERT_EQ(m.n_points, 64);
   for (index_t i = 0; i < m.n_points; ++i) EXPECT_EQ(m.fixed[i] != 0, m.X(1, i) < 1e-9) << "point " << i;
+}
+
+TEST(PointCloudFile, DevicesFifosAndFoldersAreRefusedBeforeReading) {
+  // issue 21: a FIFO blocked the reader and /dev/zero fed it without end
+  const std::string fifo = (std::filesystem::temp_directory_path() / "ph_cloud_fifo.xyz").string();
+  std::filesystem::remove(fifo);
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0644), 0);
+  for (const std::string& path : {fifo, std::string("/dev/zero"), std::filesystem::temp_directory_path().string()}) {
+    try {
+      read_point_cloud(path, 0.01);
+      ADD_FAILURE() << path << " accepted";
+    } catch (const Error& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(path), std::string::npos) << what;
+      EXPECT_TRUE(what.find("not a regular file") != std::string::npos || what.find("is a folder") != std::string::npos) << what;
+    }
+  }
+  std::filesystem::remove(fifo);
 }
 
 TEST(PointCloudFile, MalformedTruncatedAndHostileFilesAreNamedErrors) {

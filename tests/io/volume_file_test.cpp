@@ -166,6 +166,17 @@ TEST_F(VolumeFile, BadVolumesAreNamedErrors) {
   const std::string bad_nrrd = dir + "/bad.nrrd";
   std::ofstream(bad_nrrd) << "NRRD0004\ntype: float\ndimension: 3\nsizes: 4 4\nencoding: raw\n\n";
   EXPECT_NE(error_of([&] { read_volume(bad_nrrd); }).find("bad.nrrd: not a readable NRRD file"), std::string::npos);
+  // issue 21: a small file whose header declares gigabytes is refused before anything is allocated
+  const std::string huge = dir + "/huge.nrrd";
+  std::ofstream(huge) << "NRRD0004\ntype: float\ndimension: 3\nsizes: 2000 2000 2000\nencoding: raw\nendian: little\n\n0000";
+  EXPECT_NE(error_of([&] { read_volume(huge); }).find("huge.nrrd: the header declares 8e+09 voxels"), std::string::npos);
+  const std::string short_raw = dir + "/short.nrrd";
+  std::ofstream(short_raw) << "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 700 700 700\nencoding: raw\nendian: little\n\n0000";
+  EXPECT_NE(error_of([&] { read_volume(short_raw); }).find("short.nrrd: truncated: the header declares 343000000 bytes"),
+            std::string::npos);
+  // a device or a folder is not an image
+  EXPECT_NE(error_of([] { read_volume("/dev/zero.nii"); }).find("no such file"), std::string::npos);
+  EXPECT_NE(error_of([&] { read_volume(dir); }).find("is a folder"), std::string::npos);
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include <pointhaptics/haptics/haptic_log.hpp>
 
+#include <pointhaptics/io/input_file.hpp>
 #include <pointhaptics/io/output_file.hpp>
 
 #include <fmt/format.h>
@@ -23,6 +24,7 @@ void write_haptic_log(const std::string& path, const std::vector<HapticLogRow>& 
 }
 
 std::vector<HapticLogRow> read_haptic_log(const std::string& path) {
+  check_input_file(path, "haptic log");
   std::ifstream in(path);
   if (!in) throw Error(fmt::format("{}: cannot open the haptic log", path));
   std::vector<HapticLogRow> rows;

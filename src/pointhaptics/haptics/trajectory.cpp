@@ -1,6 +1,7 @@
 #include <pointhaptics/haptics/trajectory.hpp>
 
 #include <pointhaptics/core/error.hpp>
+#include <pointhaptics/io/input_file.hpp>
 
 #include <fmt/format.h>
 
@@ -23,6 +24,7 @@ Trajectory::Trajectory(std::vector<Keyframe> keyframes) : keyframes_(std::move(k
 }
 
 Trajectory Trajectory::from_csv(const std::string& path) {
+  check_input_file(path, "trajectory file");
   std::ifstream in(path);
   if (!in) throw Error(fmt::format("{}: cannot open the trajectory file", path));
   std::vector<Keyframe> frames;

@@ -1,6 +1,7 @@
 #include <pointhaptics/io/mesh_file.hpp>
 
 #include <pointhaptics/core/error.hpp>
+#include <pointhaptics/io/input_file.hpp>
 
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
@@ -15,7 +16,7 @@
 namespace pointhaptics {
 
 TriangleMesh read_mesh(const std::string& path) {
-  if (!std::filesystem::exists(path)) throw Error(fmt::format("{}: cannot open the mesh file", path));
+  check_input_file(path, "mesh file");
   Assimp::Importer importer;
   const aiScene* scene = importer.ReadFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
   if (!scene) throw Error(fmt::format("{}: cannot read the mesh: {}", path, importer.GetErrorString()));

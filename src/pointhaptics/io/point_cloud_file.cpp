@@ -1,6 +1,7 @@
 #include <pointhaptics/io/point_cloud_file.hpp>
 
 #include <pointhaptics/core/error.hpp>
+#include <pointhaptics/io/input_file.hpp>
 #include <pointhaptics/geometry/neighbour_search.hpp>
 
 #include <fmt/format.h>
@@ -430,11 +431,9 @@ PointCloud parse_point_cloud(std::string_view data, std::string_view format, con
 
 PointCloud read_point_cloud(const std::string& path, double spacing) {
   const std::string ext = lower(std::filesystem::path(path).extension().string());
+  const auto size = check_input_file(path, "point cloud file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(fmt::format("{}: cannot open the point cloud file", path));
-  std::error_code ec;
-  const auto size = std::filesystem::file_size(path, ec);
-  if (ec) throw Error(fmt::format("{}: cannot read the point cloud file ({})", path, ec.message()));
   std::string data(size, '\0');
   in.read(data.data(), static_cast<std::streamsize>(size));
   if (!in) throw Error(fmt::format("{}: reading the point cloud file failed", path));

@@ -1,6 +1,7 @@
 #include <pointhaptics/io/scene_toml.hpp>
 
 #include <pointhaptics/core/error.hpp>
+#include <pointhaptics/io/input_file.hpp>
 
 #include <fmt/format.h>
 #include <toml++/toml.h>
@@ -462,6 +463,7 @@ Scene parse_scene(std::string_view text, const std::string& name, const std::str
 }
 
 Scene read_scene_file(const std::string& path) {
+  check_input_file(path, "scene file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(fmt::format("{}: cannot open the scene file", path));
   std::stringstream buffer;

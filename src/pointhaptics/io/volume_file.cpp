@@ -1,6 +1,7 @@
 #include <pointhaptics/io/volume_file.hpp>
 
 #include <pointhaptics/core/error.hpp>
+#include <pointhaptics/io/input_file.hpp>
 
 #include <fmt/format.h>
 #include <nifti/nifti2_io.h>
@@ -87,7 +88,30 @@ VolumeImage read_nifti(const std::string& path) {
   return image;
 }
 
+// A NRRD's header alone (the data skipped), so that its sizes are checked before the data is allocated:
+// a small file declaring 2000^3 voxels allocated gigabytes and hung (issue 21).
+void check_nrrd_header(const std::string& path) {
+  std::unique_ptr<Nrrd, Nrrd* (*)(Nrrd*)> header(nrrdNew(), nrrdNuke);
+  std::unique_ptr<NrrdIoState, NrrdIoState* (*)(NrrdIoState*)> io(nrrdIoStateNew(), nrrdIoStateNix);
+  io->skipData = AIR_TRUE;
+  if (nrrdLoad(header.get(), path.c_str(), io.get())) return;  // nrrdLoad below names the problem
+  double voxels = 1;
+  for (unsigned a = 0; a < header->dim; ++a) voxels *= static_cast<double>(header->axis[a].size);
+  if (voxels > max_voxels)
+    throw Error(fmt::format("{}: the header declares {:.3g} voxels, more than this reader takes ({:.3g})", path, voxels, max_voxels));
+  // raw data in the same file must be there before that much memory is taken
+  const bool attached = io->dataFNArr->len == 0;
+  if (attached && io->encoding == nrrdEncodingRaw && header->type != nrrdTypeBlock) {
+    const double needed = voxels * static_cast<double>(nrrdTypeSize[header->type]);
+    const double size = static_cast<double>(std::filesystem::file_size(path));
+    if (size < needed)
+      throw Error(fmt::format("{}: truncated: the header declares {:.0f} bytes of raw data, the file has {:.0f} bytes in all", path,
+                              needed, size));
+  }
+}
+
 VolumeImage read_nrrd(const std::string& path) {
+  check_nrrd_header(path);
   std::unique_ptr<Nrrd, Nrrd* (*)(Nrrd*)> nrrd(nrrdNew(), nrrdNuke);
   if (nrrdLoad(nrrd.get(), path.c_str(), nullptr)) {
     char* err = biffGetDone(NRRD);
@@ -130,7 +154,7 @@ bool is_volume_file(const std::string& path) {
 }
 
 VolumeImage read_volume(const std::string& path) {
-  if (!std::filesystem::exists(path)) throw Error(fmt::format("{}: cannot open the volume image", path));
+  check_input_file(path, "volume image");
   VolumeImage image = ends_with(path, ".nrrd") || ends_with(path, ".nhdr") ? read_nrrd(path) : read_nifti(path);
   for (float v : image.values)
     if (!std::isfinite(v)) throw Error(fmt::format("{}: an intensity is not finite", path));

@@ -1,0 +1,14 @@
+#pragma once
+/// @file Input files checked before a reader opens them.
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+namespace pointhaptics {
+
+/// Check that `path` is a regular file that can be read and return its size in bytes. A folder, a FIFO or
+/// a device (/dev/zero) would block a reader or feed it without end (issue 21), so each is a named error;
+/// `what` says which input it is (e.g. "point cloud").
+std::uintmax_t check_input_file(const std::string& path, std::string_view what);
+
+}  // namespace pointhaptics
