@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
+
 namespace pointhaptics {
 namespace {
 
@@ -65,6 +67,27 @@ double tip_deflection(const Simulation& sim) {
       ++n;
     }
   return -tip / n;
+}
+
+TEST(SceneBuilder, ObjectsTooBigForTheMachineAreRefusedBeforeTheyAreBuilt) {
+  // issue 21: 10^7-10^9 points allocated gigabytes first and failed minutes later as "internal error"
+  Scene scene = parse_scene(cantilever);
+  EXPECT_EQ(estimated_points(scene), 21 * 5 * 5);
+  const ModelEstimate e = estimate_model(estimated_points(scene), scene.kernel, scene.object.spacing);
+  EXPECT_NEAR(e.neighbours_per_point, 32.5, 0.1);  // h = 2 spacings: 4/3 pi 2^3 - 1
+  scene.object.spacing = 1e-5;  // 1.5e4 x 3e3 x 3e3 points
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    build_scene_model(scene);
+    FAIL() << "built";
+  } catch (const Error& err) {
+    EXPECT_NE(std::string(err.what()).find("would need about"), std::string::npos) << err.what();
+  }
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 1.0);
+  // a limit of the caller's, below what the model needs
+  scene.object.spacing = 0.0075;
+  EXPECT_THROW(build_scene_model(scene, 1e6), Error);
+  EXPECT_NO_THROW(build_scene_model(scene, 1e9));
 }
 
 TEST(Simulation, StaticSolveAgreesWithSettledDynamics) {

@@ -18,6 +18,7 @@
 #include <atomic>
 #include <chrono>
 #include <csignal>
+#include <cstdint>
 #include <cstdio>
 #include <optional>
 #include <string>
@@ -37,6 +38,7 @@ struct RunOptions {
   bool deterministic = false;
   bool quiet = false;
   int threads = 0;
+  std::uint64_t max_memory = 0;  ///< bytes; 0: the memory available
 };
 
 void print_summary(ph::Simulation& sim, const ph::RunSummary& s, double setup_s) {
@@ -107,7 +109,7 @@ int run_command(const RunOptions& opt) {
   if (!opt.csv.empty()) ph::check_output_path(opt.csv, "--csv");
   if (!opt.force_log.empty()) ph::check_output_path(opt.force_log, "--force-log");
   const ph::Scene scene = ph::read_scene_file(opt.scene);
-  ph::Simulation sim(ph::build_scene_model(scene), scene.solver, opt.threads);
+  ph::Simulation sim(ph::build_scene_model(scene, static_cast<double>(opt.max_memory)), scene.solver, opt.threads);
   if (scene.lod.present) sim.enable_lod(scene.lod.params, ph::scene_lod_contact(scene, sim.model()));
   const double setup_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::optional<ph::VtkSeries> vtk;
@@ -198,6 +200,9 @@ int main(int argc, char** argv) {
   CLI::App* run_cmd = app.add_subcommand("run", "Simulate a scene file as it says (headless)");
   run_cmd->add_option("scene", run.scene, "Scene file (TOML)")->required();
   run_cmd->add_option("--json", run.json, "Write the result JSON to FILE");
+  run_cmd->add_option("--max-memory", run.max_memory,
+                      "Refuse an object whose model would need more memory than this (e.g. 4GB; default: the memory available)")
+      ->transform(CLI::AsSizeValue(false));
   run_cmd->add_flag("--quiet,-q", run.quiet, "Print nothing but errors");
   run_cmd->add_option("--force-log", run.force_log, "With a [probe]: write the haptic log (CSV, one row per tick) to FILE");
   run_cmd->add_option("--vtk", run.vtk, "Write a ParaView time series (DIR/frame.pvd and DIR/frame_*.vtp)");
@@ -307,6 +312,10 @@ int main(int argc, char** argv) {
     if (*lod_error_cmd) return ph::experiments::run_lod_error_experiment(lod_error);
   } catch (const ph::Error& e) {
     std::fprintf(stderr, "pointhaptics: error: %s\n", e.what());
+    return 1;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "pointhaptics: error: out of memory: this run needs more memory than the machine could give (a coarser "
+                         "spacing, fewer points or --max-memory to refuse such runs before they start)\n");
     return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "pointhaptics: internal error: %s\n", e.what());

@@ -13,8 +13,59 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <numbers>
+#include <limits>
+#include <fstream>
 
 namespace pointhaptics {
+
+ModelEstimate estimate_model(double n_points, const KernelParams& kernel, double spacing) {
+  const double ratio = kernel.support > 0 ? kernel.support / spacing : kernel.support_factor;
+  ModelEstimate e;
+  e.points = n_points;
+  e.neighbours_per_point = std::max(0.0, 4.0 / 3.0 * std::numbers::pi * ratio * ratio * ratio - 1);
+  e.bytes = 20e6 + n_points * (400 + 50 * e.neighbours_per_point);
+  return e;
+}
+
+double estimated_points(const Scene& scene) {
+  const ObjectSpec& o = scene.object;
+  const double s = o.spacing;
+  switch (o.shape) {
+    case ShapeKind::BOX: {
+      double n = 1;
+      for (int a = 0; a < 3; ++a) n *= std::floor(o.size[a] / s + 1e-9) + 1;
+      return n;
+    }
+    case ShapeKind::SPHERE: return 4.0 / 3.0 * std::numbers::pi * std::pow(o.radius / s, 3);
+    case ShapeKind::HALF_SPHERE: return 2.0 / 3.0 * std::numbers::pi * std::pow(o.radius / s, 3);
+    case ShapeKind::FILE: return NAN;
+  }
+  return NAN;
+}
+
+double available_memory() {
+  std::ifstream meminfo("/proc/meminfo");
+  std::string key;
+  double kb = 0;
+  std::string unit;
+  while (meminfo >> key >> kb >> unit)
+    if (key == "MemAvailable:") return kb * 1024;
+  return std::numeric_limits<double>::infinity();
+}
+
+void check_model_fits(double n_points, const Scene& scene, double max_memory) {
+  if (!std::isfinite(n_points)) return;
+  const bool asked = max_memory > 0;
+  const double limit = asked ? max_memory : available_memory();
+  const ModelEstimate e = estimate_model(n_points, scene.kernel, scene.object.spacing);
+  if (n_points > static_cast<double>(std::numeric_limits<index_t>::max()) / 64 || e.bytes > limit)
+    throw Error(fmt::format("{}:{}: object: {:.3g} points with about {:.0f} neighbours each would need about {:.3g} GB, more than "
+                            "{} ({:.3g} GB); use a coarser spacing{}",
+                            scene.path, scene.object.line, n_points, e.neighbours_per_point, e.bytes / 1e9,
+                            asked ? "--max-memory" : "the memory available", limit / 1e9,
+                            asked ? "" : " (or allow more with --max-memory)"));
+}
 
 PointCloud sample_object(const Scene& scene) {
   const ObjectSpec& o = scene.object;
@@ -54,8 +105,11 @@ std::vector<index_t> points_in(const Model& model, const Aabb& box) {
 
 }  // namespace
 
-Model build_scene_model(const Scene& scene) {
+Model build_scene_model(const Scene& scene, double max_memory) {
+  // too big for the machine: refused before anything is allocated (files once they are read)
+  check_model_fits(estimated_points(scene), scene, max_memory);
   const PointCloud cloud = sample_object(scene);
+  check_model_fits(static_cast<double>(cloud.X.cols()), scene, max_memory);
   Model model = build_model(cloud, scene.material, scene.kernel);
 
   // held points, one group per [[fixed]] table

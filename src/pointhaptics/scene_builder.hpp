@@ -6,6 +6,24 @@
 
 namespace pointhaptics {
 
+/// What a model of n points will take, estimated before anything is built: neighbours per point from the
+/// support (4/3 pi (h / spacing)^3 on a lattice) and bytes (measured: about 400 B per point and 50 B per
+/// neighbour pair, model, state and solver scratch together; 2 kB per point at h = 2 spacings).
+struct ModelEstimate {
+  double points = 0;
+  double neighbours_per_point = 0;
+  double bytes = 0;
+};
+ModelEstimate estimate_model(double n_points, const KernelParams& kernel, double spacing);
+/// The points the scene's object will have, before it is sampled: exact for a box, the volume over
+/// spacing^3 for a sphere or half-sphere; NaN for a file (known once read).
+double estimated_points(const Scene& scene);
+/// Memory the system can give this process now (MemAvailable of /proc/meminfo), bytes; infinity if unknown.
+double available_memory();
+/// Throws Error with the estimate if a model of n points would need more than max_memory bytes (0: the
+/// available memory): a run too big for the machine is refused before it allocates.
+void check_model_fits(double n_points, const Scene& scene, double max_memory);
+
 /// Sample the scene's object into points.
 PointCloud sample_object(const Scene& scene);
 
@@ -13,7 +31,9 @@ PointCloud sample_object(const Scene& scene);
 /// external loads. A traction's total force is spread over the points in its box in proportion to their
 /// volume (on a vertex-grid face this is proportional to each point's share of the face area).
 /// Throws Error naming the scene file and line for a box that selects no point or a point index out of range.
-Model build_scene_model(const Scene& scene);
+/// The object's size and memory are checked first (check_model_fits), against max_memory bytes (0: the
+/// memory available now).
+Model build_scene_model(const Scene& scene, double max_memory = 0);
 
 /// Where a scene's levels of detail start (reference configuration, m): lod.contact if given; else with a
 /// [probe], the point of the object below the probe's origin (the top centre by default; an interactive

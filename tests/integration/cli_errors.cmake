@@ -25,6 +25,8 @@ expect_error(out_of_range "${good}[material]\npoisson = 0.7\n" "material.poisson
 expect_error(nan_value "${good}[material]\ndensity = nan\n" "material.density: nan is not a finite number")
 expect_error(syntax "${good}[material\n" "TOML syntax error")
 expect_error(missing_cloud "[object]\nshape = \"file\"\nfile = \"no-such-cloud.xyz\"\nspacing = 0.01\n" "no-such-cloud.xyz")
+expect_error(too_big_for_the_machine "[object]\nshape = \"box\"\nsize = [1.0, 1.0, 1.0]\nspacing = 0.0005\n" "would need about .* GB, more than the memory available")
+expect_error(deeply_nested_key "${good}a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a = 1\n" "nested more than 64 levels")
 expect_error(diverging "${good}[material]\nyoung = 1e5\n[[load]]\nkind = \"point\"\npoint = 0\nforce = [1e9, 0, 0]\n" "diverged at t =")
 execute_process(COMMAND ${EXE} run ${WORK}/does-not-exist.toml RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
 if(rc EQUAL 0 OR NOT err MATCHES "does-not-exist.toml")
