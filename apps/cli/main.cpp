@@ -127,10 +127,20 @@ int run_command(const RunOptions& opt) {
     const std::unique_ptr<ph::Device> device = ph::make_scene_device(scene);
     ph::InteractiveOptions options = ph::scene_interactive_options(scene, sim.full_model());
     options.real_time = !opt.deterministic;
-    options.log = !opt.force_log.empty();
     options.stop = &interrupted;
+    // the force log is streamed to its file as the run goes: any length in bounded memory
+    options.log = false;
+    std::optional<ph::TextOutput> force_log;
+    if (!opt.force_log.empty()) {
+      force_log.emplace(opt.force_log, "--force-log");
+      ph::print_haptic_log_header(*force_log);
+      options.log_sink = [&force_log](const ph::HapticLogRow& row) { ph::print_haptic_log_row(*force_log, row); };
+    }
     interactive = ph::run_interactive(sim, *device, options);
-    if (!opt.force_log.empty()) errors.attempt([&] { ph::write_haptic_log(opt.force_log, interactive.log); });
+    if (force_log) errors.attempt([&] { force_log->commit(); });
+    if (interactive.log_dropped > 0)
+      errors.messages.push_back(fmt::format("--force-log {}: {} haptic ticks were not logged (the simulation thread fell behind)",
+                                            opt.force_log, interactive.log_dropped));
   } else {
     ph::cli::ProgressBar bar(!opt.quiet);
     // frames: every vtk_every steps (default: about 50 over the run), and the last state

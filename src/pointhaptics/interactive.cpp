@@ -178,11 +178,18 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
     Simulation& sim;
     ~Detach() { sim.set_dynamic_forces(nullptr); }
   } detach{sim};
-  if (options.log && !std::isfinite(options.duration)) throw Error("interactive run: a force log needs a finite duration");
-  const auto ticks = options.log ? static_cast<std::size_t>(std::ceil(options.duration * options.haptic_rate)) + 16 : 0;
-  HapticLoop loop(device, options.mapping, gains, options.rules, options.haptic_rate, ticks);
-  const auto stopped = [&options] { return options.stop && options.stop->load(std::memory_order_acquire); };
+  const bool streamed = static_cast<bool>(options.log_sink);
+  if (options.log && !streamed && !std::isfinite(options.duration))
+    throw Error("interactive run: a force log kept in memory needs a finite duration (stream it to a file)");
+  // the loop holds a few seconds of rows; this thread takes them after every step
+  HapticLoop loop(device, options.mapping, gains, options.rules, options.haptic_rate,
+                  options.log || streamed ? static_cast<std::size_t>(4 * options.haptic_rate) + 64 : 0);
   InteractiveResult result;
+  const auto take_log = [&] {
+    if (streamed) loop.take_log(options.log_sink);
+    else if (options.log) loop.take_log([&](const HapticLogRow& row) { result.log.push_back(row); });
+  };
+  const auto stopped = [&options] { return options.stop && options.stop->load(std::memory_order_acquire); };
   const auto start = std::chrono::steady_clock::now();
   const double t0 = sim.state().time;
   // display frames: at most one per display_period (of wall time in real time, else of simulated time),
@@ -210,6 +217,7 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
       result.max_contacts = std::max(result.max_contacts, simulation_step(sim, contact, loop, options.real_time));
       ++result.simulation_steps;
       display(false);
+      take_log();
     }
     loop.stop();
   } else {
@@ -219,6 +227,7 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
     for (long long k = 1; k <= n_ticks && !stopped(); ++k) {
       const double t = k * h;
       if (!loop.tick(t, h)) break;
+      take_log();
       while (sim.state().time - t0 < t - 1e-12) {
         result.max_contacts =
             std::max(result.max_contacts, simulation_step(sim, contact, loop, options.real_time));
@@ -230,7 +239,8 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
   display(true);
   result.simulation_wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   result.haptic = loop.stats();
-  result.log = loop.log();
+  take_log();
+  result.log_dropped = loop.log_dropped();
   return result;
 }
 

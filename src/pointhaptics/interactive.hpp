@@ -5,6 +5,7 @@
 #include <pointhaptics/simulation.hpp>
 
 #include <atomic>
+#include <functional>
 #include <memory>
 
 namespace pointhaptics {
@@ -35,7 +36,10 @@ struct InteractiveOptions {
   double coupling_safety = 0.5;  ///< fraction of the device's stable stiffness the coupling may use
   ForceRules rules;
   bool real_time = true;         ///< threads on the wall clock; false: one thread, deterministic, simulated time
-  bool log = true;               ///< keep the force log (one row per haptic tick)
+  bool log = true;               ///< keep the force log (one row per haptic tick) in the result
+  /// If set, the force log is streamed here instead (on the simulation's thread, as the run goes), so that
+  /// a run of any length logs in bounded memory (a --force-log file).
+  std::function<void(const HapticLogRow&)> log_sink;
   /// If set, the simulation publishes a DisplayFrame after every step here (lock-free; the reader, e.g. a
   /// viewer thread, calls update() and reads front()). Its frames must be sized for the object's points
   /// (all of them, with levels of detail too).
@@ -50,7 +54,8 @@ struct InteractiveOptions {
 
 struct InteractiveResult {
   HapticStats haptic;
-  std::vector<HapticLogRow> log;
+  std::vector<HapticLogRow> log;  ///< with options.log and no log_sink
+  long long log_dropped = 0;      ///< ticks not logged: the simulation thread did not take them in time
   long long simulation_steps = 0;
   double simulation_wall_s = 0;
   int max_contacts = 0;

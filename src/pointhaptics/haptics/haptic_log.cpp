@@ -13,13 +13,17 @@
 
 namespace pointhaptics {
 
+void print_haptic_log_header(TextOutput& out) { out.print("t,x,y,z,vx,vy,vz,buttons,fx,fy,fz\n"); }
+
+void print_haptic_log_row(TextOutput& out, const HapticLogRow& r) {
+  out.print("{:.6f},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{},{:.9g},{:.9g},{:.9g}\n", r.t, r.position.x(), r.position.y(),
+            r.position.z(), r.velocity.x(), r.velocity.y(), r.velocity.z(), r.buttons, r.force.x(), r.force.y(), r.force.z());
+}
+
 void write_haptic_log(const std::string& path, const std::vector<HapticLogRow>& rows) {
   write_text_file(path, "haptic log", [&](TextOutput& out) {
-    out.print("t,x,y,z,vx,vy,vz,buttons,fx,fy,fz\n");
-    for (const HapticLogRow& r : rows)
-      out.print("{:.6f},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{},{:.9g},{:.9g},{:.9g}\n", r.t, r.position.x(),
-                r.position.y(), r.position.z(), r.velocity.x(), r.velocity.y(), r.velocity.z(), r.buttons, r.force.x(),
-                r.force.y(), r.force.z());
+    print_haptic_log_header(out);
+    for (const HapticLogRow& r : rows) print_haptic_log_row(out, r);
   });
 }
 

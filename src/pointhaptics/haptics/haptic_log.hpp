@@ -2,6 +2,7 @@
 /// @file The haptic log: one row per tick (time, device position and velocity, buttons, force), as CSV.
 /// The replay device reads the same format back.
 #include <pointhaptics/haptics/haptic_loop.hpp>
+#include <pointhaptics/io/output_file.hpp>
 
 #include <string>
 #include <vector>
@@ -10,6 +11,9 @@ namespace pointhaptics {
 
 /// Header: t,x,y,z,vx,vy,vz,buttons,fx,fy,fz (s, m, m/s, bit mask, N; device frame).
 void write_haptic_log(const std::string& path, const std::vector<HapticLogRow>& rows);
+/// The same file streamed row by row (a run of any length): the header, then one call per row.
+void print_haptic_log_header(TextOutput& out);
+void print_haptic_log_row(TextOutput& out, const HapticLogRow& row);
 /// Throws Error naming the file and line for a malformed, non-finite or out-of-order row.
 std::vector<HapticLogRow> read_haptic_log(const std::string& path);
 

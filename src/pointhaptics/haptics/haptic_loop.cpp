@@ -17,10 +17,10 @@ HapticLoop::HapticLoop(Device& device, const WorkspaceMapping& mapping, const Co
       gains_(gains),
       renderer_(device.specs(), rules),
       period_(1.0 / rate_hz),
-      device_max_force_(device.specs().max_force) {
+      device_max_force_(device.specs().max_force),
+      log_(log_capacity) {
   if (!(rate_hz > 0) || !(mapping.scale > 0) || !(gains.stiffness > 0))
     throw Error("haptic loop: the rate, the workspace scale and the coupling stiffness must be positive");
-  log_.reserve(log_capacity);
 }
 
 HapticLoop::~HapticLoop() { stop(); }
@@ -62,7 +62,8 @@ bool HapticLoop::tick(double t, double dt) {
     frame.force = f;
     frame.tick = ticks_ + 1;
     frames_.publish();
-    if (log_.size() < log_.capacity()) log_.push_back({t, state.position, state.velocity, state.buttons, f});
+    if (log_.capacity() > 0 && !log_.push({t, state.position, state.velocity, state.buttons, f}))
+      log_dropped_.fetch_add(1, std::memory_order_relaxed);
     max_force_ = std::max(max_force_, f.norm());
     ++ticks_;
     last_t_ = t;

@@ -53,7 +53,8 @@ struct HapticStats {
 
 class HapticLoop {
  public:
-  /// log_capacity: rows kept for the force log (reserved now; ticks beyond it are not logged).
+  /// log_capacity: rows of the force log the loop can hold until the consumer takes them with
+  /// take_log() (0: no log); a tick that finds it full is not logged, and counted.
   HapticLoop(Device& device, const WorkspaceMapping& mapping, const CouplingGains& gains, const ForceRules& rules = {},
              double rate_hz = 1000.0, std::size_t log_capacity = 0);
   ~HapticLoop();
@@ -68,7 +69,16 @@ class HapticLoop {
   TripleBuffer<ContactModel>& contact_models() { return models_; }  ///< the simulation publishes here
   TripleBuffer<HapticFrame>& frames() { return frames_; }           ///< and reads the probe here
   HapticStats stats() const;                                        ///< after stop() (or between ticks)
-  const std::vector<HapticLogRow>& log() const { return log_; }     ///< after stop()
+  /// Consumer (one thread, e.g. the simulation's): hand every logged row not yet taken to `sink`, oldest
+  /// first; returns how many.
+  template <class Sink>
+  std::size_t take_log(Sink&& sink) {
+    std::size_t n = 0;
+    for (HapticLogRow row; log_.pop(row); ++n) sink(row);
+    return n;
+  }
+  /// Rows the loop could not log because the consumer had not taken the earlier ones.
+  long long log_dropped() const { return log_dropped_.load(std::memory_order_relaxed); }
   const Vec3& probe() const { return probe_; }
   /// Safe from any thread: the device has failed and the loop stopped commanding it.
   bool device_failed() const { return failed_flag_.load(std::memory_order_acquire); }
@@ -85,7 +95,8 @@ class HapticLoop {
   double device_max_force_;  ///< read once: specs() builds a string, which the haptic thread must not
   TripleBuffer<ContactModel> models_;
   TripleBuffer<HapticFrame> frames_;
-  std::vector<HapticLogRow> log_;
+  SpscRing<HapticLogRow> log_;
+  std::atomic<long long> log_dropped_{0};
   Vec3 probe_ = Vec3::Constant(NAN);
   bool failed_ = false;
   std::string error_;

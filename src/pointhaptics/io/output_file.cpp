@@ -32,14 +32,32 @@ void check_output_path(const std::string& path, std::string_view what) {
     throw Error(fmt::format("{} {}: the folder {} cannot be written", what, path, parent.string()));
 }
 
+TextOutput::TextOutput(std::string path, std::string what) : path_(std::move(path)), what_(std::move(what)) {
+  std::error_code ec;
+  const fs::file_status status = fs::status(path_, ec);
+  if (fs::is_directory(status)) throw Error(fmt::format("{} {}: is a folder, not a file", what_, path_));
+  // a device or FIFO is written in place: renaming a file over /dev/full would replace the device
+  in_place_ = fs::exists(status) && !fs::is_regular_file(status);
+  target_ = in_place_ ? path_ : path_ + ".partial";
+  fd_ = ::open(target_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd_ < 0) throw Error(fmt::format("{} {}: cannot write ({})", what_, path_, std::strerror(errno)));
+}
+
+TextOutput::~TextOutput() {
+  if (fd_ < 0) return;
+  ::close(fd_);
+  std::error_code ec;
+  if (!in_place_) fs::remove(target_, ec);
+}
+
 void TextOutput::flush() {
   const char* data = buffer_.data();
   std::size_t left = buffer_.size();
-  while (left > 0) {
+  while (left > 0 && error_ == 0) {
     const ssize_t n = ::write(fd_, data, left);
     if (n < 0) {
-      if (errno == EINTR) continue;
-      throw std::system_error(errno, std::generic_category());
+      if (errno != EINTR) error_ = errno;
+      continue;
     }
     data += n;
     left -= static_cast<std::size_t>(n);
@@ -47,35 +65,26 @@ void TextOutput::flush() {
   buffer_.clear();
 }
 
-void write_text_file(const std::string& path, std::string_view what, const std::function<void(TextOutput&)>& write) {
+void TextOutput::commit() {
+  flush();
+  const int fd = fd_;
+  fd_ = -1;
+  if (::close(fd) != 0 && error_ == 0) error_ = errno;
   std::error_code ec;
-  const fs::file_status status = fs::status(path, ec);
-  if (fs::is_directory(status)) throw Error(fmt::format("{} {}: is a folder, not a file", what, path));
-  // a device or FIFO is written in place: renaming a file over /dev/full would replace the device
-  const bool in_place = fs::exists(status) && !fs::is_regular_file(status);
-  const std::string target = in_place ? path : path + ".partial";
-  const int fd = ::open(target.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) throw Error(fmt::format("{} {}: cannot write ({})", what, path, std::strerror(errno)));
-  const auto give_up = [&](const std::string& reason) {
-    if (!in_place) fs::remove(target, ec);
-    throw Error(fmt::format("{} {}: cannot write ({})", what, path, reason));
-  };
-  try {
-    TextOutput out(fd);
-    write(out);
-    out.flush();
-  } catch (const std::system_error& e) {
-    ::close(fd);
-    give_up(e.code().message());
-  } catch (...) {
-    ::close(fd);
-    if (!in_place) fs::remove(target, ec);
-    throw;
+  if (error_ == 0 && !in_place_) {
+    fs::rename(target_, path_, ec);
+    if (ec) error_ = ec.value();
   }
-  if (::close(fd) != 0) give_up(std::strerror(errno));
-  if (in_place) return;
-  fs::rename(target, path, ec);
-  if (ec) give_up(ec.message());
+  if (error_ != 0) {
+    if (!in_place_) fs::remove(target_, ec);
+    throw Error(fmt::format("{} {}: cannot write ({})", what_, path_, std::strerror(error_)));
+  }
+}
+
+void write_text_file(const std::string& path, std::string_view what, const std::function<void(TextOutput&)>& write) {
+  TextOutput out(path, std::string(what));
+  write(out);
+  out.commit();
 }
 
 }  // namespace pointhaptics
