@@ -1,6 +1,7 @@
 // Tests for io/point_cloud_file: PLY (ASCII, binary little and big endian) and text clouds with their
 // attributes, and malformed, truncated and hostile files, which must end in an error naming the file.
 #include <pointhaptics/core/error.hpp>
+#include <pointhaptics/io/mesh_file.hpp>
 #include <pointhaptics/io/point_cloud_file.hpp>
 #include <pointhaptics/pointhaptics.hpp>
 
@@ -145,6 +146,15 @@ TEST(PointCloudFile, DevicesFifosAndFoldersAreRefusedBeforeReading) {
   std::filesystem::remove(fifo);
 }
 
+TEST(PointCloudFile, APlyMeshWithALongHeaderIsAMesh) {
+  // issue 21: a header of more than 1000 lines hid the faces, and the mesh was refused as a cloud
+  std::string header = "ply\nformat ascii 1.0\n";
+  for (int k = 0; k < 1500; ++k) header += "comment line " + std::to_string(k) + "\n";
+  header += "element vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 4\n"
+            "property list uchar int vertex_indices\nend_header\n";
+  EXPECT_TRUE(ply_has_faces(write("long_header.ply", header + "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n")));
+}
+
 TEST(PointCloudFile, MalformedTruncatedAndHostileFilesAreNamedErrors) {
   auto has = [](const std::string& error, const std::string& what) {
     EXPECT_NE(error.find(what), std::string::npos) << "expected \"" << what << "\" in: " << error;
@@ -183,6 +193,15 @@ TEST(PointCloudFile, MalformedTruncatedAndHostileFilesAreNamedErrors) {
   faces.replace(faces.find("element face 0"), 14, "element face 2");
   has(error_of(faces, ".ply"), "surface mesh");
   has(error_of("solid\n", ".stl"), "not a point cloud this version reads");
+  // issue 21: held flags other than 0 and 1, and more vertex lines than the header declares
+  has(error_of(text_cloud(',', true) + "0.3,0.3,0.3,nan,1\n", ".csv"), "fixed = nan must be 0 or 1");
+  has(error_of(text_cloud(',', true) + "0.3,0.3,0.3,2.5,1\n", ".csv"), "fixed = 2.5 must be 0 or 1");
+  std::string held = ply("ascii", true);
+  held.replace(held.find(" 1 4e-06"), 8, " 2 4e-06");
+  has(error_of(held, ".ply"), "fixed = 2 must be 0 or 1");
+  std::string more = ply("ascii", false);
+  more.replace(more.find("element vertex 5"), 16, "element vertex 3");
+  has(error_of(more, ".ply"), "holds 2 more data lines than its header declares (3 vertices)");
   try {
     read_point_cloud("/nonexistent/cloud.ply", 0.01);
     ADD_FAILURE() << "a missing file was accepted";

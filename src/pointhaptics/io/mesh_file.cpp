@@ -59,7 +59,9 @@ TriangleMesh read_mesh(const std::string& path) {
 bool ply_has_faces(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::string line;
-  for (int k = 0; k < 1000 && std::getline(in, line); ++k) {
+  // the header only, however many comment or property lines it has (a mesh with over 1000 was taken for a
+  // cloud), within a bound on its bytes
+  for (std::size_t read = 0; read < (1u << 24) && std::getline(in, line); read += line.size() + 1) {
     if (line.rfind("end_header", 0) == 0) break;
     std::istringstream words(line);
     std::string keyword, element;

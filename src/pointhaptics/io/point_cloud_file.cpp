@@ -114,7 +114,12 @@ RawCloud parse_text(std::string_view data, bool csv, const std::string& name) {
     };
     const Vec3 x(number(col[0], "x"), number(col[1], "y"), number(col[2], "z"));
     raw.X.push_back(x);
-    if (col[3] >= 0) raw.held.push_back(number(col[3], "fixed") != 0 ? 1 : 0);
+    if (col[3] >= 0) {
+      const double held = number(col[3], "fixed");
+      if (held != 0 && held != 1)
+        throw Error(fmt::format("{}:{}: fixed = {} must be 0 or 1", name, line_no, fields[static_cast<std::size_t>(col[3])]));
+      raw.held.push_back(held == 1 ? 1 : 0);
+    }
     if (col[4] >= 0) raw.volume.push_back(number(col[4], "volume"));
     if (raw.X.size() > static_cast<std::size_t>(std::numeric_limits<index_t>::max() / 2))
       throw Error(fmt::format("{}: too many points", name));
@@ -283,7 +288,11 @@ RawCloud parse_ply(std::string_view data, const std::string& name) {
   auto store = [&](std::uint64_t v) {
     const Vec3 x(values[static_cast<std::size_t>(ix)], values[static_cast<std::size_t>(iy)], values[static_cast<std::size_t>(iz)]);
     raw.X[v] = x;
-    if (ifixed >= 0) raw.held[v] = values[static_cast<std::size_t>(ifixed)] != 0 ? 1 : 0;
+    if (ifixed >= 0) {
+      const double held = values[static_cast<std::size_t>(ifixed)];
+      if (held != 0 && held != 1) throw Error(fmt::format("{}: vertex {}: fixed = {} must be 0 or 1", name, v, held));
+      raw.held[v] = held == 1 ? 1 : 0;
+    }
     if (ivolume >= 0) raw.volume[v] = values[static_cast<std::size_t>(ivolume)];
   };
   auto reserve = [&](std::uint64_t count) {
@@ -314,6 +323,16 @@ RawCloud parse_ply(std::string_view data, const std::string& name) {
       }
       store(v);
     }
+    // what follows the vertices must be the later elements' lines, no more: a file holding more vertex
+    // lines than its header declares was silently cut to the declared count
+    std::uint64_t later = 0;
+    for (std::size_t e = vertex_index + 1; e < elements.size(); ++e) later += elements[e].count;
+    std::uint64_t extra = 0;
+    while (auto line = next_line())
+      if (line->find_first_not_of(" \t") != std::string::npos) ++extra;
+    if (extra > later)
+      throw Error(fmt::format("{}: holds {} more data lines than its header declares ({} vertices)", name, extra - later,
+                              vertex.count));
     return raw;
   }
   // binary: fixed-size items (list properties only outside the vertices, skipped item by item)
