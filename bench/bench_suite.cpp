@@ -1,11 +1,13 @@
 #include "bench_suite.hpp"
 
+#include <pointhaptics/core/error.hpp>
 #include <pointhaptics/core/workspace.hpp>
 #include <pointhaptics/geometry/sampling.hpp>
 #include <pointhaptics/mechanics/forces.hpp>
 #include <pointhaptics/mechanics/model_builder.hpp>
 #include <pointhaptics/haptics/devices/virtual_device.hpp>
 #include <pointhaptics/interactive.hpp>
+#include <pointhaptics/io/output_file.hpp>
 #include <pointhaptics/scene_builder.hpp>
 #include <pointhaptics/simulation.hpp>
 #include <pointhaptics/solvers/explicit_solver.hpp>
@@ -19,6 +21,7 @@
 #include <map>
 #include <memory>
 #include <random>
+#include <regex>
 
 namespace pointhaptics::bench {
 namespace {
@@ -220,21 +223,42 @@ int run_bench_suite(const BenchOptions& options) {
           ->Args({solver, t})->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
   benchmark::RegisterBenchmark("haptic/points:10000", haptic_benchmark)
       ->Args({10000})->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
+  // a bad pattern or one that matches nothing is an error, not an empty table and exit 0
+  try {
+    const std::regex check(options.filter, std::regex::extended);
+  } catch (const std::regex_error& e) {
+    fmt::print(stderr, "pointhaptics bench: --filter '{}' is not a valid regular expression ({})\n", options.filter, e.what());
+    return 1;
+  }
+  if (!options.json_path.empty()) {
+    try {
+      check_output_path(options.json_path, "--json");
+    } catch (const Error& e) {
+      fmt::print(stderr, "pointhaptics bench: error: {}\n", e.what());
+      return 1;
+    }
+  }
   std::string filter_flag = "--benchmark_filter=" + options.filter;
   std::string name = "pointhaptics-bench";
   char* argv[] = {name.data(), filter_flag.data(), nullptr};
   int argc = 2;
   benchmark::Initialize(&argc, argv);
   CollectingReporter reporter;
-  benchmark::RunSpecifiedBenchmarks(&reporter);
+  const std::size_t ran = benchmark::RunSpecifiedBenchmarks(&reporter);
   benchmark::Shutdown();
+  if (ran == 0) {
+    fmt::print(stderr, "pointhaptics bench: --filter '{}' matches no benchmark\n", options.filter);
+    return 1;
+  }
   if (!options.json_path.empty()) {
-    std::ofstream out(options.json_path);
-    if (!out) {
-      fmt::print(stderr, "pointhaptics bench: cannot write {}\n", options.json_path);
+    const std::string text =
+        nlohmann::json{{"force", reporter.force}, {"step", reporter.step}, {"beam_4x1x1", reporter.beam}, {"haptic", reporter.haptic}}.dump(1);
+    try {
+      write_text_file(options.json_path, "--json", [&](TextOutput& out) { out.print("{}\n", text); });
+    } catch (const Error& e) {
+      fmt::print(stderr, "pointhaptics bench: error: {}\n", e.what());
       return 1;
     }
-    out << nlohmann::json{{"force", reporter.force}, {"step", reporter.step}, {"beam_4x1x1", reporter.beam}, {"haptic", reporter.haptic}}.dump(1) << '\n';
   }
   return 0;
 }

@@ -3,6 +3,7 @@
 // simulation), drive the probe. Long calls release the GIL.
 #include <pointhaptics/haptics/devices/virtual_device.hpp>
 #include <pointhaptics/mechanics/forces.hpp>
+#include <pointhaptics/io/point_cloud_file.hpp>
 #include <pointhaptics/mechanics/model_builder.hpp>
 #include <pointhaptics/pointhaptics.hpp>
 
@@ -10,6 +11,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <cmath>
 #include <memory>
 #include <mutex>
 
@@ -106,12 +108,12 @@ std::unique_ptr<PySimulation> from_scene(const std::string& path, int threads) {
 std::unique_ptr<PySimulation> from_points(const RowPoints& X, double spacing, py::object fixed, py::object forces,
                                           double young, double poisson, double density, double damping, const std::string& kernel,
                                           double support_factor, const std::string& solver, double dt, int threads) {
-  ph::PointCloud cloud;
-  cloud.X = points_of(X, "points");
-  if (!(spacing > 0)) throw ph::Error("spacing: must be > 0 (m)");
-  cloud.spacing = spacing;
-  cloud.volume = Eigen::VectorXd::Constant(cloud.X.cols(), spacing * spacing * spacing);
-  cloud.surface.assign(static_cast<std::size_t>(cloud.X.cols()), 0);
+  // the same rules as scene files and the point-cloud readers (issue 21: these were accepted here)
+  if (!(spacing > 0) || !std::isfinite(spacing)) throw ph::Error("spacing: must be > 0 (m)");
+  if (!(dt >= 1e-9 && dt <= 1)) throw ph::Error("dt: must lie in [1e-9, 1] (s)");
+  if (threads < 0) throw ph::Error("threads: must be >= 0 (0: all hardware threads)");
+  if (!(support_factor > 1 && support_factor <= 20)) throw ph::Error("support_factor: must lie in (1, 20]");
+  const ph::PointCloud cloud = ph::point_cloud_from_positions(points_of(X, "points"), "points", spacing);
   ph::MaterialParams material;
   material.young = young;
   material.poisson = poisson;
@@ -138,6 +140,7 @@ std::unique_ptr<PySimulation> from_points(const RowPoints& X, double spacing, py
       }
     if (!group.points.empty()) model.fixed_groups.push_back(group);
   }
+  ph::check_every_free_point_has_neighbours(model, "points");
   if (!forces.is_none()) model.f_ext = points_of(RowPoints::ensure(forces), "forces");
   if (model.f_ext.cols() != model.n_points) throw ph::Error("forces: expected an (n, 3) array");
   p->sim = std::make_unique<ph::Simulation>(std::move(model), p->scene.solver, threads);

@@ -160,8 +160,28 @@ def test_bad_input_is_a_named_error():
         ph.Simulation.from_points(np.zeros((4, 2)), spacing=0.01)
     with pytest.raises(ph.Error, match="not finite"):
         ph.Simulation.from_points(np.array([[0, 0, 0], [np.nan, 0, 0]]), spacing=0.01)
+    cube = np.stack(np.meshgrid(np.arange(3), np.arange(3), np.arange(3), indexing="ij"), axis=-1).reshape(-1, 3) * 0.01
     with pytest.raises(ph.Error, match="unknown kind"):
-        ph.Simulation.from_points(np.eye(3), spacing=0.01, solver="magic")
+        ph.Simulation.from_points(cube, spacing=0.01, solver="magic")
+    # issue 21: the same rules as scene files and the readers
+    for kwargs, words in [({"dt": 0.0}, "dt"), ({"dt": -1e-3}, "dt"), ({"threads": -2}, "threads"),
+                          ({"support_factor": 1.0}, "support_factor"), ({"support_factor": 1e6}, "support_factor")]:
+        with pytest.raises(ph.Error, match=words):
+            ph.Simulation.from_points(cube, spacing=0.01, **kwargs)
+    with pytest.raises(ph.Error, match="no solid"):
+        ph.Simulation.from_points(np.eye(3) * 0.01, spacing=0.01)
+    with pytest.raises(ph.Error, match="lie on a plane"):
+        ph.Simulation.from_points(cube[cube[:, 2] == 0], spacing=0.01)
+    with pytest.raises(ph.Error, match="no neighbour"):
+        ph.Simulation.from_points(cube * 10, spacing=0.01)
+    # a divergence is an error, and the summary says it did not converge
+    loads = np.zeros_like(cube)
+    loads[-1] = [1e9, 0, 0]
+    wild = ph.Simulation.from_points(cube, spacing=0.01, forces=loads, threads=1)
+    with pytest.raises(ph.Error, match="diverged"):
+        wild.run(0.1)
+    summary = wild.summary()
+    assert not summary["converged"] and "diverged" in summary["failure"], summary
     sim = ph.Simulation.from_scene(scene("beam_fixed_both_ends.toml"), threads=1)
     with pytest.raises(ph.Error, match="duration"):
         sim.run(-1)

@@ -154,11 +154,20 @@ Model build_scene_model(const Scene& scene, double max_memory) {
         break;
     }
   }
+  check_every_free_point_has_neighbours(model, scene.path);
   return model;
 }
 
 Vec3 scene_lod_contact(const Scene& scene, const Model& model) {
-  if (scene.lod.contact.allFinite()) return scene.lod.contact;
+  if (scene.lod.contact.allFinite()) {
+    // a contact far from the object (1e300 was accepted) selects nothing sensible
+    const Vec3 lo = model.X.rowwise().minCoeff(), hi = model.X.rowwise().maxCoeff();
+    const double away = (scene.lod.contact.cwiseMax(lo).cwiseMin(hi) - scene.lod.contact).stableNorm();
+    if (!(away <= model.h))
+      throw Error(fmt::format("{}:{}: lod.contact: [{:.4g}, {:.4g}, {:.4g}] lies {:.3g} m outside the object's bounding box (at most h = {:.3g} m)",
+                              scene.path, scene.lod.line, scene.lod.contact.x(), scene.lod.contact.y(), scene.lod.contact.z(), away, model.h));
+    return scene.lod.contact;
+  }
   if (scene.probe.present) {
     const Vec3 lo = model.X.rowwise().minCoeff(), hi = model.X.rowwise().maxCoeff();
     const Vec3 origin = scene.probe.origin.allFinite() ? scene.probe.origin : Vec3(0.5 * (lo.x() + hi.x()), hi.y(), 0.5 * (lo.z() + hi.z()));

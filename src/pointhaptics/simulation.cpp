@@ -222,6 +222,17 @@ NewtonSettings Simulation::newton_settings() const {
 }
 
 void Simulation::step() {
+  // a step that fails (divergence, Newton) leaves a state that is not a result: the summary says so
+  try {
+    step_solver();
+  } catch (const Error& e) {
+    converged_ = false;
+    failure_ = e.what();
+    throw;
+  }
+}
+
+void Simulation::step_solver() {
   const auto start = std::chrono::steady_clock::now();
   switch (solver_.kind) {
     case SolverKind::EXPLICIT: {

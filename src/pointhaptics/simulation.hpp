@@ -76,6 +76,7 @@ class Simulation {
 
  private:
   NewtonSettings newton_settings() const;
+  void step_solver();
   void prepare_solver(double stable_dt = 0);  // for model_: stable step (0: compute it), solver objects
   std::vector<index_t> take_over(LodBuild build, bool built_here);
   struct Lod;

@@ -448,6 +448,13 @@ PointCloud parse_point_cloud(std::string_view data, std::string_view format, con
   return checked(std::move(raw), name, spacing);
 }
 
+PointCloud point_cloud_from_positions(const Points& X, const std::string& name, double spacing) {
+  RawCloud raw;
+  raw.X.reserve(static_cast<std::size_t>(X.cols()));
+  for (Eigen::Index i = 0; i < X.cols(); ++i) raw.X.push_back(X.col(i));
+  return checked(std::move(raw), name, spacing);
+}
+
 PointCloud read_point_cloud(const std::string& path, double spacing) {
   const std::string ext = lower(std::filesystem::path(path).extension().string());
   const auto size = check_input_file(path, "point cloud file");

@@ -21,6 +21,11 @@ namespace pointhaptics {
 /// degenerate cloud (fewer than 4 points, or all on a plane or a line: no solid to simulate).
 PointCloud read_point_cloud(const std::string& path, double spacing);
 
+/// A cloud from positions given in memory (e.g. from Python), with the checks the readers make: at least 4
+/// points, not flat, no duplicates, finite and plausible coordinates; volumes spacing^3. Throws Error
+/// naming `name`.
+PointCloud point_cloud_from_positions(const Points& X, const std::string& name, double spacing);
+
 /// The same from the file's bytes; `format` is the extension (".ply", ".xyz", ".csv", ".txt") and `name`
 /// names it in messages. For tests and fuzzing.
 PointCloud parse_point_cloud(std::string_view data, std::string_view format, const std::string& name, double spacing);

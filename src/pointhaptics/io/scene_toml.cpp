@@ -255,7 +255,7 @@ void read_kernel(TableReader& r, KernelParams& k) {
 void read_solver(TableReader& r, SolverSpec& s) {
   const std::string kind = r.choice("kind", "explicit", {"static", "explicit", "implicit"});
   s.kind = kind == "static" ? SolverKind::STATIC : kind == "explicit" ? SolverKind::EXPLICIT : SolverKind::IMPLICIT;
-  s.dt = r.number("dt", s.dt, [](double x) { return x > 0 && x <= 1; }, "must lie in (0, 1] (s)");
+  s.dt = r.number("dt", s.dt, [](double x) { return x >= 1e-9 && x <= 1; }, "must lie in [1e-9, 1] (s)");
   s.duration = r.number("duration", s.duration, [](double x) { return x >= 0 && x <= 1e6; }, "must lie in [0, 1e6] (s)");
   s.tolerance = r.number("tolerance", s.tolerance, [](double x) { return x > 0 && x < 1; }, "must lie in (0, 1)");
   auto count = [&](std::string_view key, int fallback, int lo, int hi) {
@@ -340,10 +340,11 @@ void read_device(TableReader& r, DeviceSpec& d, const Context& ctx) {
   if (d.specs == "custom") {
     for (const char* key : {"max_force", "max_stiffness", "workspace_radius"})
       if (!r.find(key)) r.fail_table(key, "custom specs need max_force, max_stiffness and workspace_radius");
-    d.max_force = r.number("max_force", 0.0, positive, "must be > 0 (N)");
-    d.max_stiffness = r.number("max_stiffness", 0.0, positive, "must be > 0 (N/m)");
-    d.max_damping = r.number("max_damping", 0.0, non_negative, "must be >= 0 (N s/m)");
-    d.workspace_radius = r.number("workspace_radius", 0.0, positive, "must be > 0 (m)");
+    // bounds well beyond any haptic device: specs of 1e300 were accepted and rendered 0 N all session
+    d.max_force = r.number("max_force", 0.0, [](double x) { return x > 0 && x <= 1e3; }, "must lie in (0, 1000] (N)");
+    d.max_stiffness = r.number("max_stiffness", 0.0, [](double x) { return x > 0 && x <= 1e6; }, "must lie in (0, 1e6] (N/m)");
+    d.max_damping = r.number("max_damping", 0.0, [](double x) { return x >= 0 && x <= 1e4; }, "must lie in [0, 1e4] (N s/m)");
+    d.workspace_radius = r.number("workspace_radius", 0.0, [](double x) { return x > 0 && x <= 10; }, "must lie in (0, 10] (m)");
   }
   if (d.kind == "replay") {
     if (!r.find("log")) r.fail_table("log", "a replay device needs log = \"session.csv\" (a recorded force log)");

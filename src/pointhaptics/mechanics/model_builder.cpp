@@ -235,4 +235,16 @@ Model build_model(const PointCloud& cloud, const MaterialParams& material, const
   return model;
 }
 
+void check_every_free_point_has_neighbours(const Model& model, const std::string& name) {
+  index_t alone = 0, first = -1;
+  for (index_t i = 0; i < model.n_points; ++i)
+    if (!model.fixed[i] && model.neighbours.row_size(i) == 0) {
+      if (alone++ == 0) first = i;
+    }
+  if (alone > 0)
+    throw Error(fmt::format("{}: {} of {} points (the first: point {} at ({:.4g}, {:.4g}, {:.4g}) m) have no neighbour within the "
+                            "support h = {:.4g} m: the support is too small for the spacing, or the points too far apart",
+                            name, alone, model.n_points, first, model.X(0, first), model.X(1, first), model.X(2, first), model.h));
+}
+
 }  // namespace pointhaptics

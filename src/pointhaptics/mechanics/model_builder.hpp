@@ -14,6 +14,10 @@ inline constexpr double max_moment_condition = 1e6;
 /// Throws Error on invalid parameters or coincident points.
 Model build_model(const PointCloud& cloud, const MaterialParams& material, const KernelParams& kernel);
 
+/// Throws Error naming `name` if a free point has no neighbour within its support: nothing holds it, it
+/// has no strain and the run would report success on nonsense (issue 21). Call once the held points are set.
+void check_every_free_point_has_neighbours(const Model& model, const std::string& name);
+
 /// Check material parameters; throws Error naming the first bad one.
 void validate_material(const MaterialParams& material);
 
