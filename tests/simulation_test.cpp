@@ -1,5 +1,5 @@
 // Tests for simulation and scene_builder: scenes to models, loads and supports, and the seed's
-// cantilever against CalculiX (shared/reference/cantilever-calculix.md).
+// cantilever against CalculiX (docs/cantilever-calculix.md).
 #include <pointhaptics/pointhaptics.hpp>
 
 #include <gtest/gtest.h>

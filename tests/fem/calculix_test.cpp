@@ -1,5 +1,5 @@
 // Tests for fem/calculix: the .inp writer (mesh, clamps, consistent loads), the .dat reader on good and
-// malformed output, and ccx itself on the seed's cantilever (shared/reference/cantilever-calculix.md).
+// malformed output, and ccx itself on the seed's cantilever (docs/cantilever-calculix.md).
 #include <pointhaptics/core/error.hpp>
 #include <pointhaptics/fem/calculix.hpp>
 
