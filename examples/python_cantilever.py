@@ -16,7 +16,7 @@ sim = ph.Simulation.from_scene(os.path.join(scenes, "cantilever_static.toml"))
 sim.step()  # a static scene: one step is the equilibrium
 u = sim.displacement  # (n, 3) view into the simulation, metres
 tip = sim.reference[:, 0] > 0.15 - 1e-9
-print(f"{sim.n_points} points; mean tip deflection {-1e3 * u[tip, 1].mean():.2f} mm; {sim.summary()['iterations']} Newton iterations")
+print(f"{sim.n_points} points; mean tip deflection {-1e3 * u[tip, 1].mean():.2f} mm; {sim.summary()['solver']['iterations']} Newton iterations")
 
 beam = ph.Simulation.from_scene(os.path.join(scenes, "beam_fixed_both_ends.toml"))
 result = beam.probe([[0, 0, 0, 0, 0], [0.5, 0, -0.025, 0, 0], [1.0, 0, -0.025, 0, 0]], radius=0.01, duration=1.0)

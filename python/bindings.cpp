@@ -7,6 +7,7 @@
 #include <pointhaptics/mechanics/model_builder.hpp>
 #include <pointhaptics/pointhaptics.hpp>
 
+#include <fmt/format.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -41,23 +42,11 @@ ph::Points points_of(const RowPoints& a, const char* what) {
   return P;
 }
 
-py::dict summary_dict(const ph::RunSummary& s) {
-  py::dict d;
-  d["solver"] = s.solver_kind;
-  d["converged"] = s.converged;
-  d["steps"] = s.steps;
-  d["iterations"] = s.iterations;
-  d["residual"] = s.residual;
-  d["strain_energy"] = s.strain_energy;
-  d["kinetic_energy"] = s.kinetic_energy;
-  d["steps_per_s"] = s.steps_per_s;
-  d["stable_dt"] = s.stable_dt;
-  if (s.solver_kind == "implicit") d["budget_steps"] = s.budget_steps;
-  py::list reactions;
-  for (const ph::Vec3& r : s.reactions) reactions.append(py::make_tuple(r.x(), r.y(), r.z()));
-  d["reactions"] = reactions;
-  if (s.lod.enabled) d["lod_selected"] = s.lod.selected;
-  if (!s.failure.empty()) d["failure"] = s.failure;
+// The result JSON's blocks (solver, energy, timing, constraints, haptic, lod, model): the same keys as
+// `pointhaptics run --json`, built by the same code; the per-point arrays are left out (they are the views).
+py::dict summary_dict(const ph::Model& model, const ph::State& state, const ph::RunSummary& s) {
+  py::dict d = py::module_::import("json").attr("loads")(ph::result_json(model, state, s));
+  d.attr("pop")("points");
   return d;
 }
 
@@ -153,9 +142,22 @@ PYBIND11_MODULE(_pointhaptics, m) {
   m.doc() = "PointHaptics: meshless (MLS) deformable objects for haptic rendering";
   py::register_exception<ph::Error>(m, "Error", PyExc_ValueError);
 
-  py::class_<PySimulation>(m, "Simulation")
+  m.attr("__version__") = "0.1.0";
+  py::class_<PySimulation>(m, "Simulation", R"doc(A deformable object made of points, its state and its solver.
+
+Make one with Simulation.from_scene(path) (a scene file, as `pointhaptics run` reads) or
+Simulation.from_points(points, spacing, ...) (NumPy arrays). Units are SI throughout: m, s, N, Pa, kg, J.
+Arrays have one row per point of the object, n rows: reference, displacement and velocity are read-only
+views into the simulation (they follow it as it steps); positions and forces are copies. With levels of
+detail only the points near the contact are simulated; the others follow or keep their displacement, and
+every array still speaks of all n points.
+
+Calls on one Simulation from several threads follow each other (each object has a lock); step(), run() and
+probe() release the GIL while they work. Errors are pointhaptics.Error (a ValueError) with a message that
+names the problem.)doc")
       .def_static("from_scene", &from_scene, py::arg("path"), py::arg("threads") = 0,
-                  "Load a scene file (design.md's TOML) and prepare its simulation, with its levels of detail")
+                  "Load a scene file (TOML: [object], [material], [kernel], [solver], [[fixed]], [[load]], [lod] ...) and "
+                  "prepare its simulation, with its levels of detail. threads: of the force evaluation (0: all).")
       .def_static("from_points", &from_points, py::arg("points"), py::arg("spacing"), py::arg("fixed") = py::none(),
                   py::arg("forces") = py::none(), py::arg("young") = 1e5, py::arg("poisson") = 0.4, py::arg("density") = 1000.0,
                   py::arg("damping") = 0.0, py::arg("kernel") = "poly6", py::arg("support_factor") = 2.0,
@@ -168,7 +170,9 @@ PYBIND11_MODULE(_pointhaptics, m) {
             const std::lock_guard<std::mutex> lock(p.mutex);
             p.sim->step();
           },
-          "One solver step (static: the equilibrium)")
+          "Advance by one solver step: dt of explicit dynamics (sub-stepped below the stable step) or implicit "
+          "dynamics; a static solver solves for the equilibrium under the full load. Raises pointhaptics.Error on a "
+          "divergence or a failed solve (then summary() says so). Releases the GIL.")
       .def(
           "run", [](PySimulation& p, double duration) {
             if (!(duration >= 0)) throw ph::Error("run: duration must be >= 0 (s)");
@@ -177,14 +181,29 @@ PYBIND11_MODULE(_pointhaptics, m) {
             p.sim->run(duration);
           },
           py::arg("duration"), "Step until `duration` seconds more have passed (static: solve once); releases the GIL")
-      .def_property_readonly("time", [](PySimulation& p) {
-        const auto lock = locked(p);
-        return p.sim->full_state().time;
-      })
-      .def_property_readonly("n_points", [](PySimulation& p) { return p.sim->full_model().n_points; })
+      .def_property_readonly(
+          "time",
+          [](PySimulation& p) {
+            const auto lock = locked(p);
+            return p.sim->full_state().time;
+          },
+          "Simulated time so far (s)")
+      .def_property_readonly(
+          "n_points", [](PySimulation& p) { return p.sim->full_model().n_points; }, "Points of the object, n")
+      .def(
+          "__repr__",
+          [](PySimulation& p) {
+            const auto lock = locked(p);
+            const ph::Model& m = p.sim->full_model();
+            std::string lod;
+            if (const ph::ActiveSet* a = p.sim->active_set()) lod = ", " + std::to_string(a->n_selected) + " simulated";
+            return "<pointhaptics.Simulation: " + std::to_string(m.n_points) + " points" + lod + ", " +
+                   std::string(ph::to_string(p.sim->solver().kind)) + " solver, dt = " + fmt::format("{:g}", p.sim->solver().dt) +
+                   " s, t = " + fmt::format("{:g}", p.sim->full_state().time) + " s>";
+          })
       .def_property_readonly(
           "reference", [](py::object self) { return view(self.cast<PySimulation&>().sim->full_model().X, self); },
-          "Reference positions, an (n, 3) read-only view (m)")
+          "Reference (rest) positions X, an (n, 3) read-only view (m)")
       .def_property_readonly(
           "displacement",
           [](py::object self) {
@@ -217,17 +236,24 @@ PYBIND11_MODULE(_pointhaptics, m) {
             const ph::Model& m = p.sim->model();
             ph::Workspace ws(m, 1);
             ph::compute_internal_forces(m, p.sim->state().u, ws);
-            return py::array_t<double>({ws.f_int.cols(), Eigen::Index{3}},
-                                       {Eigen::Index{3 * sizeof(double)}, Eigen::Index{sizeof(double)}}, ws.f_int.data());
+            // one row per point of the object, as every other array (with levels of detail the simulated
+            // points carry theirs, the others none)
+            ph::Points f = ph::Points::Zero(3, p.sim->full_model().n_points);
+            const ph::ActiveSet* active = p.sim->active_set();
+            for (ph::index_t k = 0; k < m.n_points; ++k) f.col(active ? active->full_of[k] : k) = ws.f_int.col(k);
+            return py::array_t<double>({f.cols(), Eigen::Index{3}}, {Eigen::Index{3 * sizeof(double)}, Eigen::Index{sizeof(double)}},
+                                       f.data());
           },
-          "Internal elastic forces on the simulated points, an (n_simulated, 3) array (N)")
+          "Internal elastic forces, an (n, 3) array (a copy; N), one row per point of the object like every other "
+          "array; with levels of detail, zero on the points not simulated")
       .def_property_readonly("fixed",
                              [](PySimulation& p) {
                                const ph::Model& m = p.sim->full_model();
                                py::array_t<bool> a(m.n_points);
                                for (ph::index_t i = 0; i < m.n_points; ++i) a.mutable_at(i) = m.fixed[i] != 0;
                                return a;
-                             })
+                             },
+                             "Held points, an (n,) boolean array (a copy): the [[fixed]] boxes or the `fixed` mask")
       .def("energy",
            [](PySimulation& p) {
              const auto lock = locked(p);
@@ -237,21 +263,33 @@ PYBIND11_MODULE(_pointhaptics, m) {
              d["kinetic"] = ph::kinetic_energy(p.sim->model(), p.sim->state().velocity);
              return d;
            },
-           "Strain and kinetic energy (J)")
+           "Energies of the simulated points now, a dict: strain (the elastic energy whose gradient the forces are) and "
+          "kinetic (J)")
       .def(
           "summary",
           [](PySimulation& p) {
             const auto lock = locked(p);
-            return summary_dict(p.sim->summary());
+            const ph::RunSummary summary = p.sim->summary();
+            return summary_dict(p.sim->full_model(), p.sim->full_state(), summary);
           },
-          "Solver outcome, energies, timing")
+          "The run so far, with the result JSON's blocks and keys (`pointhaptics run --json`): solver (kind, converged, "
+          "iterations, residual, steps, substeps, stable_dt, cg_iterations, failure, interrupted), energy (strain, kinetic; "
+          "J), timing (wall_s, step_ms_mean, steps_per_s), constraints (per held group: points, reaction in N), haptic, "
+          "lod, model. A step that raised leaves converged False and its message in solver.failure.")
       .def(
           "probe",
-          [](PySimulation& p, const std::vector<std::array<double, 5>>& keyframes, double radius, const std::string& mode,
+          [](PySimulation& p, const std::vector<std::vector<double>>& keyframes, double radius, const std::string& mode,
              double duration, bool real_time) {
-            if (keyframes.empty()) throw ph::Error("probe: keyframes [[t, x, y, z, button], ...] are needed");
+            if (keyframes.empty()) throw ph::Error("probe: keyframes [[t, x, y, z(, button)], ...] are needed");
+            // as in scene files: [t, x, y, z] or [t, x, y, z, button]
             std::vector<ph::Keyframe> frames;
-            for (const auto& k : keyframes) frames.push_back({k[0], ph::Vec3(k[1], k[2], k[3]), k[4] != 0});
+            for (std::size_t k = 0; k < keyframes.size(); ++k) {
+              const std::vector<double>& f = keyframes[k];
+              if (f.size() != 4 && f.size() != 5)
+                throw ph::Error("probe: keyframe " + std::to_string(k) + " has " + std::to_string(f.size()) +
+                                " values; expected [t, x, y, z] or [t, x, y, z, button]");
+              frames.push_back({f[0], ph::Vec3(f[1], f[2], f[3]), f.size() == 5 && f[4] != 0});
+            }
             ph::VirtualDevice device(ph::Trajectory(std::move(frames)), ph::known_device_specs("touch"));
             ph::Scene scene = p.scene;
             scene.probe.present = true;
@@ -267,13 +305,15 @@ PYBIND11_MODULE(_pointhaptics, m) {
               const std::lock_guard<std::mutex> lock(p.mutex);
               r = ph::run_interactive(*p.sim, device, o);
             }
-            py::array_t<double> log({static_cast<py::ssize_t>(r.log.size()), py::ssize_t{8}});
+            // the columns of --force-log: t, x, y, z, vx, vy, vz, buttons, fx, fy, fz
+            py::array_t<double> log({static_cast<py::ssize_t>(r.log.size()), py::ssize_t{11}});
             auto w = log.mutable_unchecked<2>();
             for (std::size_t k = 0; k < r.log.size(); ++k) {
               const ph::HapticLogRow& row = r.log[k];
-              const double v[8] = {row.t, row.position.x(), row.position.y(), row.position.z(), row.force.x(), row.force.y(),
-                                   row.force.z(), static_cast<double>(row.buttons)};
-              for (int c = 0; c < 8; ++c) w(static_cast<py::ssize_t>(k), c) = v[c];
+              const double v[11] = {row.t,          row.position.x(), row.position.y(), row.position.z(),
+                                    row.velocity.x(), row.velocity.y(), row.velocity.z(), static_cast<double>(row.buttons),
+                                    row.force.x(),  row.force.y(),    row.force.z()};
+              for (int c = 0; c < 11; ++c) w(static_cast<py::ssize_t>(k), c) = v[c];
             }
             py::dict d;
             d["log"] = log;
@@ -285,7 +325,9 @@ PYBIND11_MODULE(_pointhaptics, m) {
           },
           py::arg("keyframes"), py::arg("radius") = 0.005, py::arg("mode") = "push", py::arg("duration") = 1.0,
           py::arg("real_time") = false,
-          "Drive a spherical probe with a virtual hand through keyframes [t, x, y, z, button] (device frame, m; the origin "
-          "two radii above the object's top centre) for `duration` s; returns the haptic log (columns t, x, y, z, fx, fy, "
-          "fz, buttons) and statistics. Deterministic unless real_time.");
+          "Drive a spherical probe (radius in m; mode push or grab) with a virtual hand through keyframes "
+          "[t, x, y, z] or [t, x, y, z, button] (s, m; device frame, whose origin is two radii above the object's top "
+          "centre) for `duration` s. This advances the simulation by `duration`. Returns a dict: log, an (ticks, 11) "
+          "array with the columns of --force-log (t, x, y, z, vx, vy, vz, buttons, fx, fy, fz; s, m, m/s, bit mask, N), "
+          "ticks, max_force (N), max_contacts and simulation_steps. Deterministic (simulated time) unless real_time.");
 }

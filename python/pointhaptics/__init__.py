@@ -5,6 +5,6 @@
     sim.run(1.0)
     print(sim.displacement[:5])       # an (n, 3) view into the simulation, in metres
 """
-from ._pointhaptics import Error, Simulation  # noqa: F401
+from ._pointhaptics import Error, Simulation, __version__  # noqa: F401
 
-__all__ = ["Error", "Simulation"]
+__all__ = ["Error", "Simulation", "__version__"]

@@ -26,7 +26,9 @@ def test_a_scene_runs_and_its_arrays_are_views_of_the_simulation():
     # the same view now shows the solution: the tip sags (the beam is loaded downwards at x = 0.15)
     tip = sim.reference[:, 0] > 0.15 - 1e-9
     assert u[tip, 1].mean() < -0.01
-    assert sim.summary()["converged"]
+    summary = sim.summary()
+    assert summary["solver"]["converged"] and summary["solver"]["kind"] == "static"
+    assert "points" not in summary and summary["energy"]["strain"] > 0
     np.testing.assert_allclose(sim.positions, sim.reference + u)
     assert sim.fixed.sum() == 25
     e = sim.energy()
@@ -147,10 +149,27 @@ def test_the_probe_pushes_and_the_log_comes_back():
     # press 2.5 cm down from two radii above the middle of the top face, hold
     r = sim.probe([[0, 0, 0, 0, 0], [0.5, 0, -0.025, 0, 0], [1.0, 0, -0.025, 0, 0]], radius=0.01, duration=1.0)
     log = r["log"]
-    assert log.shape == (1000, 8)
+    assert log.shape == (1000, 11)  # the columns of --force-log: t, x, y, z, vx, vy, vz, buttons, fx, fy, fz
     assert r["max_contacts"] > 0 and r["max_force"] > 0.05
-    assert log[-1, 5] > 0  # the object pushes the device up
+    assert log[-1, 9] > 0  # the object pushes the device up
     assert sim.displacement[:, 1].min() < -0.002
+
+
+def test_a_stranger_can_find_their_way():
+    # issue 21: docstrings with units and shapes, a repr, a version, keyframes as in scene files
+    assert ph.__version__ == "0.1.0"
+    doc = ph.Simulation.__doc__
+    assert "SI" in doc and "one row per point" in doc
+    for name in ["step", "run", "probe", "summary", "energy", "displacement", "velocity", "reference", "positions", "forces",
+                 "fixed", "time", "n_points", "from_scene", "from_points"]:
+        assert getattr(ph.Simulation, name).__doc__, name
+    sim = ph.Simulation.from_scene(scene("beam_probe.toml"), threads=1)
+    assert repr(sim).startswith("<pointhaptics.Simulation: ") and "explicit solver" in repr(sim)
+    r = sim.probe([[0, 0, 0, 0], [0.2, 0, -0.02, 0]], radius=0.01, duration=0.2)  # 4 values, as in scene files
+    assert r["log"].shape[1] == 11 and abs(sim.time - 0.2) < 1e-9  # probe() advances the simulation
+    with pytest.raises(ph.Error, match="keyframe 1 has 3 values"):
+        sim.probe([[0, 0, 0, 0], [0.2, 0, 0]], duration=0.1)
+    assert sim.forces.shape == (sim.n_points, 3)
 
 
 def test_bad_input_is_a_named_error():
@@ -181,7 +200,7 @@ def test_bad_input_is_a_named_error():
     with pytest.raises(ph.Error, match="diverged"):
         wild.run(0.1)
     summary = wild.summary()
-    assert not summary["converged"] and "diverged" in summary["failure"], summary
+    assert not summary["solver"]["converged"] and "diverged" in summary["solver"]["failure"], summary
     sim = ph.Simulation.from_scene(scene("beam_fixed_both_ends.toml"), threads=1)
     with pytest.raises(ph.Error, match="duration"):
         sim.run(-1)
