@@ -67,8 +67,12 @@ void print_summary(ph::Simulation& sim, const ph::RunSummary& s, double setup_s)
                s.solver_kind, s.steps, sim.solver().dt, s.substeps, s.stable_dt, st.time);
   fmt::print("displacement    max {:.4g} m at point {} ({:.4g}, {:.4g}, {:.4g})\n", max_u, worst, m.X(0, worst), m.X(1, worst),
              m.X(2, worst));
-  fmt::print("energy          strain {:.4g} J, kinetic {:.4g} J, out-of-balance {:.3g}\n", s.strain_energy, s.kinetic_energy,
-             s.residual);
+  // the out-of-balance force: |f_int + f_ext| over the free points relative to the load; in dynamics it is
+  // the inertia (and a probe's push), not an error
+  fmt::print("energy          strain {:.4g} J, kinetic {:.4g} J\n", s.strain_energy, s.kinetic_energy);
+  fmt::print("out-of-balance  {:.3g} of the load{}\n", s.residual,
+             s.solver_kind == "static" ? std::string(" (the equilibrium's residual)")
+                                       : std::string(" (in dynamics the inertia and any probe force, not an error)"));
   for (size_t g = 0; g < s.reactions.size(); ++g)
     fmt::print("reaction        {}: ({:.4g}, {:.4g}, {:.4g}) N on {} points\n", m.fixed_groups[g].name, s.reactions[g][0],
                s.reactions[g][1], s.reactions[g][2], m.fixed_groups[g].points.size());
@@ -81,8 +85,11 @@ void print_summary(ph::Simulation& sim, const ph::RunSummary& s, double setup_s)
                s.lod.selected, m.n_points, s.lod.frozen, s.lod.widened, bands, s.lod.selections, s.lod.selection_ms,
                s.lod.build_ms, s.lod.max_reselect_ms);
   }
-  fmt::print("timing          set-up {:.3f} s, stepping {:.3f} s, {:.3f} ms per step, {:.0f} steps/s\n", setup_s, s.wall_s,
-             s.step_ms_mean, s.steps_per_s);
+  if (s.solver_kind == "static")
+    fmt::print("timing          set-up {:.3f} s, solve {:.3f} s\n", setup_s, s.wall_s);
+  else
+    fmt::print("timing          set-up {:.3f} s, stepping {:.3f} s, {:.3f} ms per step, {:.0f} steps/s\n", setup_s, s.wall_s,
+               s.step_ms_mean, s.steps_per_s);
 }
 
 // SIGINT or SIGTERM during a run: stop at the next step and write what was reached (issue 21)
@@ -117,6 +124,8 @@ int run_command(const RunOptions& opt) {
     vtk.emplace(opt.vtk);
     ph::add_vtk_frame(*vtk, sim);  // the initial state
   }
+  const double start_time = sim.state().time;
+  const bool options_real_time = !opt.deterministic;
   interrupted.store(false);
   std::signal(SIGINT, on_interrupt);
   std::signal(SIGTERM, on_interrupt);
@@ -177,6 +186,17 @@ int run_command(const RunOptions& opt) {
                  "{} simulation steps\n",
                  h.ticks, h.rate_hz, h.period_p50_us, h.period_p99_us, h.period_max_us, h.tick_max_us, h.spin_mean_us, h.max_force_n,
                  interactive.max_contacts, interactive.simulation_steps);
+      if (options_real_time && interactive.simulation_wall_s > 0) {
+        // a real-time run whose simulation could not keep up with the wall clock says by how much
+        const double simulated = sim.state().time - start_time;
+        if (simulated < 0.95 * interactive.simulation_wall_s)
+          fmt::print("warning         the simulation fell behind the wall clock: {:.3g} s simulated in {:.3g} s ({:.0f}% of real "
+                     "time); the hand felt a slower object (fewer points, levels of detail, or the implicit solver)\n",
+                     simulated, interactive.simulation_wall_s, 100 * simulated / interactive.simulation_wall_s);
+      }
+      if (h.period_max_us > 1000)
+        fmt::print("warning         a haptic period was {:.0f} us off its 1 ms (p99 {:.0f} us): the machine was busy\n",
+                   h.period_max_us, h.period_p99_us);
     }
   }
   for (const std::string& message : errors.messages) fmt::print(stderr, "pointhaptics: error: {}\n", message);
