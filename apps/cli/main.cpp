@@ -145,6 +145,12 @@ int run_command(const RunOptions& opt) {
       ph::print_haptic_log_header(*force_log);
       options.log_sink = [&force_log](const ph::HapticLogRow& row) { ph::print_haptic_log_row(*force_log, row); };
     }
+    // ParaView frames every --vtk-every steps (default: the first and last states only, since a real-time
+    // run's step count is not known in advance)
+    if (vtk && opt.vtk_every > 0)
+      options.after_step = [&](long long step) {
+        if (step % opt.vtk_every == 0) errors.attempt([&] { ph::add_vtk_frame(*vtk, sim); });
+      };
     interactive = ph::run_interactive(sim, *device, options);
     if (force_log) errors.attempt([&] { force_log->commit(); });
     if (interactive.log_dropped > 0)

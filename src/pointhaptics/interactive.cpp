@@ -218,6 +218,7 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
       ++result.simulation_steps;
       display(false);
       take_log();
+      if (options.after_step) options.after_step(result.simulation_steps);
     }
     loop.stop();
   } else {
@@ -233,6 +234,7 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
             std::max(result.max_contacts, simulation_step(sim, contact, loop, options.real_time));
         ++result.simulation_steps;
         display(false);
+        if (options.after_step) options.after_step(result.simulation_steps);
       }
     }
   }

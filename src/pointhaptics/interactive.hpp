@@ -48,6 +48,9 @@ struct InteractiveOptions {
   /// time otherwise; 0: after every step), and after the last step. Each frame carries the whole object's displacements (with levels of detail, the
   /// absorbed points followed by MLS): a viewer wants about 100 a second, not one per step.
   double display_period = 0;
+  /// If set, called on the simulation's thread after every step with the number of steps so far (e.g. to
+  /// write output frames); it holds up the simulation while it runs, not the haptic loop.
+  std::function<void(long long)> after_step;
   /// If set, the run also ends (at the next step) once this becomes true: a viewer's window closed.
   const std::atomic<bool>* stop = nullptr;
 };

@@ -100,4 +100,11 @@ assert rows[0].startswith("t,x,y,z") and len(rows) > 1000, (len(rows), err)
 times = [float(r.split(",")[0]) for r in rows[1:]]
 assert all(b > a for a, b in zip(times, times[1:])), "rows out of order"
 print(f"ok: an endless run streamed {len(rows) - 1} rows to its force log before SIGINT")
+# 12b: --vtk-every animates an interactive run (only its first and last frames were written)
+frames = os.path.join(work, "probe_frames")
+p, _ = run(probe, "--deterministic", "--vtk", frames, "--vtk-every", "100")
+assert p.returncode == 0, p.stderr
+vtp = [f for f in os.listdir(frames) if f.endswith(".vtp")]
+assert len(vtp) == 3000 // 100 + 2, len(vtp)  # every 100 of 3000 steps, the first and the last state
+print(f"ok: --vtk-every 100 wrote {len(vtp)} frames of a probe run")
 print("outputs ok")
