@@ -2,6 +2,8 @@
 // cantilever against CalculiX (docs/cantilever-calculix.md).
 #include <pointhaptics/pointhaptics.hpp>
 
+#include "support/test_scenes.hpp"
+
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -9,27 +11,7 @@
 namespace pointhaptics {
 namespace {
 
-const char* cantilever = R"(
-[object]
-shape = "box"
-size = [0.15, 0.03, 0.03]
-spacing = 0.0075
-[material]
-young = 1e5
-poisson = 0.4
-density = 1000.0
-damping = 20.0
-[[fixed]]
-box = { min = [-1.0, -1.0, -1.0], max = [0.0, 1.0, 1.0] }
-[[load]]
-kind = "traction"
-box = { min = [0.15, -1.0, -1.0], max = [1.0, 1.0, 1.0] }
-total = [0.0, -0.01, 0.0]
-[solver]
-kind = "explicit"
-dt = 1e-3
-duration = 2.0
-)";
+const std::string cantilever = test::cantilever_scene();
 
 TEST(SceneBuilder, LoadsAndSupportsFollowTheScene) {
   const Model model = build_scene_model(parse_scene(cantilever));

@@ -2,6 +2,8 @@
 // them), for every solver kind. The program replaces malloc to count allocations.
 #include <pointhaptics/pointhaptics.hpp>
 
+#include "support/test_scenes.hpp"
+
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -59,26 +61,7 @@ namespace pointhaptics {
 namespace {
 
 Simulation beam(const std::string& solver) {
-  const std::string text = R"(
-[object]
-shape = "box"
-size = [0.15, 0.03, 0.03]
-spacing = 0.0075
-[material]
-young = 1e5
-poisson = 0.4
-damping = 5.0
-[[fixed]]
-box = { min = [-1.0, -1.0, -1.0], max = [0.0, 1.0, 1.0] }
-[[load]]
-kind = "traction"
-box = { min = [0.15, -1.0, -1.0], max = [1.0, 1.0, 1.0] }
-total = [0.0, -0.01, 0.0]
-[solver]
-kind = ")" + solver + R"("
-dt = 2e-3
-)";
-  const Scene scene = parse_scene(text);
+  const Scene scene = parse_scene(test::cantilever_scene(solver, "2e-3"));
   return Simulation(build_scene_model(scene), scene.solver, 1);
 }
 
