@@ -108,8 +108,10 @@ std::unique_ptr<PySimulation> from_points(const RowPoints& X, double spacing, py
   material.poisson = poisson;
   material.density = density;
   material.damping = damping;
-  if (!(young > 0) || !(poisson > -1 && poisson < 0.5) || !(density > 0) || !(damping >= 0))
-    throw ph::Error("material: young > 0, -1 < poisson < 0.5, density > 0 and damping >= 0 are needed");
+  if (!(young > 0 && young <= 1e13) || !(poisson > -1 && poisson < 0.5) || !(density >= 1e-3 && density <= 1e5) ||
+      !(damping >= 0 && std::isfinite(damping)))
+    throw ph::Error("material: 0 < young <= 1e13 Pa, -1 < poisson < 0.5, 1e-3 <= density <= 1e5 kg/m^3 and damping >= 0 are "
+                    "needed (as in scene files)");
   ph::KernelParams k;
   k.type = kernel_type(kernel);
   k.support_factor = support_factor;

@@ -33,6 +33,11 @@ expect_error(huge_device_specs "${good}[probe]\nkeyframes = [[0.0, 0.0, 0.0, 0.0
 expect_error(far_lod_contact "${good}[lod]\nlevels = [ { distance = 3.0, K = 6 } ]\ncontact = [1e300, 0.0, 0.0]\n" "lod.contact: .* outside the object")
 file(WRITE ${WORK}/sparse.xyz "0 0 0\n0.01 0 0\n0 0.01 0\n0 0 0.01\n0.01 0.01 0.01\n")
 expect_error(no_neighbours "[object]\nshape = \"file\"\nfile = \"${WORK}/sparse.xyz\"\nspacing = 0.001\n" "have no neighbour within the support")
+# issue 21: messages that named the wrong cause
+expect_error(huge_spacing "[object]\nshape = \"box\"\nsize = [0.1, 0.1, 0.1]\nspacing = 1e300\n" "spacing 1e\\+300 m is larger than the body")
+expect_error(tiny_spacing "[object]\nshape = \"box\"\nsize = [0.1, 0.1, 0.1]\nspacing = 1e-300\n" "spacing 1e-300 m is too fine")
+expect_error(huge_young "${good}[material]\nyoung = 1e300\n" "material.young: 1e\\+300 is out of range")
+expect_error(tiny_density "${good}[material]\ndensity = 1e-320\n" "material.density: 1e-320 is out of range")
 expect_error(diverging "${good}[material]\nyoung = 1e5\n[[load]]\nkind = \"point\"\npoint = 0\nforce = [1e9, 0, 0]\n" "diverged at t =")
 execute_process(COMMAND ${EXE} run ${WORK}/does-not-exist.toml RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
 if(rc EQUAL 0 OR NOT err MATCHES "does-not-exist.toml")

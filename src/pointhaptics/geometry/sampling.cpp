@@ -7,6 +7,8 @@
 #include <oneapi/tbb/parallel_for.h>
 
 #include <array>
+#include <fmt/format.h>
+
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -15,8 +17,12 @@ namespace pointhaptics {
 namespace {
 
 void check_spacing(double spacing, double extent) {
-  if (!(spacing > 0) || !std::isfinite(spacing)) throw Error("sampling: spacing must be positive and finite, got " + std::to_string(spacing));
-  if (extent / spacing > 2000) throw Error("sampling: spacing " + std::to_string(spacing) + " m is too fine for a body of " + std::to_string(extent) + " m (more than 2000 points per axis)");
+  if (!(spacing > 0) || !std::isfinite(spacing)) throw Error(fmt::format("sampling: spacing must be positive and finite, got {:.3g}", spacing));
+  if (extent / spacing > 2000)
+    throw Error(fmt::format("sampling: spacing {:.3g} m is too fine for a body of {:.3g} m (more than 2000 points per axis)", spacing, extent));
+  // coarser than the body itself: a handful of points, or points that coincide to round-off
+  if (spacing > extent)
+    throw Error(fmt::format("sampling: spacing {:.3g} m is larger than the body ({:.3g} m): no interior to simulate", spacing, extent));
 }
 
 // grid points spacing apart, one at `centre`, for which inside() holds

@@ -234,10 +234,12 @@ void read_object(TableReader& r, ObjectSpec& o, const Context& ctx) {
 }
 
 void read_material(TableReader& r, MaterialParams& m) {
-  m.young = r.number("young", m.young, positive, "must be > 0 (Pa)");
+  // beyond any solid (steel is 2e11 Pa, air 1.2 kg/m^3): 1e300 Pa or 1e-320 kg/m^3 made the solver "diverge"
+  m.young = r.number("young", m.young, [](double x) { return x > 0 && x <= 1e13; }, "must lie in (0, 1e13] (Pa)");
   m.poisson = r.number("poisson", m.poisson, [](double x) { return x > -1 && x < 0.5; }, "must lie in (-1, 0.5)");
-  m.density = r.number("density", m.density, positive, "must be > 0 (kg/m^3)");
-  m.volume_stiffness = r.number("volume_stiffness", m.volume_stiffness, non_negative, "must be >= 0 (Pa)");
+  m.density = r.number("density", m.density, [](double x) { return x >= 1e-3 && x <= 1e5; }, "must lie in [1e-3, 1e5] (kg/m^3)");
+  m.volume_stiffness =
+      r.number("volume_stiffness", m.volume_stiffness, [](double x) { return x >= 0 && x <= 1e13; }, "must lie in [0, 1e13] (Pa)");
   m.damping = r.number("damping", m.damping, non_negative, "must be >= 0 (1/s)");
   m.hourglass = r.number("hourglass", m.hourglass, [](double x) { return x >= 0 && x <= 10; }, "must lie in [0, 10]");
   m.volume = r.choice("volume", "cell", {"cell", "kernel"}) == "cell" ? VolumeMode::CELL : VolumeMode::KERNEL;
