@@ -163,9 +163,31 @@ int run_command(const RunOptions& opt) {
                                   ? 1
                                   : std::max<long long>(1, std::llround(std::ceil(scene.solver.duration / scene.solver.dt - 1e-9)));
     const long long every = opt.vtk_every > 0 ? opt.vtk_every : std::max<long long>(1, n_steps / 50);
+    const auto stepping = std::chrono::steady_clock::now();
+    bool estimated = false;
     for (long long step = 1; step <= n_steps && !interrupted.load(); ++step) {
       sim.step();
       bar.update(static_cast<double>(step) / static_cast<double>(n_steps));
+      // after a second, a run that will take long says so, with what it costs and what would be faster
+      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - stepping).count();
+      if (!estimated && elapsed > 1.0 && step < n_steps) {
+        estimated = true;
+        const double total = elapsed / static_cast<double>(step) * static_cast<double>(n_steps);
+        if (total > 60) {
+          const ph::RunSummary so_far = sim.summary();
+          const bool stiff = scene.solver.kind == ph::SolverKind::EXPLICIT && so_far.substeps > 4 * so_far.steps;
+          fmt::print(stderr,
+                     "pointhaptics: {}: this run will take about {} ({} steps of {:.3g} s at {:.3g} ms each{}){}; Ctrl-C "
+                     "stops it and writes the state reached\n",
+                     opt.scene, total < 7200 ? fmt::format("{:.0f} min", total / 60) : fmt::format("{:.1f} h", total / 3600),
+                     n_steps, scene.solver.dt, 1e3 * elapsed / static_cast<double>(step),
+                     scene.solver.kind == ph::SolverKind::EXPLICIT
+                         ? fmt::format(", {:.0f} sub-steps each below the stable step {:.3g} s",
+                                       static_cast<double>(so_far.substeps) / static_cast<double>(so_far.steps), so_far.stable_dt)
+                         : std::string(),
+                     stiff ? "; a stiff object: solver.kind = \"implicit\" takes steps of any size" : "");
+        }
+      }
       if (vtk && step % every == 0 && step < n_steps) errors.attempt([&] { ph::add_vtk_frame(*vtk, sim); });
     }
   }

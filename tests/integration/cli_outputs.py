@@ -100,6 +100,17 @@ assert rows[0].startswith("t,x,y,z") and len(rows) > 1000, (len(rows), err)
 times = [float(r.split(",")[0]) for r in rows[1:]]
 assert all(b > a for a, b in zip(times, times[1:])), "rows out of order"
 print(f"ok: an endless run streamed {len(rows) - 1} rows to its force log before SIGINT")
+# 4: a run that cannot finish in reasonable time says so after a second, and suggests the implicit solver
+stiff = os.path.join(work, "stiff.toml")
+open(stiff, "w").write('[object]\nshape = "box"\nsize = [0.1, 0.03, 0.03]\nspacing = 0.005\n[material]\nyoung = 1e12\n'
+                       '[[fixed]]\nbox = { min = [-1, -1, -1], max = [0.0, 1, 1] }\n[solver]\nkind = "explicit"\nduration = 100.0\n')
+proc = subprocess.Popen([cli, "run", stiff, "--quiet"], stderr=subprocess.PIPE, text=True)
+time.sleep(4)
+proc.send_signal(signal.SIGINT)
+_, err = proc.communicate(timeout=60)
+assert proc.returncode == 130 and "this run will take about" in err and "implicit" in err, (proc.returncode, err)
+print("ok: " + err.splitlines()[0])
+
 # 12b: --vtk-every animates an interactive run (only its first and last frames were written)
 frames = os.path.join(work, "probe_frames")
 p, _ = run(probe, "--deterministic", "--vtk", frames, "--vtk-every", "100")
