@@ -4,6 +4,7 @@
 #include <imgui.h>
 
 #include <algorithm>
+#include <cmath>
 #include <array>
 
 namespace pointhaptics::viewer {
@@ -31,7 +32,9 @@ bool combo(const char* label, Enum& value, const std::array<const char*, N>& nam
 
 void plot(const char* label, const RollingSeries& series, std::vector<float>& scratch, const char* unit) {
   series.values(scratch);
-  const std::string overlay = fmt::format("{:.3g} {}", series.latest(), unit);
+  // round-off (a force of 1e-15 N when nothing touches) shows as the 0 it is
+  const double latest = std::abs(series.latest()) < 1e-9 * std::max(1.0, static_cast<double>(series.max())) ? 0.0 : series.latest();
+  const std::string overlay = fmt::format("{:.3g} {}", latest, unit);
   const float top = std::max(series.max() * 1.1f, 1e-6f);
   ImGui::PlotLines(label, scratch.data(), static_cast<int>(scratch.size()), 0, overlay.c_str(), 0.0f, top, ImVec2(0, 60));
 }
