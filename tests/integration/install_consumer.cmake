@@ -20,3 +20,21 @@ if(NOT rc EQUAL 0)
   message(FATAL_ERROR "the consumer failed: ${out}")
 endif()
 message(STATUS "consumer: ${out}")
+# the Python package lands where Debian's python3 looks under /usr/local (the default prefix), and imports
+# from there
+execute_process(COMMAND /usr/bin/python3 -c "import site, sys, sysconfig; v = '%d.%d' % sys.version_info[:2]; \
+assert '/usr/local/lib/python' + v + '/dist-packages' in sys.path; print('lib/python' + v + '/dist-packages')"
+                RESULT_VARIABLE rc OUTPUT_VARIABLE python_dir ERROR_VARIABLE err OUTPUT_STRIP_TRAILING_WHITESPACE)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "python3 does not search /usr/local/lib/python3.X/dist-packages: ${err}")
+endif()
+if(NOT EXISTS ${WORK}/prefix/${python_dir}/pointhaptics/__init__.py)
+  message(FATAL_ERROR "the Python package is not installed in ${python_dir}, where python3 looks under /usr/local")
+endif()
+execute_process(COMMAND ${CMAKE_COMMAND} -E env PYTHONPATH=${WORK}/prefix/${python_dir}
+                /usr/bin/python3 -c "import pointhaptics as ph; print('python', ph.__version__, ph.__file__)"
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE out)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "the installed Python package does not import: ${out}")
+endif()
+message(STATUS "installed ${out}")
