@@ -162,6 +162,8 @@ std::vector<index_t> Simulation::update_lod(const Vec3& contact, bool onset, boo
   return {};
 }
 
+namespace {
+
 // A re-selection must not add energy. The new active set sees the same displacement field through other
 // points, volumes and stencils, and measured on a probe sliding over the half-sphere its strain energy came
 // out 30-100% above the old set's, its kinetic energy about 10% (mass moves between points, absorbed points
@@ -174,6 +176,8 @@ void remove_added_energy(const Model& model, double energy_before, State& state)
   if (!(added > 0) || !(kinetic > 0)) return;
   state.velocity *= std::sqrt(std::max(0.0, kinetic - added) / kinetic);
 }
+
+}  // namespace
 
 std::vector<index_t> Simulation::take_over(LodBuild build, bool built_here) {
   Lod& l = *lod_;
