@@ -111,7 +111,10 @@ struct OutputErrors {
 
 int run_command(const RunOptions& opt) {
   const auto start = std::chrono::steady_clock::now();
-  // every output is checked before anything is computed: a long run must not end in "cannot write"
+  // the ParaView folder first (made with its parents, so other outputs may go beside it), then every output
+  // is checked before anything is computed: a long run must not end in "cannot write"
+  std::optional<ph::VtkSeries> vtk;
+  if (!opt.vtk.empty()) vtk.emplace(opt.vtk);
   if (!opt.json.empty()) ph::check_output_path(opt.json, "--json");
   if (!opt.csv.empty()) ph::check_output_path(opt.csv, "--csv");
   if (!opt.force_log.empty()) ph::check_output_path(opt.force_log, "--force-log");
@@ -119,11 +122,7 @@ int run_command(const RunOptions& opt) {
   ph::Simulation sim(ph::build_scene_model(scene, static_cast<double>(opt.max_memory)), scene.solver, opt.threads);
   if (scene.lod.present) sim.enable_lod(scene.lod.params, ph::scene_lod_contact(scene, sim.model()));
   const double setup_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::optional<ph::VtkSeries> vtk;
-  if (!opt.vtk.empty()) {
-    vtk.emplace(opt.vtk);
-    ph::add_vtk_frame(*vtk, sim);  // the initial state
-  }
+  if (vtk) ph::add_vtk_frame(*vtk, sim);  // the initial state
   const double start_time = sim.state().time;
   const bool options_real_time = !opt.deterministic;
   interrupted.store(false);
