@@ -157,15 +157,9 @@ int run_command(const RunOptions& opt) {
                                             opt.force_log, interactive.log_dropped));
   } else {
     ph::cli::ProgressBar bar(!opt.quiet);
-    // frames: every vtk_every steps (default: about 50 over the run), and the last state
-    const long long n_steps = scene.solver.kind == ph::SolverKind::STATIC
-                                  ? 1
-                                  : std::max<long long>(1, std::llround(std::ceil(scene.solver.duration / scene.solver.dt - 1e-9)));
-    const long long every = opt.vtk_every > 0 ? opt.vtk_every : std::max<long long>(1, n_steps / 50);
     const auto stepping = std::chrono::steady_clock::now();
     bool estimated = false;
-    for (long long step = 1; step <= n_steps && !interrupted.load(); ++step) {
-      sim.step();
+    sim.run(scene.solver.duration, [&](long long step, long long n_steps) {
       bar.update(static_cast<double>(step) / static_cast<double>(n_steps));
       // after a second, a run that will take long says so, with what it costs and what would be faster
       const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - stepping).count();
@@ -187,8 +181,11 @@ int run_command(const RunOptions& opt) {
                      stiff ? "; a stiff object: solver.kind = \"implicit\" takes steps of any size" : "");
         }
       }
+      // frames: every vtk_every steps (default: about 50 over the run), and the last state below
+      const long long every = opt.vtk_every > 0 ? opt.vtk_every : std::max<long long>(1, n_steps / 50);
       if (vtk && step % every == 0 && step < n_steps) errors.attempt([&] { ph::add_vtk_frame(*vtk, sim); });
-    }
+      return !interrupted.load();
+    });
   }
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);

@@ -13,9 +13,9 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
-#include <numbers>
-#include <limits>
 #include <fstream>
+#include <limits>
+#include <numbers>
 
 namespace pointhaptics {
 

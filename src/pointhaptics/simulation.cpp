@@ -77,7 +77,6 @@ Simulation::Simulation(Simulation&&) noexcept = default;
 
 void Simulation::prepare_solver(double stable_dt) {
   stable_dt_ = stable_dt > 0 ? stable_dt : stable_time_step(model_);
-  min_free_mass_ = min_free_mass(model_);
   extra_forces_ = Points::Zero(3, model_.n_points);
   static_.reset();
   implicit_.reset();
@@ -241,10 +240,7 @@ void Simulation::step_solver() {
   switch (solver_.kind) {
     case SolverKind::EXPLICIT: {
       // internal forces, then symplectic Euler, sub-stepped below the stable step
-      // contact springs stiffer than the material shorten the stable step (issue 21: a probe of 1e4 N/m diverged)
-      const double stable =
-          dynamic_forces_ ? stable_time_step_with_springs(stable_dt_, dynamic_forces_->max_point_stiffness(), min_free_mass_) : stable_dt_;
-      const ExplicitStepStats stats = explicit_step(model_, state_, ws_, solver_.dt, stable, dynamic_forces_);
+      const ExplicitStepStats stats = explicit_step(model_, state_, ws_, solver_.dt, stable_dt_, dynamic_forces_);
       substeps_ += stats.substeps;
       iterations_ += stats.substeps;
       break;
@@ -286,16 +282,12 @@ void Simulation::step_solver() {
   step_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-void Simulation::run(double duration, const std::function<void(double)>& progress) {
-  if (solver_.kind == SolverKind::STATIC) {
+void Simulation::run(double duration, const std::function<bool(long long, long long)>& after_step) {
+  const long long n_steps =
+      solver_.kind == SolverKind::STATIC ? 1 : std::max<long long>(0, std::llround(std::ceil(duration / solver_.dt - 1e-9)));
+  for (long long k = 1; k <= n_steps; ++k) {
     step();
-    if (progress) progress(1.0);
-    return;
-  }
-  const long long n_steps = std::llround(std::ceil(duration / solver_.dt - 1e-9));
-  for (long long k = 0; k < n_steps; ++k) {
-    step();
-    if (progress) progress(static_cast<double>(k + 1) / n_steps);
+    if (after_step && !after_step(k, n_steps)) return;
   }
 }
 

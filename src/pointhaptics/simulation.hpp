@@ -27,9 +27,10 @@ class Simulation {
   /// Advance by one solver step (dt): explicit (sub-stepped) or implicit dynamics; for a static solver,
   /// solve for the equilibrium under the full load (once; later calls start from the last solution).
   void step();
-  /// Dynamics: step until state().time reaches `duration`; static: one solve. progress(fraction) is
-  /// called after each step.
-  void run(double duration, const std::function<void(double)>& progress = {});
+  /// Dynamics: step until state().time reaches `duration` (ceil(duration / dt) steps); static: one solve.
+  /// after_step(step, n_steps), if given, is called after each step; returning false stops the run there
+  /// (an interrupted run keeps the state reached).
+  void run(double duration, const std::function<bool(long long step, long long n_steps)>& after_step = {});
 
   /// The simulated model and its state: the whole object, or with levels of detail the active set.
   const Model& model() const { return model_; }
@@ -93,7 +94,6 @@ class Simulation {
   std::unique_ptr<StaticSolver> static_;      ///< static
   std::unique_ptr<ImplicitSolver> implicit_;  ///< implicit
   double stable_dt_ = 0;
-  double min_free_mass_ = 0;  ///< kg, for the stable step with contact springs
   long long steps_ = 0, substeps_ = 0, iterations_ = 0, cg_iterations_ = 0;
   bool converged_ = true;
   long long budget_steps_ = 0;  ///< implicit steps the iteration budget ended above the tolerance

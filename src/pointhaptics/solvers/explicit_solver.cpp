@@ -120,8 +120,10 @@ double strain_stiffening(const Model& model, Workspace& ws) {
 
 ExplicitStepStats explicit_step(const Model& model, State& state, Workspace& ws, double dt, double stable_dt,
                                 DynamicForces* extra) {
-  // the rest-state step, shortened where the last force evaluation found the material stretched beyond
-  // what its safety factor covers (0.8 leaves omega^2 a margin of 1.56; a quarter is kept for stiffening)
+  // the rest-state step, shortened by the springs of the state-dependent forces (a probe's contact: issue
+  // 21, 1e4 N/m diverged), then where the last force evaluation found the material stretched beyond what
+  // its safety factor covers (0.8 leaves omega^2 a margin of 1.56; a quarter is kept for stiffening)
+  if (extra) stable_dt = stable_time_step_with_springs(stable_dt, extra->max_point_stiffness(), min_free_mass(model));
   stable_dt *= std::min(1.0, std::sqrt(covered_stiffening / strain_stiffening(model, ws)));
   const int n_sub = std::max(1, static_cast<int>(std::ceil(dt / stable_dt * (1 - 1e-12))));
   const double h = dt / n_sub;

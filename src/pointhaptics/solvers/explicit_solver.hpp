@@ -38,8 +38,8 @@ struct ExplicitStepStats {
 };
 
 /// Advance the state by dt with ceil(dt / stable step) equal symplectic Euler sub-steps, the stable step
-/// shortened by sqrt(1.25 / strain_stiffening()) where the material is stretched by more than its safety
-/// factor covers:
+/// shortened for the springs of `extra` (stable_time_step_with_springs) and by sqrt(1.25 / strain_stiffening())
+/// where the material is stretched by more than its safety factor covers:
 ///   v <- (v + h M^-1 (f_int + f_ext)) / (1 + h c),   u <- u + h v   (c: mass-proportional damping)
 /// Held points follow their prescribed displacement. Throws Error naming the step and point if a
 /// displacement becomes non-finite or grows beyond 100 times the object's size (divergence).
