@@ -50,19 +50,17 @@ py::dict summary_dict(const ph::Model& model, const ph::State& state, const ph::
   return d;
 }
 
-ph::SolverKind solver_kind(const std::string& kind) {
-  if (kind == "static") return ph::SolverKind::STATIC;
-  if (kind == "explicit") return ph::SolverKind::EXPLICIT;
-  if (kind == "implicit") return ph::SolverKind::IMPLICIT;
-  throw ph::Error("solver: unknown kind \"" + kind + "\" (expected static | explicit | implicit)");
+// a name from the enum's one table (core/parameters.hpp), or an error listing the names
+template <class E>
+E enum_value(const char* what, const char* key, const std::string& name) {
+  if (const std::optional<E> e = ph::parse_enum<E>(name)) return *e;
+  throw ph::Error(fmt::format("{}: unknown {} \"{}\" (expected {})", what, key, name, ph::enum_choices<E>()));
 }
 
-ph::KernelType kernel_type(const std::string& type) {
-  if (type == "poly6") return ph::KernelType::POLY6;
-  if (type == "spiky") return ph::KernelType::SPIKY;
-  if (type == "viscosity") return ph::KernelType::VISCOSITY;
-  if (type == "quadratic") return ph::KernelType::QUADRATIC;
-  throw ph::Error("kernel: unknown type \"" + type + "\" (expected poly6 | spiky | viscosity | quadratic)");
+// A step that failed (divergence, Newton, load stepping) is an exception in Python, as the docstrings say;
+// summary() then says so too
+void raise_if_failed(const ph::StepReport& report) {
+  if (report.status == ph::StepStatus::FAILED) throw ph::Error(report.failure);
 }
 
 // The simulation with the scene it came from (for its probe), so that Python owns one object. Calls that
@@ -113,10 +111,10 @@ std::unique_ptr<PySimulation> from_points(const RowPoints& X, double spacing, py
     throw ph::Error("material: 0 < young <= 1e13 Pa, -1 < poisson < 0.5, 1e-3 <= density <= 1e5 kg/m^3 and damping >= 0 are "
                     "needed (as in scene files)");
   ph::KernelParams k;
-  k.type = kernel_type(kernel);
+  k.type = enum_value<ph::KernelType>("kernel", "type", kernel);
   k.support_factor = support_factor;
   auto p = std::make_unique<PySimulation>();
-  p->scene.solver.kind = solver_kind(solver);
+  p->scene.solver.kind = enum_value<ph::SolverKind>("solver", "kind", solver);
   p->scene.solver.dt = dt;
   ph::Model model = ph::build_model(cloud, material, k);
   if (!fixed.is_none()) {
@@ -170,7 +168,7 @@ names the problem.)doc")
           "step", [](PySimulation& p) {
             py::gil_scoped_release release;
             const std::lock_guard<std::mutex> lock(p.mutex);
-            p.sim->step();
+            raise_if_failed(p.sim->step());
           },
           "Advance by one solver step: dt of explicit dynamics (sub-stepped below the stable step) or implicit "
           "dynamics; a static solver solves for the equilibrium under the full load. Raises pointhaptics.Error on a "
@@ -181,8 +179,11 @@ names the problem.)doc")
             py::gil_scoped_release release;
             const std::lock_guard<std::mutex> lock(p.mutex);
             p.sim->run(duration);
+            if (p.sim->diagnostics().failed) throw ph::Error(p.sim->diagnostics().failure);
           },
-          py::arg("duration"), "Step until `duration` seconds more have passed (static: solve once); releases the GIL")
+          py::arg("duration"),
+          "Step until `duration` seconds more have passed (static: solve once); stops at a failed step and raises "
+          "pointhaptics.Error (summary() then says so); releases the GIL")
       .def_property_readonly(
           "time",
           [](PySimulation& p) {
@@ -307,6 +308,7 @@ names the problem.)doc")
               const std::lock_guard<std::mutex> lock(p.mutex);
               r = ph::run_interactive(*p.sim, device, o);
             }
+            if (p.sim->diagnostics().failed) throw ph::Error(p.sim->diagnostics().failure);
             // the columns of --force-log: t, x, y, z, vx, vy, vz, buttons, fx, fy, fz
             py::array_t<double> log({static_cast<py::ssize_t>(r.log.size()), py::ssize_t{11}});
             auto w = log.mutable_unchecked<2>();

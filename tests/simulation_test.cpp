@@ -105,11 +105,17 @@ TEST(Simulation, StepsEndedByTheIterationBudgetAreCountedNotFailures) {
   EXPECT_EQ(s.iterations, 10);
   EXPECT_GT(s.residual, 1e-13);
   EXPECT_NE(result_json(sim.model(), sim.state(), s).find("\"budget_steps\": 10"), std::string::npos);
-  // the same tolerance without a budget: the step fails with a named error
+  // the same tolerance without a budget: the first step fails with a named failure, the run stops there,
+  // and the simulation refuses to step on from a state that is not a result
   scene.solver.iteration_budget = 0;
   scene.solver.max_iterations = 1;
   Simulation strict(build_scene_model(scene), scene.solver, 1);
-  EXPECT_THROW(strict.run(0.01), Error);
+  strict.run(0.01);
+  EXPECT_EQ(strict.diagnostics().steps, 1);
+  EXPECT_TRUE(strict.diagnostics().failed);
+  EXPECT_FALSE(strict.summary().converged);
+  EXPECT_NE(strict.summary().failure.find("did not converge"), std::string::npos) << strict.summary().failure;
+  EXPECT_THROW(strict.step(), Error);
 }
 
 TEST(Simulation, CantileverSettlesOnTheCalculixDeflection) {

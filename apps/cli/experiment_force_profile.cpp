@@ -51,6 +51,7 @@ int run_force_profile_experiment(const ForceProfileOptions& options) {
   o.mapping.origin = at;
   const InteractiveResult r = run_interactive(sim, device, o);
   if (r.haptic.device_failed) throw Error(fmt::format("force-profile: the device failed: {}", r.haptic.device_error));
+  if (sim.diagnostics().failed) throw Error(fmt::format("force-profile: {}", sim.diagnostics().failure));
 
   auto csv = fmt::output_file((out / "force-profile.csv").string());
   csv.print("t_s,force_n,fx_n,fy_n,fz_n,device_y_m,button\n");

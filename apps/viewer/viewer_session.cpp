@@ -140,6 +140,7 @@ void ViewerSession::start() {
       o.stop = &stop_;
       const InteractiveResult r = run_interactive(*prepared_->simulation, *prepared_->device, o);
       if (r.haptic.device_failed) run_error_ = "the device failed: " + r.haptic.device_error;
+      if (prepared_->simulation->diagnostics().failed) run_error_ = prepared_->simulation->diagnostics().failure;
     } catch (const std::exception& e) {
       run_error_ = e.what();
     }

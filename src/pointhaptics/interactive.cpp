@@ -15,80 +15,22 @@
 namespace pointhaptics {
 namespace {
 
-// The probe's contact as forces on the points, evaluated at every explicit sub-step with the probe of
-// the step; remembers the last local contact model.
-class ContactForces : public DynamicForces {
- public:
-  ContactForces(const Model& model, const ProbeParams& params, double coupling_stiffness, double max_force)
-      : contact(model, params), k(coupling_stiffness), max_force(max_force), scratch(Points::Zero(3, model.n_points)) {}
-
-  // Once per step: the probe is where the coupling spring (toward the device point, its force capped at
-  // the device's maximum: the hand cannot push harder than it can feel) balances the contact forces at
-  // the step's start; a few Newton steps on the local model from the last position. Within the step the
-  // probe stays there (re-solving it at every sub-step let the contact set chatter and excite the lattice).
-  void solve_probe(const Model& model, const State& state) {
-    if (!device.allFinite()) {
-      probe = device;
-      return;
-    }
-    Vec3 p = probe.allFinite() ? probe : device;
-    for (int it = 0; it < 8; ++it) {
-      scratch.setZero();
-      // the state is the same at every iteration: the positions and their grid are made once
-      const ContactModel m = contact.apply(model, state.u, p, button, state.time, scratch, it > 0);
-      Vec3 d = device;
-      const auto solver = (k * Mat3::Identity() - m.K).ldlt();
-      Vec3 next = solver.solve(k * d + m.f0 - m.K * p);
-      const double pull = k * (d - next).norm();
-      if (pull > max_force && next.allFinite()) {
-        d = next + (d - next) * (max_force / pull);
-        next = solver.solve(k * d + m.f0 - m.K * p);
-      }
-      if (!next.allFinite()) break;
-      const bool settled = (next - p).norm() < 1e-9 + 1e-6 * contact.params().radius;
-      p = next;
-      if (settled) break;
-    }
-    probe = p;
-  }
-  void add(const Model& model, const State& state, Points& f) override {
-    last = contact.apply(model, state.u, probe, button, state.time, f);
-  }
-  // levels of detail re-selected: the simulated points were renumbered
-  void remap(const Model& model, const std::vector<index_t>& new_index) {
-    contact.remap(model, new_index);
-    scratch = Points::Zero(3, model.n_points);
-  }
-  double max_point_stiffness() const override { return contact.params().stiffness; }
-  bool add_stiffness(const Model&, const State&, Eigen::Matrix<double, 9, Eigen::Dynamic>& springs) override {
-    contact.add_stiffness(springs);
-    return last.contacts > 0;
-  }
-  ProbeContact contact;
-  double k, max_force;
-  Vec3 device = Vec3::Constant(NAN);  ///< the device point of the latest haptic frame
-  Vec3 probe = Vec3::Constant(NAN);   ///< the probe as the simulation solved it last
-  bool button = false;
-  ContactModel last;
-  Points scratch;
-};
-
 // What a viewer shows of the step just made.
-void publish_display(Simulation& sim, const ContactForces& contact, const HapticFrame& haptic, long long step,
-                     TripleBuffer<DisplayFrame>& display) {
+void publish_display(Simulation& sim, const HapticFrame& haptic, long long step, TripleBuffer<DisplayFrame>& display) {
+  const ProbeTool& probe = *sim.probe();
   DisplayFrame& d = display.back();
   d.time = sim.state().time;
   d.step = step;
   d.u = sim.full_state().u;  // same size every time: no allocation
-  d.probe = contact.probe;
+  d.probe = probe.probe();
   d.device = haptic.device;
   d.force = haptic.force;
   d.haptic_ticks = haptic.tick;
-  d.contacts = contact.last.contacts;
+  d.contacts = probe.contact_model().contacts;
   const ActiveSet* active = sim.active_set();
   d.simulated = active ? active->n_selected : sim.model().n_points;
   d.grabbed.clear();
-  for (const index_t i : contact.contact.grabbed()) d.grabbed.push_back(active ? active->full_of[i] : i);
+  for (const index_t i : probe.contact().grabbed()) d.grabbed.push_back(active ? active->full_of[i] : i);
   if (active && d.lod_selections != sim.lod_selections()) {  // a new active set (rare): each slot catches up once
     const Selection& selection = *sim.lod_selection();
     d.lod_band.assign(sim.full_model().n_points, -1);
@@ -98,30 +40,17 @@ void publish_display(Simulation& sim, const ContactForces& contact, const Haptic
   display.publish();
 }
 
-// One simulation step with the latest probe; then the local model is published (run_interactive publishes
-// the display frames, at most one per display_period).
-int simulation_step(Simulation& sim, ContactForces& contact, HapticLoop& loop, bool real_time) {
+// One simulation step with the latest device point; then the local contact model is published for the
+// haptic loop (run_interactive publishes the display frames, at most one per display_period).
+int simulation_step(Simulation& sim, HapticLoop& loop) {
   loop.frames().update();
   const HapticFrame& frame = loop.frames().front();
-  contact.device = frame.device;
-  contact.button = frame.button;
-  contact.solve_probe(sim.model(), sim.state());
-  const int contacts_before = contact.last.contacts;
+  sim.inputs().device = frame.device;
+  sim.inputs().button = frame.button;
   sim.step();
-  loop.contact_models().back() = contact.last;
+  loop.contact_models().back() = sim.probe()->contact_model();
   loop.contact_models().publish();
-  if (sim.lod_enabled()) {
-    // levels of detail follow the contact point: at contact onset and when it moved far enough; on this
-    // thread, while the haptic thread keeps rendering the local model just published
-    const bool onset = contacts_before == 0 && contact.last.contacts > 0;
-    // in real time built on a worker thread and taken over at the first step after it is ready; in
-    // deterministic runs built here, so that a run is reproducible
-    const std::vector<index_t> new_index =
-        sim.update_lod(sim.lod_contact_of_probe(contact.probe, contact.contact.grabbed(), contact.contact.touched()), onset,
-                       real_time);
-    if (!new_index.empty()) contact.remap(sim.model(), new_index);
-  }
-  return contact.last.contacts;
+  return sim.probe()->contact_model().contacts;
 }
 
 }  // namespace
@@ -172,11 +101,12 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
   if (options.display && options.display->back().u.cols() != sim.full_model().n_points)
     throw Error("interactive run: the display frames must be sized for the model's points (3 x n)");
   const CouplingGains gains = coupling_budget(device.specs(), options.mapping.scale, options.coupling_safety);
-  ContactForces contact(sim.model(), options.probe, gains.stiffness, device.specs().max_force);
-  sim.set_dynamic_forces(&contact);
-  struct Detach {  // the simulation must not keep a pointer to `contact` if a step throws
+  // in real time levels of detail are built on a worker thread and taken over at the first step after they
+  // are ready; in deterministic runs in place, so that a run is reproducible
+  sim.attach_probe(options.probe, gains.stiffness, device.specs().max_force, options.real_time);
+  struct Detach {  // the probe belongs to this run
     Simulation& sim;
-    ~Detach() { sim.set_dynamic_forces(nullptr); }
+    ~Detach() { sim.detach_probe(); }
   } detach{sim};
   const bool streamed = static_cast<bool>(options.log_sink);
   if (options.log && !streamed && !std::isfinite(options.duration))
@@ -203,18 +133,18 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
     if (!last && t - last_display < options.display_period) return;
     last_display = t;
     last_display_step = result.simulation_steps;
-    publish_display(sim, contact, loop.frames().front(), result.simulation_steps - 1, *options.display);
+    publish_display(sim, loop.frames().front(), result.simulation_steps - 1, *options.display);
   };
   if (options.real_time) {
     loop.start();
     for (;;) {
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      if (wall >= options.duration || loop.device_failed() || stopped()) break;
+      if (wall >= options.duration || loop.device_failed() || stopped() || sim.diagnostics().failed) break;
       if (sim.state().time - t0 > wall) {  // ahead of the wall clock: wait for it
         std::this_thread::sleep_for(std::chrono::duration<double>(sim.state().time - t0 - wall));
         continue;
       }
-      result.max_contacts = std::max(result.max_contacts, simulation_step(sim, contact, loop, options.real_time));
+      result.max_contacts = std::max(result.max_contacts, simulation_step(sim, loop));
       ++result.simulation_steps;
       display(false);
       take_log();
@@ -225,13 +155,12 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
     const double h = 1.0 / options.haptic_rate;
     if (!std::isfinite(options.duration)) throw Error("interactive run: a deterministic run needs a finite duration");
     const auto n_ticks = static_cast<long long>(std::llround(options.duration * options.haptic_rate));
-    for (long long k = 1; k <= n_ticks && !stopped(); ++k) {
+    for (long long k = 1; k <= n_ticks && !stopped() && !sim.diagnostics().failed; ++k) {
       const double t = k * h;
       if (!loop.tick(t, h)) break;
       take_log();
-      while (sim.state().time - t0 < t - 1e-12) {
-        result.max_contacts =
-            std::max(result.max_contacts, simulation_step(sim, contact, loop, options.real_time));
+      while (sim.state().time - t0 < t - 1e-12 && !sim.diagnostics().failed) {
+        result.max_contacts = std::max(result.max_contacts, simulation_step(sim, loop));
         ++result.simulation_steps;
         display(false);
         if (options.after_step) options.after_step(result.simulation_steps);

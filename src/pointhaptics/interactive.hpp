@@ -76,7 +76,8 @@ InteractiveOptions scene_interactive_options(const Scene& scene, const Model& mo
 /// (but never ahead of the wall clock), exchanging the probe and the local contact model through
 /// lock-free buffers. Deterministic (real_time = false): the same exchange, interleaved on one thread in
 /// simulated time (a haptic tick every 1/rate s, a simulation step every dt), for tests and experiments.
-/// A device that fails stops the run with zero force; the result says so. Throws Error on bad options.
+/// A device that fails stops the run with zero force; the result says so. A step that fails stops the run
+/// (sim.diagnostics() says why). Throws Error on bad options.
 InteractiveResult run_interactive(Simulation& sim, Device& device, const InteractiveOptions& options);
 
 }  // namespace pointhaptics

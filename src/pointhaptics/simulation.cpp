@@ -6,7 +6,6 @@
 #include <pointhaptics/mechanics/forces.hpp>
 #include <pointhaptics/solvers/explicit_solver.hpp>
 #include <pointhaptics/solvers/reactions.hpp>
-#include <pointhaptics/solvers/static_solver.hpp>
 
 #include <fmt/format.h>
 
@@ -65,9 +64,7 @@ struct Simulation::Lod {
 Simulation::Simulation(Model model, const SolverSpec& solver, int n_threads)
     : model_(std::move(model)), solver_(solver), state_(State::at_rest(model_)), ws_(model_, n_threads), n_threads_(n_threads) {
   prepare_solver();
-  // held points start at their prescribed displacement at t = 0
-  for (const FixedGroup& group : model_.fixed_groups)
-    for (index_t i : group.points) state_.u.col(i) = prescribed_displacement(group, 0.0);
+  hold_points(model_, 0.0, state_.u);  // held points start at their prescribed displacement at t = 0
 }
 
 Simulation::~Simulation() {
@@ -76,12 +73,8 @@ Simulation::~Simulation() {
 Simulation::Simulation(Simulation&&) noexcept = default;
 
 void Simulation::prepare_solver(double stable_dt) {
-  stable_dt_ = stable_dt > 0 ? stable_dt : stable_time_step(model_);
-  extra_forces_ = Points::Zero(3, model_.n_points);
-  static_.reset();
-  implicit_.reset();
-  if (solver_.kind == SolverKind::STATIC) static_ = std::make_unique<StaticSolver>(model_);
-  if (solver_.kind == SolverKind::IMPLICIT) implicit_ = std::make_unique<ImplicitSolver>(model_);
+  stable_dt_ = stable_dt > 0 ? stable_dt : stable_time_step(model_);  // reported for every kind; explicit steps below it
+  solver_impl_ = make_solver(model_, solver_, stable_dt_);
 }
 
 void Simulation::enable_lod(const LodParams& params, const Vec3& contact) {
@@ -201,6 +194,7 @@ std::vector<index_t> Simulation::take_over(LodBuild build, bool built_here) {
   model_ = l.active.model;
   ws_ = Workspace(model_, n_threads_);
   prepare_solver(build.stable_dt);
+  if (probe_) probe_->remap(model_, new_index);  // grabbed points follow their new numbers
   l.full_state_current = false;
   const bool first = l.selections == 0;  // made by enable_lod(), before any step: set-up, not a stall
   if (!first) l.last_selection_time = time;
@@ -212,81 +206,86 @@ std::vector<index_t> Simulation::take_over(LodBuild build, bool built_here) {
   return new_index;
 }
 
-NewtonSettings Simulation::newton_settings() const {
-  NewtonSettings s;
-  s.tolerance = solver_.tolerance > 0 ? solver_.tolerance : solver_.kind == SolverKind::STATIC ? 1e-8 : 1e-6;
-  s.max_iterations = solver_.max_iterations;
-  s.max_cg_iterations = solver_.max_cg_iterations;
-  if (solver_.kind == SolverKind::IMPLICIT && solver_.iteration_budget > 0) {
-    s.max_iterations = solver_.iteration_budget;
-    s.accept_at_budget = true;
-  }
-  return s;
+void Simulation::attach_probe(const ProbeParams& params, double coupling_stiffness, double max_force, bool asynchronous_lod) {
+  if (solver_.kind == SolverKind::STATIC) throw Error("probe: needs a dynamic solver (explicit or implicit)");
+  probe_.emplace(model_, params, coupling_stiffness, max_force);
+  asynchronous_lod_ = asynchronous_lod;
+  inputs_ = StepInputs{};
 }
 
-void Simulation::step() {
-  // a step that fails (divergence, Newton) leaves a state that is not a result: the summary says so
-  try {
-    step_solver();
-  } catch (const Error& e) {
-    converged_ = false;
-    failure_ = e.what();
-    throw;
-  }
+void Simulation::detach_probe() {
+  probe_.reset();
+  inputs_ = StepInputs{};
 }
 
-void Simulation::step_solver() {
-  const auto start = std::chrono::steady_clock::now();
-  switch (solver_.kind) {
-    case SolverKind::EXPLICIT: {
-      // internal forces, then symplectic Euler, sub-stepped below the stable step
-      const ExplicitStepStats stats = explicit_step(model_, state_, ws_, solver_.dt, stable_dt_, dynamic_forces_);
-      substeps_ += stats.substeps;
-      iterations_ += stats.substeps;
-      break;
-    }
-    case SolverKind::IMPLICIT: {
-      const Points* extra = nullptr;
-      const Eigen::Matrix<double, 9, Eigen::Dynamic>* springs = nullptr;
-      if (dynamic_forces_) {
-        extra_forces_.setZero();
-        dynamic_forces_->add(model_, state_, extra_forces_);
-        extra = &extra_forces_;
-        springs_.setZero(9, model_.n_points);
-        if (dynamic_forces_->add_stiffness(model_, state_, springs_)) springs = &springs_;
-      }
-      const NewtonStats stats = implicit_->step(model_, state_, ws_, solver_.dt, newton_settings(), extra, springs);
-      iterations_ += stats.iterations;
-      cg_iterations_ += stats.cg_iterations;
-      residual_ = stats.residual;
-      // a step the iteration budget ended keeps its iterate, as the scene asked (real time): counted, not a failure
-      if (stats.residual > newton_settings().tolerance) {
-        if (solver_.iteration_budget > 0) ++budget_steps_;
-        else converged_ = false;
-      }
-      break;
-    }
-    case SolverKind::STATIC: {
-      const StaticStats stats = static_->solve(model_, state_, ws_, newton_settings());
-      iterations_ += stats.iterations;
-      cg_iterations_ += stats.cg_iterations;
-      substeps_ += stats.load_steps;
-      residual_ = stats.residual;
-      converged_ = stats.converged;
-      failure_ = stats.failure;
-      break;
-    }
-  }
-  ++steps_;
+// ---- the step pipeline: each stage is one function below, in the order step() calls them ----------------
+
+const StepReport& Simulation::step() {
+  if (diagnostics_.failed)
+    throw Error(fmt::format("simulation: no step after a failed one (t = {:.6g} s: {})", state_.time, diagnostics_.failure));
+  using clock = std::chrono::steady_clock;
+  const auto start = clock::now();
+  // 1. the inputs (inputs_) were filled by the caller; 2. the active set follows the last step's contact
+  follow_contact();
+  const auto selected = clock::now();
+  // 3. the tools take their place for this step
+  place_tools();
+  const auto placed = clock::now();
+  // 4. the solver: internal, external and tool forces, time integration or equilibrium, held points
+  report_ = solver_impl_->step(model_, state_, ws_, probe_ ? &*probe_ : nullptr);
+  const auto solved = clock::now();
+  // 5. a state that is not finite is not a result, whatever the solver said
+  check_finite(report_);
+  // 6. the outputs: diagnostics, and the object's state is stale until asked for
+  const auto seconds = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
+  diagnostics_.active_set_seconds += seconds(start, selected);
+  diagnostics_.tools_seconds += seconds(selected, placed);
+  diagnostics_.solve_seconds += seconds(placed, solved);
+  record(report_, seconds(start, clock::now()));
   if (lod_) lod_->full_state_current = false;
-  step_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return report_;
+}
+
+void Simulation::follow_contact() {
+  // levels of detail follow the probe's contact point: at contact onset and when it moved far enough (as
+  // the last step left it; the haptic side keeps rendering the local model published meanwhile)
+  if (!lod_ || !probe_ || diagnostics_.steps == 0) return;
+  const ProbeTool& p = *probe_;
+  const bool onset = p.contacts_before_step() == 0 && p.contact_model().contacts > 0;
+  update_lod(lod_contact_of_probe(p.probe(), p.contact().grabbed(), p.contact().touched()), onset, asynchronous_lod_);
+}
+
+void Simulation::place_tools() {
+  if (probe_) probe_->place(model_, state_, inputs_.device, inputs_.button);
+}
+
+void Simulation::check_finite(StepReport& report) const {
+  if (report.status == StepStatus::FAILED || state_.u.allFinite()) return;
+  report.status = StepStatus::FAILED;
+  report.failure = fmt::format("the state is not finite at t = {:.6g} s", state_.time);
+}
+
+void Simulation::record(const StepReport& report, double seconds) {
+  StepDiagnostics& d = diagnostics_;
+  ++d.steps;
+  d.substeps += report.substeps;
+  d.iterations += report.iterations;
+  d.cg_iterations += report.cg_iterations;
+  if (solver_.kind != SolverKind::EXPLICIT) d.residual = report.residual;
+  if (report.status == StepStatus::AT_BUDGET) ++d.budget_steps;
+  d.status = report.status;
+  if (report.status == StepStatus::FAILED) {
+    d.failed = true;
+    d.failure = report.failure;
+  }
+  d.step_seconds += seconds;
 }
 
 void Simulation::run(double duration, const std::function<bool(long long, long long)>& after_step) {
   const long long n_steps =
       solver_.kind == SolverKind::STATIC ? 1 : std::max<long long>(0, std::llround(std::ceil(duration / solver_.dt - 1e-9)));
   for (long long k = 1; k <= n_steps; ++k) {
-    step();
+    if (step().status == StepStatus::FAILED) return;
     if (after_step && !after_step(k, n_steps)) return;
   }
 }
@@ -294,23 +293,24 @@ void Simulation::run(double duration, const std::function<bool(long long, long l
 RunSummary Simulation::summary() {
   RunSummary s;
   s.solver_kind = std::string(to_string(solver_.kind));
-  s.converged = state_.u.allFinite() && converged_;
-  s.failure = failure_;
-  s.steps = steps_;
-  s.substeps = substeps_;
-  s.iterations = iterations_;
-  s.cg_iterations = cg_iterations_;
-  s.budget_steps = budget_steps_;
+  const StepDiagnostics& d = diagnostics_;
+  s.converged = state_.u.allFinite() && !d.failed;
+  s.failure = d.failure;
+  s.steps = d.steps;
+  s.substeps = d.substeps;
+  s.iterations = d.iterations;
+  s.cg_iterations = d.cg_iterations;
+  s.budget_steps = d.budget_steps;
   s.stable_dt = stable_dt_;
   compute_internal_forces(model_, state_.u, ws_);
   s.reactions = support_reactions(model_, ws_.f_int);
   // dynamics is out of balance by the inertia; its Newton residual includes it
-  s.residual = solver_.kind == SolverKind::IMPLICIT ? residual_ : relative_residual(model_, ws_.f_int);
+  s.residual = solver_.kind == SolverKind::IMPLICIT ? d.residual : relative_residual(model_, ws_.f_int);
   s.strain_energy = strain_energy(model_, state_.u).total();
   s.kinetic_energy = kinetic_energy(model_, state_.velocity);
-  s.wall_s = step_seconds_;
-  s.step_ms_mean = steps_ > 0 ? 1e3 * step_seconds_ / steps_ : 0;
-  s.steps_per_s = step_seconds_ > 0 ? steps_ / step_seconds_ : 0;
+  s.wall_s = d.step_seconds;
+  s.step_ms_mean = d.steps > 0 ? 1e3 * d.step_seconds / static_cast<double>(d.steps) : 0;
+  s.steps_per_s = d.step_seconds > 0 ? static_cast<double>(d.steps) / d.step_seconds : 0;
   if (lod_) {
     const Lod& l = *lod_;
     LodSummary& o = s.lod;

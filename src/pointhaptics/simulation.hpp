@@ -2,20 +2,42 @@
 /// @file The simulation: a Model, its State and the solver's Workspace, and the step pipeline.
 #include <pointhaptics/core/state.hpp>
 #include <pointhaptics/core/workspace.hpp>
+#include <pointhaptics/haptics/probe_tool.hpp>
 #include <pointhaptics/io/result_json.hpp>
 #include <pointhaptics/io/scene.hpp>
 #include <pointhaptics/lod/active_set.hpp>
-#include <pointhaptics/solvers/explicit_solver.hpp>
-#include <pointhaptics/solvers/implicit_solver.hpp>
-#include <pointhaptics/solvers/newton.hpp>
-#include <pointhaptics/solvers/static_solver.hpp>
+#include <pointhaptics/solvers/solver.hpp>
 
 #include <functional>
 #include <memory>
+#include <optional>
+#include <string>
 
 namespace pointhaptics {
 
 struct LodBuild;  // simulation.cpp
+
+/// What a step takes from outside the object. The caller fills it between steps (MuJoCo's step1/step2:
+/// read the last step's outputs, set the inputs, step); the step reads it in its first stage.
+struct StepInputs {
+  Vec3 device = Vec3::Constant(NAN);  ///< the probe's device point in the scene, m (NaN: the probe is lifted off)
+  bool button = false;                ///< the device's button (grab)
+};
+
+/// Counters and timers of the steps so far: the simulation's diagnostics, read by summary().
+struct StepDiagnostics {
+  long long steps = 0;          ///< steps taken (a static solve is one)
+  long long substeps = 0;       ///< explicit sub-steps, static load increments
+  long long iterations = 0;     ///< Newton iterations (explicit: sub-steps)
+  long long cg_iterations = 0;
+  long long budget_steps = 0;   ///< implicit steps the iteration budget ended above the tolerance
+  double residual = 0;          ///< the last Newton residual
+  StepStatus status = StepStatus::CONVERGED;  ///< of the last step
+  bool failed = false;          ///< a step failed: the state is not a result, and no step follows
+  std::string failure;          ///< why
+  double step_seconds = 0;      ///< wall time in steps, s, and in its stages:
+  double active_set_seconds = 0, tools_seconds = 0, solve_seconds = 0;
+};
 
 class Simulation {
  public:
@@ -24,13 +46,29 @@ class Simulation {
   ~Simulation();
   Simulation(Simulation&&) noexcept;
 
-  /// Advance by one solver step (dt): explicit (sub-stepped) or implicit dynamics; for a static solver,
-  /// solve for the equilibrium under the full load (once; later calls start from the last solution).
-  void step();
+  /// One step, as a table of contents (simulation.cpp): the inputs -> the active set (levels of detail follow
+  /// the probe) -> the tools placed -> the solver (forces and time integration, held points) -> the finite
+  /// check -> the outputs published. Dynamics: dt (explicit: sub-stepped below the stable step); static: the
+  /// equilibrium under the full load (later calls start from the last solution). Never throws for a step that
+  /// fails numerically: the report says FAILED and why, diagnostics() keeps it, and a further step throws
+  /// Error (a failed state is not a result). Throws Error for a step after a failed one.
+  const StepReport& step();
   /// Dynamics: step until state().time reaches `duration` (ceil(duration / dt) steps); static: one solve.
-  /// after_step(step, n_steps), if given, is called after each step; returning false stops the run there
-  /// (an interrupted run keeps the state reached).
+  /// Stops at a failed step (diagnostics().failed says so). after_step(step, n_steps), if given, is called
+  /// after each step; returning false stops the run there (an interrupted run keeps the state reached).
   void run(double duration, const std::function<bool(long long step, long long n_steps)>& after_step = {});
+  /// Filled by the caller before a step (MuJoCo's step1/step2).
+  StepInputs& inputs() { return inputs_; }
+  const StepDiagnostics& diagnostics() const { return diagnostics_; }
+
+  /// A probe from now on (dynamics only): placed at every step on a coupling spring of `coupling_stiffness`
+  /// (N/m) toward inputs().device, its force capped at `max_force` (N), pushing or grabbing the points.
+  /// With levels of detail the active set follows its contact point, re-selected on a worker thread when
+  /// `asynchronous_lod` (real time) and in place otherwise (reproducible runs).
+  void attach_probe(const ProbeParams& params, double coupling_stiffness, double max_force, bool asynchronous_lod);
+  void detach_probe();
+  /// The probe (nullptr without one): its position, contact set and last local contact model.
+  const ProbeTool* probe() const { return probe_ ? &*probe_ : nullptr; }
 
   /// The simulated model and its state: the whole object, or with levels of detail the active set.
   const Model& model() const { return model_; }
@@ -67,18 +105,19 @@ class Simulation {
   /// Replace the state (same model); used by tests and by replay.
   void set_state(const State& state);
   const SolverSpec& solver() const { return solver_; }
-  /// State-dependent forces added at every dynamic step (probe contact): explicit dynamics evaluates them
-  /// at every sub-step, implicit dynamics once per step (held over it). Not owned; nullptr: none.
-  void set_dynamic_forces(DynamicForces* forces) { dynamic_forces_ = forces; }
   double stable_dt() const { return stable_dt_; }
 
   /// Results at the current state: energies, reactions, residual, timing.
   RunSummary summary();
 
  private:
-  NewtonSettings newton_settings() const;
-  void step_solver();
-  void prepare_solver(double stable_dt = 0);  // for model_: stable step (0: compute it), solver objects
+  // the stages of step()
+  void follow_contact();
+  void place_tools();
+  void check_finite(StepReport& report) const;
+  void record(const StepReport& report, double seconds);
+
+  void prepare_solver(double stable_dt = 0);  // for model_: the solver (stable step 0: compute it)
   std::vector<index_t> take_over(LodBuild build, bool built_here);
   struct Lod;
   std::unique_ptr<Lod> lod_;
@@ -88,18 +127,13 @@ class Simulation {
   State state_;
   Workspace ws_;
   int n_threads_ = 0;
-  Points extra_forces_;
-  Eigen::Matrix<double, 9, Eigen::Dynamic> springs_;
-  DynamicForces* dynamic_forces_ = nullptr;
-  std::unique_ptr<StaticSolver> static_;      ///< static
-  std::unique_ptr<ImplicitSolver> implicit_;  ///< implicit
+  std::unique_ptr<Solver> solver_impl_;
   double stable_dt_ = 0;
-  long long steps_ = 0, substeps_ = 0, iterations_ = 0, cg_iterations_ = 0;
-  bool converged_ = true;
-  long long budget_steps_ = 0;  ///< implicit steps the iteration budget ended above the tolerance
-  double residual_ = 0;
-  std::string failure_;
-  double step_seconds_ = 0;
+  StepInputs inputs_;
+  StepReport report_;
+  StepDiagnostics diagnostics_;
+  std::optional<ProbeTool> probe_;
+  bool asynchronous_lod_ = false;
 };
 
 }  // namespace pointhaptics

@@ -1,7 +1,11 @@
 #pragma once
 /// @file Plain parameter structs: material, kernel and volume choices (all SI units).
+#include <array>
 #include <cstdint>
+#include <optional>
+#include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace pointhaptics {
@@ -73,8 +77,67 @@ struct LodParams {
   double max_widening = 3.0;     ///< ... but never beyond this multiple of h
 };
 
-std::string_view to_string(KernelType type);
-std::string_view to_string(LodScheme scheme);
-std::string_view to_string(VolumeMode mode);
+enum class SolverKind { STATIC, EXPLICIT, IMPLICIT };
+
+/// [solver]: which solver advances the object, and how far.
+struct SolverSpec {
+  SolverKind kind = SolverKind::EXPLICIT;
+  double dt = 1e-3;            ///< s
+  double duration = 1.0;       ///< s
+  double tolerance = 0;        ///< static, implicit: relative residual; 0 = default (1e-8 static, 1e-6 implicit)
+  int max_iterations = 50;     ///< static, implicit: Newton iterations per solve
+  int max_cg_iterations = 2000;///< static, implicit: CG iterations per Newton iteration
+  int iteration_budget = 0;    ///< implicit: Newton iterations per step in real time, keeping the iterate (0 = off)
+};
+
+/// The one table per enum of the names the scene file, the command line and Python use: to_string(),
+/// parse_enum() and enum_choices() all read it, so a new value is one new line here.
+template <class E>
+struct EnumNames;
+template <>
+struct EnumNames<KernelType> {
+  static constexpr std::array<std::pair<KernelType, std::string_view>, 4> table{
+      {{KernelType::POLY6, "poly6"}, {KernelType::SPIKY, "spiky"}, {KernelType::VISCOSITY, "viscosity"}, {KernelType::QUADRATIC, "quadratic"}}};
+};
+template <>
+struct EnumNames<VolumeMode> {
+  static constexpr std::array<std::pair<VolumeMode, std::string_view>, 2> table{{{VolumeMode::CELL, "cell"}, {VolumeMode::KERNEL, "kernel"}}};
+};
+template <>
+struct EnumNames<LodScheme> {
+  static constexpr std::array<std::pair<LodScheme, std::string_view>, 2> table{{{LodScheme::RANDOM, "random"}, {LodScheme::DITHER, "dither"}}};
+};
+template <>
+struct EnumNames<SolverKind> {
+  static constexpr std::array<std::pair<SolverKind, std::string_view>, 3> table{
+      {{SolverKind::STATIC, "static"}, {SolverKind::EXPLICIT, "explicit"}, {SolverKind::IMPLICIT, "implicit"}}};
+};
+
+/// The name of an enum value ("?" for a value outside the table).
+template <class E>
+constexpr std::string_view enum_name(E value) {
+  for (const auto& [v, name] : EnumNames<E>::table)
+    if (v == value) return name;
+  return "?";
+}
+/// The value of a name, if it is one.
+template <class E>
+std::optional<E> parse_enum(std::string_view name) {
+  for (const auto& [v, n] : EnumNames<E>::table)
+    if (n == name) return v;
+  return std::nullopt;
+}
+/// "a | b | c": the names, for messages.
+template <class E>
+std::string enum_choices() {
+  std::string list;
+  for (const auto& [v, name] : EnumNames<E>::table) list += (list.empty() ? "" : " | ") + std::string(name);
+  return list;
+}
+
+inline std::string_view to_string(KernelType type) { return enum_name(type); }
+inline std::string_view to_string(LodScheme scheme) { return enum_name(scheme); }
+inline std::string_view to_string(VolumeMode mode) { return enum_name(mode); }
+inline std::string_view to_string(SolverKind kind) { return enum_name(kind); }
 
 }  // namespace pointhaptics

@@ -1,5 +1,7 @@
 #include <pointhaptics/haptics/haptic_loop.hpp>
 
+#include <pointhaptics/haptics/coupling.hpp>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -33,21 +35,9 @@ bool HapticLoop::tick(double t, double dt) {
     const Vec3 vd = mapping_.scale * state.velocity;
     models_.update();
     const ContactModel& m = models_.front();
-    // the probe is where the coupling spring balances the local contact model:
-    //   k (d - p) + f0 + K (p - p0) = 0  =>  (k I - K) p = k d + f0 - K p0   (K <= 0, so always solvable)
+    // the probe is where the coupling spring balances the local contact model (haptics/coupling.hpp)
     const double k = gains_.stiffness;
-    Vec3 p = d;
-    if (m.contacts > 0 && m.p0.allFinite()) {
-      const Mat3 A = k * Mat3::Identity() - m.K;
-      const auto solver = A.ldlt();
-      p = solver.solve(k * d + m.f0 - m.K * m.p0);
-      // the probe pushes on the object with the coupling force; the hand cannot feel more than the
-      // device's maximum, so the object is not pushed harder either: pull the device point in to where
-      // the coupling force is at that maximum, and solve again
-      const double pull = k * (d - p).norm(), limit = device_max_force_;
-      if (pull > limit && p.allFinite()) p = solver.solve(k * (p + (d - p) * (limit / pull)) + m.f0 - m.K * m.p0);
-      if (!p.allFinite()) p = d;
-    }
+    const Vec3 p = m.contacts > 0 && m.p0.allFinite() ? coupled_probe(m, d, k, device_max_force_) : d;
     const Vec3 vp = probe_.allFinite() && dt > 0 ? Vec3((p - probe_) / dt) : vd;
     probe_ = p;
     // the coupling pulls the device toward the probe (scene forces are rendered unscaled)

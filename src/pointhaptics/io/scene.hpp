@@ -47,18 +47,6 @@ struct LoadSpec {
   int line = 0;
 };
 
-enum class SolverKind { STATIC, EXPLICIT, IMPLICIT };
-
-struct SolverSpec {
-  SolverKind kind = SolverKind::EXPLICIT;
-  double dt = 1e-3;            ///< s
-  double duration = 1.0;       ///< s
-  double tolerance = 0;        ///< static, implicit: relative residual; 0 = default (1e-8 static, 1e-6 implicit)
-  int max_iterations = 50;     ///< static, implicit: Newton iterations per solve
-  int max_cg_iterations = 2000;///< static, implicit: CG iterations per Newton iteration
-  int iteration_budget = 0;    ///< implicit: Newton iterations per step in real time, keeping the iterate (0 = off)
-};
-
 /// [probe]: a spherical probe driven by a device (design.md, "Haptics").
 struct ProbeSpec {
   bool present = false;
@@ -101,7 +89,5 @@ struct Scene {
   DeviceSpec device;
   LodSpec lod;
 };
-
-std::string_view to_string(SolverKind kind);
 
 }  // namespace pointhaptics

@@ -15,15 +15,6 @@
 
 namespace pointhaptics {
 
-std::string_view to_string(SolverKind kind) {
-  switch (kind) {
-    case SolverKind::STATIC: return "static";
-    case SolverKind::EXPLICIT: return "explicit";
-    case SolverKind::IMPLICIT: return "implicit";
-  }
-  return "?";
-}
-
 namespace {
 
 struct Context {
@@ -149,6 +140,14 @@ class TableReader {
     for (auto c : choices) list += (list.empty() ? "" : " | ") + std::string(c);
     fail_at(*node, key, fmt::format("unknown value \"{}\" (expected {})", value, list));
   }
+  // a string naming a value of enum E (its table in core/parameters.hpp)
+  template <class E>
+  E enumeration(std::string_view key, E fallback) {
+    const toml::node* node = table_.get(key);
+    const std::string value = string(key, std::string(enum_name(fallback)));
+    if (const std::optional<E> e = parse_enum<E>(value)) return *e;
+    fail_at(*node, key, fmt::format("unknown value \"{}\" (expected {})", value, enum_choices<E>()));
+  }
   const toml::table* subtable(std::string_view key) {
     const toml::node* node = find(key);
     if (!node) return nullptr;
@@ -242,12 +241,11 @@ void read_material(TableReader& r, MaterialParams& m) {
       r.number("volume_stiffness", m.volume_stiffness, [](double x) { return x >= 0 && x <= 1e13; }, "must lie in [0, 1e13] (Pa)");
   m.damping = r.number("damping", m.damping, non_negative, "must be >= 0 (1/s)");
   m.hourglass = r.number("hourglass", m.hourglass, [](double x) { return x >= 0 && x <= 10; }, "must lie in [0, 10]");
-  m.volume = r.choice("volume", "cell", {"cell", "kernel"}) == "cell" ? VolumeMode::CELL : VolumeMode::KERNEL;
+  m.volume = r.enumeration("volume", m.volume);
 }
 
 void read_kernel(TableReader& r, KernelParams& k) {
-  const std::string type = r.choice("type", "poly6", {"poly6", "spiky", "viscosity", "quadratic"});
-  k.type = type == "poly6" ? KernelType::POLY6 : type == "spiky" ? KernelType::SPIKY : type == "viscosity" ? KernelType::VISCOSITY : KernelType::QUADRATIC;
+  k.type = r.enumeration("type", k.type);
   if (r.find("support_factor") && r.find("support"))
     r.fail_at(*r.find("support"), "support", "give either support (m) or support_factor, not both");
   k.support_factor = r.number("support_factor", k.support_factor, [](double x) { return x > 1 && x <= 20; }, "must lie in (1, 20]");
@@ -255,8 +253,7 @@ void read_kernel(TableReader& r, KernelParams& k) {
 }
 
 void read_solver(TableReader& r, SolverSpec& s) {
-  const std::string kind = r.choice("kind", "explicit", {"static", "explicit", "implicit"});
-  s.kind = kind == "static" ? SolverKind::STATIC : kind == "explicit" ? SolverKind::EXPLICIT : SolverKind::IMPLICIT;
+  s.kind = r.enumeration("kind", s.kind);
   s.dt = r.number("dt", s.dt, [](double x) { return x >= 1e-9 && x <= 1; }, "must lie in [1e-9, 1] (s)");
   s.duration = r.number("duration", s.duration, [](double x) { return x >= 0 && x <= 1e6; }, "must lie in [0, 1e6] (s)");
   s.tolerance = r.number("tolerance", s.tolerance, [](double x) { return x > 0 && x < 1; }, "must lie in (0, 1)");
@@ -387,7 +384,7 @@ void read_lod(TableReader& r, LodSpec& l) {
   const long long seed_value = r.integer("seed", 1);
   if (seed_value < 0) r.fail_at(*seed, "seed", "must be >= 0");
   p.seed = static_cast<std::uint64_t>(seed_value);
-  p.scheme = r.choice("scheme", "random", {"random", "dither"}) == "random" ? LodScheme::RANDOM : LodScheme::DITHER;
+  p.scheme = r.enumeration("scheme", p.scheme);
   p.reselect = r.number("reselect", p.reselect, positive, "must be > 0 (units of h)");
   p.reselect_interval = r.number("reselect_interval", p.reselect_interval, [](double x) { return x >= 0 && x <= 1e3; },
                                  "must lie in [0, 1000] (s)");

@@ -11,7 +11,6 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -92,11 +91,6 @@ double min_free_mass(const Model& model) {
   return m;
 }
 
-Vec3 prescribed_displacement(const FixedGroup& group, double t) {
-  const double s = group.ramp > 0 ? std::clamp(t / group.ramp, 0.0, 1.0) : 1.0;
-  return s * group.displacement;
-}
-
 namespace {
 const double covered_stiffening = 1.25;  // stiffening the safety factor of stable_time_step() absorbs
 }  // namespace
@@ -118,54 +112,60 @@ double strain_stiffening(const Model& model, Workspace& ws) {
   return std::isfinite(m) ? m : 1.0;
 }
 
-ExplicitStepStats explicit_step(const Model& model, State& state, Workspace& ws, double dt, double stable_dt,
-                                DynamicForces* extra) {
+StepReport explicit_step(const Model& model, State& state, Workspace& ws, double dt, double stable_dt,
+                         DynamicForces* forces) {
   // the rest-state step, shortened by the springs of the state-dependent forces (a probe's contact: issue
   // 21, 1e4 N/m diverged), then where the last force evaluation found the material stretched beyond what
   // its safety factor covers (0.8 leaves omega^2 a margin of 1.56; a quarter is kept for stiffening)
-  if (extra) stable_dt = stable_time_step_with_springs(stable_dt, extra->max_point_stiffness(), min_free_mass(model));
+  if (forces) stable_dt = stable_time_step_with_springs(stable_dt, forces->max_point_stiffness(), min_free_mass(model));
   stable_dt *= std::min(1.0, std::sqrt(covered_stiffening / strain_stiffening(model, ws)));
   const int n_sub = std::max(1, static_cast<int>(std::ceil(dt / stable_dt * (1 - 1e-12))));
   const double h = dt / n_sub;
   const double c = model.material.damping;
   const double limit2 = (100 * model.extent) * (100 * model.extent);
+  StepReport report;
+  double* first_bad = ws.chunk_scalars.data();  // per chunk: the first diverged point, or -1 (no atomics)
   for (int sub = 0; sub < n_sub; ++sub) {
     compute_internal_forces(model, state.u, ws);
-    if (extra) {
+    if (forces) {
       ws.acceleration.setZero();  // scratch for the dynamic forces
-      extra->add(model, state, ws.acceleration);
+      forces->add(model, state, ws.acceleration);
     }
-    std::atomic<index_t> bad_point{-1};
     ws.for_each_chunk([&](int chunk) {
+      first_bad[chunk] = -1;
       for (index_t i = ws.chunk_begin(chunk); i < ws.chunk_end(chunk); ++i) {
         if (model.fixed[i]) continue;
         auto v = state.velocity.col(i);
         auto u = state.u.col(i);
         Vec3 f = ws.f_int.col(i) + model.f_ext.col(i);
-        if (extra) f += ws.acceleration.col(i);
+        if (forces) f += ws.acceleration.col(i);
         v = (v + h / model.mass[i] * f) / (1 + h * c);
         u += h * v;
-        if (!(u.squaredNorm() < limit2)) bad_point = i;  // also catches NaN
+        if (!(u.squaredNorm() < limit2) && first_bad[chunk] < 0) first_bad[chunk] = i;  // also catches NaN
       }
     });
     state.time += h;
-    // held points follow their prescribed displacement
-    for (const FixedGroup& group : model.fixed_groups) {
-      const Vec3 target = prescribed_displacement(group, state.time);
-      for (index_t i : group.points) {
-        state.velocity.col(i) = (target - state.u.col(i)) / h;
-        state.u.col(i) = target;
-      }
-    }
-    if (bad_point >= 0) {
-      const index_t i = bad_point;
-      throw Error(fmt::format(
+    hold_points(model, state.time, state.u, &state.velocity, h);
+    report.substeps = report.iterations = sub + 1;
+    for (int chunk = 0; chunk < ws.n_threads(); ++chunk) {
+      if (first_bad[chunk] < 0) continue;
+      const auto i = static_cast<index_t>(first_bad[chunk]);
+      report.status = StepStatus::FAILED;
+      report.failure = fmt::format(
           "explicit solver diverged at t = {:.6g} s (sub-step {} of {}, h = {:.3g} s): point {} has displacement "
           "({:.3g}, {:.3g}, {:.3g}) m; lower dt, add damping or check the material",
-          state.time, sub + 1, n_sub, h, i, state.u(0, i), state.u(1, i), state.u(2, i)));
+          state.time, sub + 1, n_sub, h, i, state.u(0, i), state.u(1, i), state.u(2, i));
+      return report;
     }
   }
-  return {n_sub};
+  return report;
+}
+
+ExplicitSolver::ExplicitSolver(const Model& model, double dt, double stable_dt)
+    : dt_(dt), stable_dt_(stable_dt > 0 ? stable_dt : stable_time_step(model)) {}
+
+StepReport ExplicitSolver::step(const Model& model, State& state, Workspace& ws, DynamicForces* forces) {
+  return explicit_step(model, state, ws, dt_, stable_dt_, forces);
 }
 
 }  // namespace pointhaptics

@@ -1,7 +1,6 @@
 #pragma once
 /// @file Explicit dynamics: symplectic Euler with automatic sub-steps below the stable step.
-#include <pointhaptics/core/state.hpp>
-#include <pointhaptics/core/workspace.hpp>
+#include <pointhaptics/solvers/solver.hpp>
 
 namespace pointhaptics {
 
@@ -30,37 +29,26 @@ double strain_stiffening(const Model& model, Workspace& ws);
 /// The lightest free point's mass, kg (infinity if none is free).
 double min_free_mass(const Model& model);
 
-/// Prescribed displacement of a fixed group at time t (ramped in linearly over group.ramp).
-Vec3 prescribed_displacement(const FixedGroup& group, double t);
-
-struct ExplicitStepStats {
-  int substeps = 0;  ///< sub-steps taken for this step
-};
-
 /// Advance the state by dt with ceil(dt / stable step) equal symplectic Euler sub-steps, the stable step
-/// shortened for the springs of `extra` (stable_time_step_with_springs) and by sqrt(1.25 / strain_stiffening())
+/// shortened for the springs of `forces` (stable_time_step_with_springs) and by sqrt(1.25 / strain_stiffening())
 /// where the material is stretched by more than its safety factor covers:
-///   v <- (v + h M^-1 (f_int + f_ext)) / (1 + h c),   u <- u + h v   (c: mass-proportional damping)
-/// Held points follow their prescribed displacement. Throws Error naming the step and point if a
-/// displacement becomes non-finite or grows beyond 100 times the object's size (divergence).
-/// Forces that depend on the state and are evaluated at every sub-step (e.g. probe contact), so that
-/// stiff contact springs are integrated at the stable sub-step, not held over a whole step.
-class DynamicForces {
- public:
-  virtual ~DynamicForces() = default;
-  /// Add the forces (N) at `state` into f (3 x n).
-  virtual void add(const Model& model, const State& state, Points& f) = 0;
-  /// The forces' stiffness -df_i/du_i per point (3x3, column-major, 9 x n, N/m, symmetric positive
-  /// semi-definite), added into `springs`, for implicit steps; false if there is none to add. Called
-  /// after add() at the same state.
-  virtual bool add_stiffness(const Model&, const State&, Eigen::Matrix<double, 9, Eigen::Dynamic>&) { return false; }
-  /// The largest stiffness (N/m) these forces can put on one point (an upper bound of the largest
-  /// eigenvalue of its 3x3 block), for the explicit stable step; 0 if they have no springs.
-  virtual double max_point_stiffness() const { return 0; }
-};
+///   v <- (v + h M^-1 (f_int + f_ext + f_tools)) / (1 + h c),   u <- u + h v   (c: mass-proportional damping)
+/// Held points follow their prescribed displacement. A displacement that becomes non-finite or grows
+/// beyond 100 times the object's size (divergence) ends the step FAILED, naming the time and the point.
+/// `forces`, if given, are evaluated at every sub-step.
+StepReport explicit_step(const Model& model, State& state, Workspace& ws, double dt, double stable_dt,
+                         DynamicForces* forces = nullptr);
 
-/// extra, if given, is evaluated at every sub-step and added to the constant loads.
-ExplicitStepStats explicit_step(const Model& model, State& state, Workspace& ws, double dt, double stable_dt,
-                                DynamicForces* extra = nullptr);
+/// explicit_step() as a Solver: steps of `dt` below the model's stable step.
+class ExplicitSolver final : public Solver {
+ public:
+  /// stable_dt: the model's stable step if already known (0: stable_time_step(model)).
+  ExplicitSolver(const Model& model, double dt, double stable_dt = 0);
+  StepReport step(const Model& model, State& state, Workspace& ws, DynamicForces* forces) override;
+  double stable_dt() const override { return stable_dt_; }
+
+ private:
+  double dt_, stable_dt_;
+};
 
 }  // namespace pointhaptics

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <limits>
 
 namespace pointhaptics {
 
@@ -21,8 +22,7 @@ StaticStats load_stepping(const Model& model, State& state, Workspace& ws, Newto
     // predictor: the last equilibrium, scaled to the new load factor (exact for a linear response)
     if (reached > 0) trial = state.u * (factor / reached);
     else trial = state.u;
-    for (const FixedGroup& group : model.fixed_groups)
-      for (index_t i : group.points) trial.col(i) = factor * group.displacement;
+    hold_points(model, std::numeric_limits<double>::infinity(), trial, nullptr, 0, factor);  // ramps are for dynamics
     const NewtonStats ns = newton.solve(model, problem, trial, ws, settings);
     stats.iterations += ns.iterations;
     stats.cg_iterations += ns.cg_iterations;
@@ -56,11 +56,19 @@ StaticStats solve_static(const Model& model, State& state, Workspace& ws, Newton
   return load_stepping(model, state, ws, newton, settings, load, trial);
 }
 
-StaticSolver::StaticSolver(const Model& model)
-    : newton_(model), load_(Points::Zero(3, model.n_points)), trial_(Points::Zero(3, model.n_points)) {}
+StaticSolver::StaticSolver(const Model& model, const NewtonSettings& settings)
+    : settings_(settings), newton_(model), load_(Points::Zero(3, model.n_points)), trial_(Points::Zero(3, model.n_points)) {}
 
-StaticStats StaticSolver::solve(const Model& model, State& state, Workspace& ws, const NewtonSettings& settings) {
-  return load_stepping(model, state, ws, newton_, settings, load_, trial_);
+StepReport StaticSolver::step(const Model& model, State& state, Workspace& ws, DynamicForces*) {
+  const StaticStats stats = load_stepping(model, state, ws, newton_, settings_, load_, trial_);
+  StepReport report;
+  report.status = stats.converged ? StepStatus::CONVERGED : StepStatus::FAILED;
+  report.substeps = stats.load_steps;
+  report.iterations = stats.iterations;
+  report.cg_iterations = stats.cg_iterations;
+  report.residual = stats.residual;
+  report.failure = stats.failure;
+  return report;
 }
 
 }  // namespace pointhaptics

@@ -1,8 +1,7 @@
 #pragma once
 /// @file Static equilibrium: Newton with line search on the total potential energy, with automatic
 /// load stepping when a full step fails.
-#include <pointhaptics/core/state.hpp>
-#include <pointhaptics/solvers/newton.hpp>
+#include <pointhaptics/solvers/solver.hpp>
 
 namespace pointhaptics {
 
@@ -25,17 +24,18 @@ struct StaticStats {
 StaticStats solve_static(const Model& model, State& state, Workspace& ws, NewtonSolver& newton,
                          const NewtonSettings& settings);
 
-/// solve_static() with its Newton solver and load-stepping buffers sized once for the model, so that a
-/// solve allocates nothing.
-class StaticSolver {
+/// solve_static() as a Solver, with its Newton solver and load-stepping buffers sized once for the model,
+/// so that a solve allocates nothing. A solve that does not reach the full load is FAILED (the state holds
+/// the last converged equilibrium).
+class StaticSolver final : public Solver {
  public:
-  explicit StaticSolver(const Model& model);
-  StaticStats solve(const Model& model, State& state, Workspace& ws, const NewtonSettings& settings);
+  StaticSolver(const Model& model, const NewtonSettings& settings);
+  StepReport step(const Model& model, State& state, Workspace& ws, DynamicForces* forces) override;
 
  private:
+  NewtonSettings settings_;
   NewtonSolver newton_;
   Points load_, trial_;  ///< the load of the increment and Newton's iterate  (3 x n)
-  friend StaticStats solve_static(const Model&, State&, Workspace&, NewtonSolver&, const NewtonSettings&);
 };
 
 }  // namespace pointhaptics

@@ -1,0 +1,46 @@
+#pragma once
+/// @file The probe as a tool of the simulation: placed on its coupling spring once per step, then its
+/// contact forces act on the points at every (sub-)step the solver takes.
+#include <pointhaptics/haptics/contact.hpp>
+#include <pointhaptics/solvers/solver.hpp>
+
+#include <vector>
+
+namespace pointhaptics {
+
+class ProbeTool final : public DynamicForces {
+ public:
+  /// coupling_stiffness: the spring between the device point and the probe, N/m; max_force: the device's
+  /// largest force, N (the hand cannot push harder than it can feel).
+  ProbeTool(const Model& model, const ProbeParams& params, double coupling_stiffness, double max_force);
+
+  /// Once per step: the probe is where the coupling spring toward `device` (its force capped at max_force)
+  /// balances the contact forces at the step's start; a few Newton steps on the local model from the last
+  /// position. Within the step the probe stays there (re-solving it at every sub-step let the contact set
+  /// chatter and excite the lattice). A non-finite device point lifts the probe off.
+  void place(const Model& model, const State& state, const Vec3& device, bool button);
+  void add(const Model& model, const State& state, Points& f) override;
+  bool add_stiffness(const Model&, const State&, Eigen::Matrix<double, 9, Eigen::Dynamic>& springs) override;
+  double max_point_stiffness() const override { return contact_.params().stiffness; }
+  /// The model's points were renumbered (a level-of-detail re-selection): new_index[old], -1 if dropped.
+  void remap(const Model& model, const std::vector<index_t>& new_index);
+
+  const Vec3& probe() const { return probe_; }
+  /// The local contact model of the last force evaluation, for the haptic side.
+  const ContactModel& contact_model() const { return last_; }
+  /// Points in contact when the step began (before place()): contact onset is 0 before, > 0 after.
+  int contacts_before_step() const { return contacts_before_; }
+  const ProbeContact& contact() const { return contact_; }
+
+ private:
+  ProbeContact contact_;
+  double k_, max_force_;
+  Vec3 device_ = Vec3::Constant(NAN);
+  Vec3 probe_ = Vec3::Constant(NAN);
+  bool button_ = false;
+  int contacts_before_ = 0;
+  ContactModel last_;
+  Points scratch_;
+};
+
+}  // namespace pointhaptics
