@@ -135,6 +135,12 @@ TEST(SceneToml, UnknownChoicesListTheAllowedOnes) {
             std::string::npos);
   EXPECT_NE(error_of("shape   = \"box\"", "shape = \"cube\"").find("object.shape"), std::string::npos);
   EXPECT_NE(error_of("kind = \"explicit\"", "kind = \"rk4\"").find("solver.kind"), std::string::npos);
+  // the material model: one table of names (core/parameters.hpp) for the scene, the CLI and Python
+  EXPECT_NE(error_of("young = 1e5", "model = \"jelly\"\nyoung = 1e5").find("material.model: unknown value \"jelly\" (expected svk)"),
+            std::string::npos);
+  std::string svk = full_scene;
+  svk.replace(svk.find("young = 1e5"), 11, "model = \"svk\"\nyoung = 1e5");
+  EXPECT_EQ(parse_scene(svk).material.model, MaterialModel::SVK);
 }
 
 TEST(SceneToml, MissingRequiredKeys) {

@@ -1,5 +1,6 @@
 // Tests for mechanics/point_fields: exact stress and energy density for a homogeneous stretch and shear.
 #include <pointhaptics/mechanics/deformation.hpp>
+#include <pointhaptics/mechanics/energies/svk.hpp>
 #include <pointhaptics/mechanics/model_builder.hpp>
 #include <pointhaptics/mechanics/point_fields.hpp>
 
@@ -20,7 +21,7 @@ TEST(PointFields, HomogeneousDeformationGivesTheAnalyticStressEverywhere) {
   const Points u = (F - Mat3::Identity()) * m.X;
   const PointFields f = point_fields(m, u);
   const Mat3 E = green_strain(F - Mat3::Identity());
-  const Mat3 S = svk_stress(E, m.lambda, m.mu);
+  const Mat3 S = StVenantKirchhoff{m.lambda, m.mu}.second_piola(E);
   const Mat3 sigma = F * S * F.transpose() / F.determinant();
   const Mat3 dev = sigma - sigma.trace() / 3 * Mat3::Identity();
   for (index_t i = 0; i < m.n_points; ++i) {

@@ -24,7 +24,13 @@ enum class VolumeMode {
   KERNEL,  ///< the seed's m_i = total mass / N, rho_i = sum_j m_j w_ij (Eq. 7), v_i = m_i / rho_i (Eq. 8)
 };
 
+/// The constitutive models (mechanics/energies/: one file each, and a line in material.hpp's registry).
+enum class MaterialModel {
+  SVK,  ///< St. Venant-Kirchhoff, the seed's (Green strain, seed Eq. 2)
+};
+
 struct MaterialParams {
+  MaterialModel model = MaterialModel::SVK;
   double young = 1e5;              ///< Young's modulus E, Pa
   double poisson = 0.4;            ///< Poisson ratio nu, in (-1, 0.5)
   double density = 1000.0;         ///< rho, kg/m^3
@@ -100,6 +106,10 @@ struct EnumNames<KernelType> {
       {{KernelType::POLY6, "poly6"}, {KernelType::SPIKY, "spiky"}, {KernelType::VISCOSITY, "viscosity"}, {KernelType::QUADRATIC, "quadratic"}}};
 };
 template <>
+struct EnumNames<MaterialModel> {
+  static constexpr std::array<std::pair<MaterialModel, std::string_view>, 1> table{{{MaterialModel::SVK, "svk"}}};
+};
+template <>
 struct EnumNames<VolumeMode> {
   static constexpr std::array<std::pair<VolumeMode, std::string_view>, 2> table{{{VolumeMode::CELL, "cell"}, {VolumeMode::KERNEL, "kernel"}}};
 };
@@ -138,6 +148,7 @@ std::string enum_choices() {
 inline std::string_view to_string(KernelType type) { return enum_name(type); }
 inline std::string_view to_string(LodScheme scheme) { return enum_name(scheme); }
 inline std::string_view to_string(VolumeMode mode) { return enum_name(mode); }
+inline std::string_view to_string(MaterialModel model) { return enum_name(model); }
 inline std::string_view to_string(SolverKind kind) { return enum_name(kind); }
 
 }  // namespace pointhaptics

@@ -233,6 +233,7 @@ void read_object(TableReader& r, ObjectSpec& o, const Context& ctx) {
 }
 
 void read_material(TableReader& r, MaterialParams& m) {
+  m.model = r.enumeration("model", m.model);  // the registry: mechanics/energies/material.hpp
   // beyond any solid (steel is 2e11 Pa, air 1.2 kg/m^3): 1e300 Pa or 1e-320 kg/m^3 made the solver "diverge"
   m.young = r.number("young", m.young, [](double x) { return x > 0 && x <= 1e13; }, "must lie in (0, 1e13] (Pa)");
   m.poisson = r.number("poisson", m.poisson, [](double x) { return x > -1 && x < 0.5; }, "must lie in (-1, 0.5)");

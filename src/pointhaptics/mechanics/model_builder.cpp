@@ -2,6 +2,7 @@
 
 #include <pointhaptics/core/error.hpp>
 #include <pointhaptics/geometry/neighbour_search.hpp>
+#include <pointhaptics/mechanics/energies/hourglass.hpp>
 #include <pointhaptics/mechanics/kernels.hpp>
 
 #include <Eigen/Eigenvalues>
@@ -38,52 +39,6 @@ double support_radius(const PointCloud& cloud, const KernelParams& kernel) {
     throw Error(fmt::format("kernel: support_factor = {} must be positive", kernel.support_factor));
   if (!(cloud.spacing > 0)) throw Error("kernel: the point cloud has no spacing; give kernel.support in m");
   return kernel.support_factor * cloud.spacing;
-}
-
-// The hourglass energy (physics.md, averaged-gradient form): W = sum_i sum_j (k_ij / 2) |r_ij|^2 with
-// r_ij = u_j - u_i - (G_i + G_j) X_ij / 2 and k_ij = (alpha E / 2) (v_i w^_ij + v_j w^_ji) / |X_ij|^2,
-// w^_ij = w_ij / sum_k w_ik. k must be symmetric for the one-pass force (stencil_loop.hpp). Also the exact
-// diagonal of its (constant) Hessian: the weight of u_m in r_ij is
-//   [m = j] - [m = i] - (a_im + a_jm) / 2,  a_im = d_im . X_ij (m in N(i)), a_ii = d_ii . X_ij,
-// so diag_m = sum over pairs of k_ij (weight)^2, over the two stencils of each pair (serial; O(pairs x stencil)).
-void compute_hourglass(Model& model, const Eigen::VectorXd& w, const std::vector<double>& weight_sum) {
-  const Csr& nbr = model.neighbours;
-  const index_t n = model.n_points;
-  const double scale = 0.5 * model.material.hourglass * model.material.young;
-  auto share = [&](index_t i) { return weight_sum[i] > 0 ? model.volume[i] / weight_sum[i] : 0.0; };
-  const bool per_point = model.support.size() == n;
-  for (index_t i = 0; i < n; ++i)
-    for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
-      const index_t j = nbr.index[e];
-      const double r2 = (model.X.col(j) - model.X.col(i)).squaredNorm();
-      // w_ji from j's own support (equal to w_ij with one support for all), so that k_ij = k_ji
-      const double w_ji = per_point ? kernel_value(model.kernel.type, std::sqrt(r2), model.support[j]) : w[e];
-      model.hg_coef[e] = scale * (w[e] * share(i) + w_ji * share(j)) / r2;
-    }
-  model.hg_diagonal = Eigen::VectorXd::Zero(n);
-  if (!(model.material.hourglass > 0)) return;
-  std::vector<double> weight(n, 0.0);
-  std::vector<index_t> touched;
-  for (index_t i = 0; i < n; ++i)
-    for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
-      const index_t j = nbr.index[e];
-      const Vec3 xij = model.X.col(j) - model.X.col(i);
-      auto add = [&](index_t m, double value) {
-        if (weight[m] == 0.0) touched.push_back(m);
-        weight[m] += value;
-      };
-      add(j, 1.0);
-      add(i, -1.0);
-      for (index_t s : {i, j}) {  // the two gradients G_i and G_j
-        add(s, -0.5 * model.d_self.col(s).dot(xij));
-        for (index_t f = nbr.begin(s); f < nbr.end(s); ++f) add(nbr.index[f], -0.5 * model.d.col(f).dot(xij));
-      }
-      for (index_t m : touched) {
-        model.hg_diagonal[m] += model.hg_coef[e] * weight[m] * weight[m];
-        weight[m] = 0.0;
-      }
-      touched.clear();
-    }
 }
 
 }  // namespace
@@ -214,7 +169,7 @@ Model build_model(const PointCloud& cloud, const MaterialParams& material, const
     model.d_self.col(i) = -d_sum;
     weight_sum[i] = w_sum;
   });
-  compute_hourglass(model, w, weight_sum);
+  build_hourglass(model, w, weight_sum);
 
   // diagnostics
   ModelDiagnostics& diag = model.diagnostics;

@@ -3,12 +3,14 @@
 /// applied matrix-free (physics.md, "Tangent"), and its 3x3 diagonal blocks for block-Jacobi.
 #include <pointhaptics/core/workspace.hpp>
 
+#include <vector>
+
 namespace pointhaptics {
 
 enum class TangentMode {
   EXACT,      ///< the exact Hessian; indefinite under compression (the geometric term dF S)
-  PROJECTED,  ///< positive semi-definite: the geometric term uses the positive part of S and the
-              ///< volume term drops its (J - 1) d(cof F) part (a per-point Gauss-Newton)
+  PROJECTED,  ///< positive semi-definite per point: the material's projection (SVK: the positive part of S in
+              ///< the geometric term) and the volume term without its (J - 1) d(cof F) part (Gauss-Newton)
 };
 
 /// The linearisation of the internal forces at one configuration u: K du = -(d f_int / du) du.
@@ -29,10 +31,9 @@ class Tangent {
 
  private:
   TangentMode mode_ = TangentMode::EXACT;
-  Eigen::Matrix<double, 9, Eigen::Dynamic> F_;  ///< F_i at the linearisation point (column-major 3x3)
-  Eigen::Matrix<double, 9, Eigen::Dynamic> S_;  ///< S_i, or its positive part (PROJECTED)
-  /// scratch of diagonal_blocks: F_i F_i^T and cof F_i per stencil (column-major 3x3 each)
-  mutable Eigen::Matrix<double, 18, Eigen::Dynamic> stencil_factors_;
+  /// the material's Linearisation per point (mechanics/energies/), as plain doubles: the tangent is one
+  /// class whatever the material
+  std::vector<double> linearisation_;
 };
 
 }  // namespace pointhaptics

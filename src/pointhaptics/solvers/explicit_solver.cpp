@@ -2,7 +2,7 @@
 
 #include <pointhaptics/core/error.hpp>
 #include <pointhaptics/geometry/neighbour_search.hpp>
-#include <pointhaptics/mechanics/deformation.hpp>
+#include <pointhaptics/mechanics/energies/material.hpp>
 #include <pointhaptics/mechanics/forces.hpp>
 #include <pointhaptics/mechanics/tangent.hpp>
 
@@ -97,15 +97,17 @@ const double covered_stiffening = 1.25;  // stiffening the safety factor of stab
 
 double strain_stiffening(const Model& model, Workspace& ws) {
   double* chunk_max = ws.chunk_scalars.data();
-  ws.for_each_chunk([&](int chunk) {
-    double m = 1;
-    const index_t end = std::min(ws.chunk_end(chunk), model.stencil_end());
-    for (index_t i = ws.chunk_begin(chunk); i < end; ++i) {
-      Mat3 G;
-      for (int c = 0; c < 3; ++c) G.col(c) = ws.gradients.block<3, 1>(4 * c, i);
-      m = std::max(m, svk_stiffening(G));
-    }
-    chunk_max[chunk] = m;
+  with_material(model, [&](const auto& energy) {
+    ws.for_each_chunk([&](int chunk) {
+      double m = 1;
+      const index_t end = std::min(ws.chunk_end(chunk), model.stencil_end());
+      for (index_t i = ws.chunk_begin(chunk); i < end; ++i) {
+        Mat3 G;
+        for (int c = 0; c < 3; ++c) G.col(c) = ws.gradients.block<3, 1>(4 * c, i);
+        m = std::max(m, energy.material.stiffening(G));
+      }
+      chunk_max[chunk] = m;
+    });
   });
   double m = 1;
   for (int c = 0; c < ws.n_threads(); ++c) m = std::max(m, chunk_max[c]);

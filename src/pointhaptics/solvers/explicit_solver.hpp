@@ -22,7 +22,7 @@ double estimated_stable_time_step(const Model& model, double safety = 0.7);
 /// `stable_dt` is the springless step stable_time_step() gave with the same safety.
 double stable_time_step_with_springs(double stable_dt, double spring_stiffness, double min_mass, double safety = 0.8);
 
-/// The largest svk_stiffening() over the gradients of the workspace's last force evaluation (1 at rest):
+/// The largest material stiffening() (energies/svk.hpp) over the gradients of the workspace's last force evaluation (1 at rest):
 /// the factor by which the material is stiffer than the rest state the stable step was computed for.
 double strain_stiffening(const Model& model, Workspace& ws);
 

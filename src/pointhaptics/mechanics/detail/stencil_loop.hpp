@@ -11,17 +11,10 @@
 /// docs/performance.md). The pad lane stays zero throughout: it starts zero in u and every operation
 /// maps zero lanes to zero.
 #include <pointhaptics/core/workspace.hpp>
+#include <pointhaptics/mechanics/energies/hourglass.hpp>
 
 #include <algorithm>
 #include <cstring>
-
-// Stress maps are small lambdas called once per stencil; GCC otherwise keeps them out of line and the
-// force loop loses ~20% returning the 3x3 through memory.
-#if defined(__GNUC__)
-#define PH_ALWAYS_INLINE __attribute__((always_inline))
-#else
-#define PH_ALWAYS_INLINE
-#endif
 
 // GCC builds without AVX (the sanitizer presets) warn that passing a Lane4 has another ABI than with
 // AVX; everything here is inline in one internal header and never crosses a library boundary.
@@ -83,13 +76,10 @@ inline void gradient_pass(const Model& model, const PaddedPoints& u, index_t fir
 }
 
 /// Pass 2: adds, for the stencils i in [first, last), the terms of y = -dW/du into `out` (padded), with
-/// the stress map A_i = stress(i, G_i) and the gradients of pass 1. The hourglass energy (physics.md, in
-/// its averaged-gradient form) is W = sum_i sum_j (k_ij / 2) |r_ij|^2 with r_ij = u_j - u_i - (G_i + G_j) X_ij / 2
-/// and k_ij symmetric; its exact gradient is
-///   y_j -= k_ij r_ij,  y_i += k_ij r_ij  (per pair),   and A_i -= Q_i = sum_j k_ij r_ij X_ij^T,
-/// then y_j -= A_i d_ij, y_i -= A_i d_ii. r vanishes for any field whose gradient the stencils reproduce
-/// at both ends, so quadratic (bending) fields cost nothing inside the body, while checkerboard
-/// (zero-energy) modes, whose interior gradients vanish, are fully penalised.
+/// the stress map A_i = stress(i, G_i) and the gradients of pass 1. With the hourglass penalty
+/// (energies/hourglass.hpp) its exact gradient is added per pair:
+///   y_j -= k_ij r_ij,  y_i += k_ij r_ij,   and A_i -= Q_i = sum_j k_ij r_ij X_ij^T,
+/// then y_j -= A_i d_ij, y_i -= A_i d_ii.
 template <bool hourglass, class StressMap>
 void stencil_loop(const Model& model, const PaddedPoints& u, const PaddedGradients& gradients, index_t first,
                   index_t last, PaddedPoints& y, StressMap&& stress) {
@@ -121,10 +111,9 @@ void stencil_loop(const Model& model, const PaddedPoints& u, const PaddedGradien
         const index_t j = nbr_index[e];
         const double* gj = Gall + 12 * static_cast<std::ptrdiff_t>(j);
         const double x0 = X[3 * j] - Xi0, x1 = X[3 * j + 1] - Xi1, x2 = X[3 * j + 2] - Xi2;
-        const double ke = k[e], kh = 0.5 * k[e];
-        // k r = k (u_j - u_i) - (k/2) (G_i + G_j) X_ij
-        const Lane4 r = ke * (load4(U + 4 * j) - ui) -
-                        ((Gi0 + load4(gj)) * (kh * x0) + (Gi1 + load4(gj + 4)) * (kh * x1) + (Gi2 + load4(gj + 8)) * (kh * x2));
+        // k r = k (u_j - u_i) - (k/2) (G_i + G_j) X_ij  (energies/hourglass.hpp)
+        const Lane4 r = hourglass_pair_force(k[e], Lane4(load4(U + 4 * j) - ui), Lane4(Gi0 + load4(gj)), Lane4(Gi1 + load4(gj + 4)),
+                                             Lane4(Gi2 + load4(gj + 8)), x0, x1, x2);
         Q0 += r * x0;
         Q1 += r * x1;
         Q2 += r * x2;
