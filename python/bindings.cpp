@@ -86,9 +86,12 @@ std::unique_lock<std::mutex> locked(PySimulation& p) {
 
 std::unique_ptr<PySimulation> from_scene(const std::string& path, int threads) {
   auto p = std::make_unique<PySimulation>();
-  p->scene = ph::read_scene_file(path);
-  p->sim = std::make_unique<ph::Simulation>(ph::build_scene_model(p->scene), p->scene.solver, threads);
-  if (p->scene.lod.present) p->sim->enable_lod(p->scene.lod.params, ph::scene_lod_contact(p->scene, p->sim->model()));
+  ph::SessionOptions options;
+  options.threads = threads;
+  options.make_device = false;  // Python drives the probe itself (run_probe)
+  ph::SceneSession session = ph::open_scene_file(path, options);
+  p->scene = std::move(session.scene);
+  p->sim = std::move(session.simulation);
   return p;
 }
 

@@ -118,9 +118,12 @@ int run_command(const RunOptions& opt) {
   if (!opt.json.empty()) ph::check_output_path(opt.json, "--json");
   if (!opt.csv.empty()) ph::check_output_path(opt.csv, "--csv");
   if (!opt.force_log.empty()) ph::check_output_path(opt.force_log, "--force-log");
-  const ph::Scene scene = ph::read_scene_file(opt.scene);
-  ph::Simulation sim(ph::build_scene_model(scene, static_cast<double>(opt.max_memory)), scene.solver, opt.threads);
-  if (scene.lod.present) sim.enable_lod(scene.lod.params, ph::scene_lod_contact(scene, sim.model()));
+  ph::SessionOptions session_options;
+  session_options.threads = opt.threads;
+  session_options.max_memory = static_cast<double>(opt.max_memory);
+  ph::SceneSession session = ph::open_scene_file(opt.scene, session_options);
+  const ph::Scene& scene = session.scene;
+  ph::Simulation& sim = *session.simulation;
   const double setup_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (vtk) ph::add_vtk_frame(*vtk, sim);  // the initial state
   const double start_time = sim.state().time;
@@ -132,8 +135,7 @@ int run_command(const RunOptions& opt) {
   OutputErrors errors;
   if (scene.probe.present) {
     // with a probe: the haptic loop at 1 kHz and the simulation, in real time unless asked otherwise
-    const std::unique_ptr<ph::Device> device = ph::make_scene_device(scene);
-    ph::InteractiveOptions options = ph::scene_interactive_options(scene, sim.full_model());
+    ph::InteractiveOptions options = session.interactive;
     options.real_time = !opt.deterministic;
     options.stop = &interrupted;
     // the force log is streamed to its file as the run goes: any length in bounded memory
@@ -150,7 +152,7 @@ int run_command(const RunOptions& opt) {
       options.after_step = [&](long long step) {
         if (step % opt.vtk_every == 0) errors.attempt([&] { ph::add_vtk_frame(*vtk, sim); });
       };
-    interactive = ph::run_interactive(sim, *device, options);
+    interactive = ph::run_interactive(sim, *session.device, options);
     if (force_log) errors.attempt([&] { force_log->commit(); });
     if (interactive.log_dropped > 0)
       errors.messages.push_back(fmt::format("--force-log {}: {} haptic ticks were not logged (the simulation thread fell behind)",

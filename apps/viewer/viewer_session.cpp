@@ -1,7 +1,7 @@
 #include "viewer_session.hpp"
 
 #include <pointhaptics/haptics/devices/openhaptics_device.hpp>
-#include <pointhaptics/scene_builder.hpp>
+#include <pointhaptics/scene_session.hpp>
 
 #include <fmt/format.h>
 
@@ -79,16 +79,19 @@ std::unique_ptr<Prepared> prepare(const Scene& scene_in, ProbeSource source, int
   // the viewer always has a probe (the scene's [probe] values, else the defaults): levels of detail start
   // under it
   scene.probe.present = true;
-  Model model = build_scene_model(scene);
+  SessionOptions session_options;
+  session_options.threads = threads;
+  session_options.make_device = false;  // the viewer's own: the mouse, a device, or the scene's script
+  SceneSession session = open_scene(scene, session_options);
+  p->simulation = std::move(session.simulation);
+  p->options = session.interactive;
+  const Model& model = p->simulation->full_model();
   p->reference = model.X;
   p->fixed = model.fixed;
   p->point_radius = 0.5 * model.spacing;
   p->lo = model.X.rowwise().minCoeff();
   p->hi = model.X.rowwise().maxCoeff();
   p->shell = visible_shell(model.neighbours);
-  p->simulation = std::make_unique<Simulation>(std::move(model), scene.solver, threads);
-  if (scene.lod.present) p->simulation->enable_lod(scene.lod.params, scene_lod_contact(scene, p->simulation->full_model()));
-  p->options = scene_interactive_options(scene, p->simulation->full_model());
   // the mouse pushes, and grabs while its button is held; a scene's grab mode grabs only
   if (!scene.probe.grab) p->options.probe.mode = ProbeMode::PUSH_GRAB;
   p->options.duration = std::numeric_limits<double>::infinity();

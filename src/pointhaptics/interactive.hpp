@@ -64,13 +64,6 @@ struct InteractiveResult {
   int max_contacts = 0;
 };
 
-/// The device a scene's [probe] and [device] describe: a virtual device following the trajectory or
-/// keyframes, or a replay of a recorded log. Throws Error naming the scene and the problem.
-std::unique_ptr<Device> make_scene_device(const Scene& scene);
-/// The interactive options of a scene: probe, workspace mapping (the device origin defaults to 2 probe
-/// radii above the centre of the object's top), duration (solver.duration; a replay defaults to its log).
-InteractiveOptions scene_interactive_options(const Scene& scene, const Model& model);
-
 /// Run the simulation with a probe driven by `device` for options.duration. Real time: the haptic loop
 /// ticks on its own thread at the haptic rate while this thread steps the simulation as fast as it can
 /// (but never ahead of the wall clock), exchanging the probe and the local contact model through

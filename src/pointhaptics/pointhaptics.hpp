@@ -8,6 +8,7 @@
 #include <pointhaptics/io/scene_toml.hpp>
 #include <pointhaptics/mechanics/energy.hpp>
 #include <pointhaptics/scene_builder.hpp>
+#include <pointhaptics/scene_session.hpp>
 #include <pointhaptics/haptics/haptic_log.hpp>
 #include <pointhaptics/interactive.hpp>
 #include <pointhaptics/simulation.hpp>

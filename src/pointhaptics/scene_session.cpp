@@ -1,0 +1,74 @@
+#include <pointhaptics/scene_session.hpp>
+
+#include <pointhaptics/haptics/devices/openhaptics_device.hpp>
+#include <pointhaptics/haptics/devices/replay_device.hpp>
+#include <pointhaptics/haptics/devices/virtual_device.hpp>
+#include <pointhaptics/haptics/haptic_log.hpp>
+#include <pointhaptics/io/scene_toml.hpp>
+#include <pointhaptics/scene_builder.hpp>
+
+#include <fmt/format.h>
+
+#include <chrono>
+
+namespace pointhaptics {
+
+SceneSession open_scene(Scene scene, const SessionOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  SceneSession s;
+  s.simulation = std::make_unique<Simulation>(build_scene_model(scene, options.max_memory), scene.solver, options.threads);
+  if (scene.lod.present) s.simulation->enable_lod(scene.lod.params, scene_lod_contact(scene, s.simulation->full_model()));
+  if (scene.probe.present) {
+    s.interactive = scene_interactive_options(scene, s.simulation->full_model());
+    if (options.make_device) s.device = make_scene_device(scene);
+  }
+  s.scene = std::move(scene);
+  s.setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return s;
+}
+
+SceneSession open_scene_file(const std::string& path, const SessionOptions& options) {
+  return open_scene(read_scene_file(path), options);
+}
+
+namespace {
+
+DeviceSpecs scene_device_specs(const DeviceSpec& d) {
+  if (d.specs != "custom") return known_device_specs(d.specs);
+  return {"custom", d.max_force, d.max_stiffness, d.max_damping, d.workspace_radius};
+}
+
+}  // namespace
+
+std::unique_ptr<Device> make_scene_device(const Scene& scene) {
+  const DeviceSpecs specs = scene_device_specs(scene.device);
+  if (scene.device.kind == "replay") return std::make_unique<ReplayDevice>(read_haptic_log(scene.device.log), specs);
+  if (scene.device.kind == "openhaptics") return std::make_unique<OpenHapticsDevice>(scene.device.library);  // its own specs
+  if (scene.device.kind != "virtual") throw Error(fmt::format("{}: device.kind = \"{}\" is not available", scene.path, scene.device.kind));
+  if (!scene.probe.trajectory.empty()) return std::make_unique<VirtualDevice>(Trajectory::from_csv(scene.probe.trajectory), specs);
+  std::vector<Keyframe> frames;
+  for (const auto& k : scene.probe.keyframes) frames.push_back({k[0], Vec3(k[1], k[2], k[3]), k[4] != 0});
+  try {
+    return std::make_unique<VirtualDevice>(Trajectory(std::move(frames)), specs);
+  } catch (const Error& e) {
+    throw Error(fmt::format("{}:{}: probe.keyframes: {}", scene.path, scene.probe.line, e.what()));
+  }
+}
+
+InteractiveOptions scene_interactive_options(const Scene& scene, const Model& model) {
+  InteractiveOptions o;
+  o.probe.radius = scene.probe.radius;
+  o.probe.mode = scene.probe.grab ? ProbeMode::GRAB : ProbeMode::PUSH;
+  o.probe.stiffness = scene.probe.stiffness;
+  o.mapping.scale = scene.probe.scale;
+  if (scene.probe.origin.allFinite()) {
+    o.mapping.origin = scene.probe.origin;
+  } else {
+    const Vec3 lo = model.X.rowwise().minCoeff(), hi = model.X.rowwise().maxCoeff();
+    o.mapping.origin = Vec3(0.5 * (lo.x() + hi.x()), hi.y() + 2 * scene.probe.radius, 0.5 * (lo.z() + hi.z()));
+  }
+  o.duration = scene.solver.duration;
+  return o;
+}
+
+}  // namespace pointhaptics

@@ -1,0 +1,83 @@
+// Tests for haptics/coupling and haptics/probe_tool: the coupling solve balances the contact model and caps
+// the force at the device's maximum; the probe tool settles where the coupling spring balances the object's
+// contact forces, and its forces, springs and renumbering are those of its contact.
+#include <pointhaptics/haptics/coupling.hpp>
+#include <pointhaptics/haptics/probe_tool.hpp>
+
+#include <pointhaptics/mechanics/model_builder.hpp>
+
+#include "support/test_models.hpp"
+
+#include <gtest/gtest.h>
+
+namespace pointhaptics {
+namespace {
+
+ContactModel pushing_back(double stiffness) {
+  ContactModel m;
+  m.p0 = Vec3(0, 0.01, 0);
+  m.f0 = Vec3(0, 0.5, 0);
+  m.K = -stiffness * Mat3::Identity();
+  m.contacts = 4;
+  return m;
+}
+
+TEST(Coupling, TheProbeBalancesTheSpringAndTheContactModel) {
+  const ContactModel m = pushing_back(200);
+  const Vec3 d(0.001, 0.005, -0.002);
+  const double k = 400;
+  const Vec3 p = coupled_probe(m, d, k, 100.0);
+  EXPECT_LE((k * (d - p) + m.f0 + m.K * (p - m.p0)).norm(), 1e-12);
+  // without contact the probe is the device point
+  EXPECT_LE((coupled_probe(ContactModel{}, d, k, 100.0) - d).norm(), 1e-15);
+}
+
+TEST(Coupling, TheCouplingForceIsCappedAtTheDevicesMaximum) {
+  // pressed 5 cm into a stiff object: k |d - p| would be far beyond 3.3 N
+  const ContactModel m = pushing_back(1e5);
+  const Vec3 d = m.p0 - Vec3(0, 0.05, 0);
+  const double k = 400, max_force = 3.3;
+  const Vec3 free = coupled_probe(m, d, k, 1e9);
+  ASSERT_GT(k * (d - free).norm(), max_force);
+  const Vec3 p = coupled_probe(m, d, k, max_force);
+  // the probe sits where the device point, pulled in toward the free answer to the capped force, holds it
+  const Vec3 pulled = free + (d - free) * (max_force / (k * (d - free).norm()));
+  EXPECT_LE((k * (pulled - p) + m.f0 + m.K * (p - m.p0)).norm(), 1e-9);
+  EXPECT_LT((p - m.p0).norm(), (free - m.p0).norm());
+}
+
+TEST(ProbeTool, SettlesWhereTheCouplingBalancesTheContactAndActsThroughIt) {
+  MaterialParams material;
+  material.young = 1e4;
+  const Model model = build_model(test::jittered_box(6, 3, 6, 0.01, 0.0), material, KernelParams{});
+  const State state = State::at_rest(model);
+  ProbeParams params;
+  params.radius = 0.008;
+  const double k = 300;
+  ProbeTool tool(model, params, k, 10.0);
+  // the device point 4 mm into the top face (y = 0.02) above the middle
+  const Vec3 device(0.025, 0.02 + params.radius - 0.004, 0.025);
+  tool.place(model, state, device, false);
+  Points f = Points::Zero(3, model.n_points);
+  tool.add(model, state, f);
+  const ContactModel m = tool.contact_model();
+  ASSERT_GT(m.contacts, 0);
+  // balanced: the coupling's pull equals the contact force on the probe
+  EXPECT_LE((k * (device - tool.probe()) + m.f0).norm(), 1e-6 * m.f0.norm());
+  // the points feel the opposite of the probe
+  EXPECT_LE((f.rowwise().sum() + m.f0).norm(), 1e-9 * m.f0.norm());
+  Eigen::Matrix<double, 9, Eigen::Dynamic> springs = Eigen::Matrix<double, 9, Eigen::Dynamic>::Zero(9, model.n_points);
+  EXPECT_TRUE(tool.add_stiffness(model, state, springs));
+  EXPECT_GT(springs.norm(), 0.0);
+  EXPECT_DOUBLE_EQ(tool.max_point_stiffness(), material.young * model.spacing);  // the default contact stiffness
+  // lifted off: no contact
+  tool.place(model, state, Vec3::Constant(NAN), false);
+  f.setZero();
+  tool.add(model, state, f);
+  EXPECT_EQ(tool.contact_model().contacts, 0);
+  EXPECT_EQ(tool.contacts_before_step(), m.contacts);
+  EXPECT_EQ(f.norm(), 0.0);
+}
+
+}  // namespace
+}  // namespace pointhaptics
