@@ -191,31 +191,31 @@ names the problem.)doc")
           "time",
           [](PySimulation& p) {
             const auto lock = locked(p);
-            return p.sim->full_state().time;
+            return p.sim->state().time;
           },
           "Simulated time so far (s)")
       .def_property_readonly(
-          "n_points", [](PySimulation& p) { return p.sim->full_model().n_points; }, "Points of the object, n")
+          "n_points", [](PySimulation& p) { return p.sim->model().n_points; }, "Points of the object, n")
       .def(
           "__repr__",
           [](PySimulation& p) {
             const auto lock = locked(p);
-            const ph::Model& m = p.sim->full_model();
+            const ph::Model& m = p.sim->simulated_model();
             std::string lod;
             if (const ph::ActiveSet* a = p.sim->active_set()) lod = ", " + std::to_string(a->n_selected) + " simulated";
             return "<pointhaptics.Simulation: " + std::to_string(m.n_points) + " points" + lod + ", " +
                    std::string(ph::to_string(p.sim->solver().kind)) + " solver, dt = " + fmt::format("{:g}", p.sim->solver().dt) +
-                   " s, t = " + fmt::format("{:g}", p.sim->full_state().time) + " s>";
+                   " s, t = " + fmt::format("{:g}", p.sim->state().time) + " s>";
           })
       .def_property_readonly(
-          "reference", [](py::object self) { return view(self.cast<PySimulation&>().sim->full_model().X, self); },
+          "reference", [](py::object self) { return view(self.cast<PySimulation&>().sim->model().X, self); },
           "Reference (rest) positions X, an (n, 3) read-only view (m)")
       .def_property_readonly(
           "displacement",
           [](py::object self) {
             PySimulation& p = self.cast<PySimulation&>();
             const auto lock = locked(p);
-            return view(p.sim->full_state().u, self);
+            return view(p.sim->state().u, self);
           },
           "Displacements, an (n, 3) read-only view into the simulation (m): it changes as the simulation steps")
       .def_property_readonly(
@@ -223,14 +223,14 @@ names the problem.)doc")
           [](py::object self) {
             PySimulation& p = self.cast<PySimulation&>();
             const auto lock = locked(p);
-            return view(p.sim->full_state().velocity, self);
+            return view(p.sim->state().velocity, self);
           },
           "Velocities, an (n, 3) read-only view (m/s)")
       .def_property_readonly(
           "positions",
           [](PySimulation& p) {
             const auto lock = locked(p);
-            const ph::Points x = p.sim->full_model().X + p.sim->full_state().u;
+            const ph::Points x = p.sim->model().X + p.sim->state().u;
             return py::array_t<double>({x.cols(), Eigen::Index{3}}, {Eigen::Index{3 * sizeof(double)}, Eigen::Index{sizeof(double)}},
                                        x.data());
           },
@@ -239,12 +239,12 @@ names the problem.)doc")
           "forces",
           [](PySimulation& p) {
             const auto lock = locked(p);
-            const ph::Model& m = p.sim->model();
+            const ph::Model& m = p.sim->simulated_model();
             ph::Workspace ws(m, 1);
-            ph::compute_internal_forces(m, p.sim->state().u, ws);
+            ph::compute_internal_forces(m, p.sim->simulated_state().u, ws);
             // one row per point of the object, as every other array (with levels of detail the simulated
             // points carry theirs, the others none)
-            ph::Points f = ph::Points::Zero(3, p.sim->full_model().n_points);
+            ph::Points f = ph::Points::Zero(3, p.sim->model().n_points);
             const ph::ActiveSet* active = p.sim->active_set();
             for (ph::index_t k = 0; k < m.n_points; ++k) f.col(active ? active->full_of[k] : k) = ws.f_int.col(k);
             return py::array_t<double>({f.cols(), Eigen::Index{3}}, {Eigen::Index{3 * sizeof(double)}, Eigen::Index{sizeof(double)}},
@@ -254,7 +254,7 @@ names the problem.)doc")
           "array; with levels of detail, zero on the points not simulated")
       .def_property_readonly("fixed",
                              [](PySimulation& p) {
-                               const ph::Model& m = p.sim->full_model();
+                               const ph::Model& m = p.sim->simulated_model();
                                py::array_t<bool> a(m.n_points);
                                for (ph::index_t i = 0; i < m.n_points; ++i) a.mutable_at(i) = m.fixed[i] != 0;
                                return a;
@@ -263,10 +263,10 @@ names the problem.)doc")
       .def("energy",
            [](PySimulation& p) {
              const auto lock = locked(p);
-             const ph::EnergyTerms e = ph::strain_energy(p.sim->model(), p.sim->state().u);
+             const ph::EnergyTerms e = ph::strain_energy(p.sim->simulated_model(), p.sim->simulated_state().u);
              py::dict d;
              d["strain"] = e.total();
-             d["kinetic"] = ph::kinetic_energy(p.sim->model(), p.sim->state().velocity);
+             d["kinetic"] = ph::kinetic_energy(p.sim->simulated_model(), p.sim->simulated_state().velocity);
              return d;
            },
            "Energies of the simulated points now, a dict: strain (the elastic energy whose gradient the forces are) and "
@@ -276,7 +276,7 @@ names the problem.)doc")
           [](PySimulation& p) {
             const auto lock = locked(p);
             const ph::RunSummary summary = p.sim->summary();
-            return summary_dict(p.sim->full_model(), p.sim->full_state(), summary);
+            return summary_dict(p.sim->model(), p.sim->state(), summary);
           },
           "The run so far, with the result JSON's blocks and keys (`pointhaptics run --json`): solver (kind, converged, "
           "iterations, residual, steps, substeps, stable_dt, cg_iterations, failure, interrupted), energy (strain, kinetic; "
@@ -303,7 +303,7 @@ names the problem.)doc")
             if (mode != "push" && mode != "grab") throw ph::Error("probe: mode must be push or grab");
             scene.probe.grab = mode == "grab";
             scene.solver.duration = duration;
-            ph::InteractiveOptions o = ph::scene_interactive_options(scene, p.sim->full_model());
+            ph::InteractiveOptions o = ph::scene_interactive_options(scene, p.sim->model());
             o.real_time = real_time;
             ph::InteractiveResult r;
             {

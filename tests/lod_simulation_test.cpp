@@ -54,7 +54,7 @@ TEST(LodSimulation, SelectingEverythingSolvesLikeTheFullModel) {
   LodParams p;
   p.k1 = p.k2 = 50.0;
   lod.enable_lod(p, scene_lod_contact(scene, lod.model()));
-  EXPECT_EQ(lod.model().n_points, full.model().n_points);
+  EXPECT_EQ(lod.simulated_model().n_points, full.model().n_points);
   full.step();
   lod.step();
   const RunSummary s = lod.summary();
@@ -63,7 +63,7 @@ TEST(LodSimulation, SelectingEverythingSolvesLikeTheFullModel) {
   EXPECT_EQ(s.lod.selected, full.model().n_points);
   EXPECT_EQ(s.lod.selections, 1);
   const Points& a = full.state().u;
-  const Points& b = lod.full_state().u;
+  const Points& b = lod.state().u;
   EXPECT_LE((a - b).norm(), 1e-6 * a.norm());
 }
 
@@ -75,23 +75,23 @@ TEST(LodSimulation, RunsOnTheActiveSetAndReportsIt) {
   LodParams p;
   p.levels = {{3.0, 6}};
   sim.enable_lod(p, sim.model().X.col(top));
-  EXPECT_LT(sim.model().n_points, sim.full_model().n_points);
+  EXPECT_LT(sim.simulated_model().n_points, sim.model().n_points);
   sim.step();
   const RunSummary s = sim.summary();
   ASSERT_TRUE(s.converged) << s.failure;
   EXPECT_EQ(s.lod.band_count.size(), 3u);
   EXPECT_EQ(s.lod.band_selected[0], s.lod.band_count[0]);  // everything within T_r1
   EXPECT_GT(s.lod.selected, 0);
-  EXPECT_EQ(static_cast<index_t>(s.lod.active.size()), sim.full_model().n_points);
+  EXPECT_EQ(static_cast<index_t>(s.lod.active.size()), sim.model().n_points);
   EXPECT_TRUE(s.lod.active[top]);
   // the loaded point moved down; points far from the contact did not move at all
-  const State& st = sim.full_state();
+  const State& st = sim.state();
   EXPECT_LT(st.u(1, top), 0.0);
-  const index_t far = point_at(sim.full_model(), Vec3(0.0, 0.04, 0.0));
+  const index_t far = point_at(sim.model(), Vec3(0.0, 0.04, 0.0));
   EXPECT_FALSE(s.lod.active[far]);
   EXPECT_EQ(st.u.col(far).norm(), 0.0);
   // the JSON marks active points
-  const std::string json = result_json(sim.full_model(), st, s);
+  const std::string json = result_json(sim.model(), st, s);
   EXPECT_NE(json.find("\"selections\": 1"), std::string::npos);
 }
 
@@ -118,23 +118,25 @@ TEST(LodSimulation, ReselectionCarriesTheStateWithoutAJumpInTheContactForce) {
   for (int k = 0; k < 150; ++k) ASSERT_NE(sim.step().status, StepStatus::FAILED);
   // the force a push probe at probe_at feels now (pushing has no memory: a fresh contact each time)
   auto felt = [&] {
-    Points scratch = Points::Zero(3, sim.model().n_points);
-    return ProbeContact(sim.model(), probe).apply(sim.model(), sim.state().u, probe_at, false, sim.state().time, scratch).f0;
+    Points scratch = Points::Zero(3, sim.simulated_model().n_points);
+    return ProbeContact(sim.simulated_model(), probe)
+        .apply(sim.simulated_model(), sim.simulated_state().u, probe_at, false, sim.time(), scratch)
+        .f0;
   };
   const Vec3 before = felt();
   ASSERT_GT(before.norm(), 1e-3);
   EXPECT_LE((sim.probe()->probe() - probe_at).norm(), 1e-6);
   // the probe slides by 0.8 h: beyond the re-selection distance
   const long long selections = sim.summary().lod.selections;
-  probe_at.x() += 0.8 * sim.full_model().h;
+  probe_at.x() += 0.8 * sim.model().h;
   const Vec3 slid = felt();
-  const Points u_before = sim.full_state().u;
+  const Points u_before = sim.state().u;
   const std::vector<index_t> new_index = sim.update_lod(sim.lod_contact_of_probe(probe_at));
   ASSERT_FALSE(new_index.empty()) << "no re-selection";
   const Vec3 after = felt();
   EXPECT_LE((after - slid).norm(), 1e-9 * slid.norm()) << "force before " << slid.transpose() << ", after " << after.transpose();
   // every point simulated before and after kept its displacement
-  const Points u_after = sim.full_state().u;
+  const Points u_after = sim.state().u;
   for (index_t k = 0; k < static_cast<index_t>(new_index.size()); ++k)
     if (new_index[k] >= 0) {
       const index_t i = sim.active_set()->full_of[new_index[k]];
@@ -142,7 +144,7 @@ TEST(LodSimulation, ReselectionCarriesTheStateWithoutAJumpInTheContactForce) {
     }
   EXPECT_EQ(sim.summary().lod.selections, selections + 1);
   // a small move does not re-select
-  probe_at.x() += 0.1 * sim.full_model().h;
+  probe_at.x() += 0.1 * sim.model().h;
   EXPECT_TRUE(sim.update_lod(sim.lod_contact_of_probe(probe_at)).empty());
   // stepping on goes on smoothly, the probe's own contact renumbered with the points
   sim.inputs().device = probe_at;
@@ -174,7 +176,11 @@ struct PressedBlock {
     sim.set_state(st);
     for (int k = 0; k < 20; ++k) sim.step();
   }
-  double energy() { return strain_energy(sim.model(), sim.state().u).total() + kinetic_energy(sim.model(), sim.state().velocity); }
+  // of what is simulated
+  double energy() {
+    return strain_energy(sim.simulated_model(), sim.simulated_state().u).total() +
+           kinetic_energy(sim.simulated_model(), sim.simulated_state().velocity);
+  }
   static Simulation make() {
     Scene scene = block_scene(Vec3::Zero(), 0);
     scene.loads.clear();
@@ -202,13 +208,13 @@ TEST(LodSimulation, ATakeOverAddsNoEnergy) {
 
 TEST(LodSimulation, NoReselectionSoonerThanTheIntervalAfterTheLast) {
   PressedBlock b(0.05);
-  const double h = b.sim.full_model().h;
+  const double h = b.sim.model().h;
   ASSERT_FALSE(b.sim.update_lod(Vec3(0.03 + h, 0.04, 0.03)).empty());
   // 2 h further, 1 ms later: too soon
   b.sim.step();
   EXPECT_TRUE(b.sim.update_lod(Vec3(0.03 + 3 * h, 0.04, 0.03)).empty());
   // ... until the interval has passed
-  while (b.sim.state().time < 0.020 + 0.05 - 1e-9) b.sim.step();
+  while (b.sim.time() < 0.020 + 0.05 - 1e-9) b.sim.step();
   b.sim.step();
   EXPECT_FALSE(b.sim.update_lod(Vec3(0.03 + 3 * h, 0.04, 0.03)).empty());
   EXPECT_EQ(b.sim.lod_selections(), 3);
@@ -224,9 +230,9 @@ TEST(LodSimulation, AsynchronousReselectionKeepsSteppingUntilTheNewSetTakesOver)
   const Vec3 c(0.03, 0.04, 0.03);
   sim.enable_lod(p, c);
   for (int k = 0; k < 5; ++k) sim.step();
-  const index_t before = sim.model().n_points;  // new_index has an entry per old active point
+  const index_t before = sim.simulated_model().n_points;  // new_index has an entry per old active point
   // moved by 2 h: a re-selection starts on a worker thread; this thread keeps stepping the old set
-  const Vec3 moved = c + Vec3(2 * sim.full_model().h, 0, 0);
+  const Vec3 moved = c + Vec3(2 * sim.model().h, 0, 0);
   EXPECT_TRUE(sim.update_lod(moved, false, true).empty());
   std::vector<index_t> new_index;
   int steps = 0;
@@ -241,8 +247,8 @@ TEST(LodSimulation, AsynchronousReselectionKeepsSteppingUntilTheNewSetTakesOver)
   EXPECT_LT(s.lod.max_reselect_ms, 1e4);
   // the new selection is around the moved contact: the point nearest it is simulated
   index_t nearest = 0;
-  for (index_t i = 0; i < sim.full_model().n_points; ++i)
-    if ((sim.full_model().X.col(i) - moved).norm() < (sim.full_model().X.col(nearest) - moved).norm()) nearest = i;
+  for (index_t i = 0; i < sim.model().n_points; ++i)
+    if ((sim.model().X.col(i) - moved).norm() < (sim.model().X.col(nearest) - moved).norm()) nearest = i;
   EXPECT_TRUE(s.lod.active[nearest]);
   for (int k = 0; k < 10; ++k) sim.step();
   EXPECT_TRUE(sim.state().u.allFinite());
@@ -272,16 +278,16 @@ SlideResult slide(bool lod, LodScheme scheme = LodScheme::RANDOM) {
   p.scheme = scheme;
   if (lod) sim.enable_lod(p, scene_lod_contact(scene, sim.model()));
   const auto device = make_scene_device(scene);
-  InteractiveOptions o = scene_interactive_options(scene, sim.full_model());
+  InteractiveOptions o = scene_interactive_options(scene, sim.model());
   o.real_time = false;
   DisplayFrame blank;
-  blank.u = Points::Zero(3, sim.full_model().n_points);
+  blank.u = Points::Zero(3, sim.model().n_points);
   TripleBuffer<DisplayFrame> display(blank);
   o.display = &display;
   SlideResult out;
   out.run = run_interactive(sim, *device, o);
   out.summary = sim.summary();
-  out.n_points = sim.full_model().n_points;
+  out.n_points = sim.model().n_points;
   display.update();
   out.last_frame = display.front().u;
   return out;

@@ -26,7 +26,7 @@ TEST(SceneSession, AProbeSceneGetsItsDeviceOptionsAndLevelsOfDetail) {
   const SceneSession s = open_scene(parse_scene(test::cantilever_scene() + probe_and_lod), {1, 0, true});
   ASSERT_TRUE(s.simulation);
   EXPECT_TRUE(s.simulation->lod_enabled());
-  EXPECT_LT(s.simulation->model().n_points, s.simulation->full_model().n_points);
+  EXPECT_LT(s.simulation->simulated_model().n_points, s.simulation->model().n_points);
   ASSERT_TRUE(s.device);
   EXPECT_NE(dynamic_cast<VirtualDevice*>(s.device.get()), nullptr);
   EXPECT_DOUBLE_EQ(s.interactive.probe.radius, 0.004);
@@ -38,7 +38,7 @@ TEST(SceneSession, AProbeSceneGetsItsDeviceOptionsAndLevelsOfDetail) {
   const SceneSession without = open_scene(parse_scene(test::cantilever_scene() + probe_and_lod), {1, 0, false});
   EXPECT_FALSE(without.device);
   EXPECT_EQ(without.interactive.mapping.origin, s.interactive.mapping.origin);
-  EXPECT_EQ(without.simulation->model().n_points, s.simulation->model().n_points);
+  EXPECT_EQ(without.simulation->simulated_model().n_points, s.simulation->simulated_model().n_points);
 }
 
 TEST(SceneSession, APlainSceneHasNeitherDeviceNorLevelsOfDetail) {

@@ -76,7 +76,7 @@ struct Timing {
 Timing time_steps(Simulation& sim, double seconds) {
   sim.step();  // warm up
   const long long sub0 = sim.summary().substeps;
-  const double t0 = sim.state().time;
+  const double t0 = sim.time();
   const auto start = std::chrono::steady_clock::now();
   double wall = 0;
   int steps = 0;
@@ -87,7 +87,7 @@ Timing time_steps(Simulation& sim, double seconds) {
   }
   Timing t;
   t.steps_per_s = (sim.summary().substeps - sub0) / wall;
-  t.realtime = (sim.state().time - t0) / wall;
+  t.realtime = (sim.time() - t0) / wall;
   t.stable_dt = sim.stable_dt();
   return t;
 }
@@ -211,7 +211,7 @@ int run_propagation_experiment(const LodExperimentOptions& options) {
     sim.run(duration);
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const RunSummary s = sim.summary();
-    r.u = sim.full_state().u;
+    r.u = sim.state().u;
     r.timing.steps_per_s = s.substeps / wall;
     r.timing.realtime = duration / wall;
     r.timing.stable_dt = s.stable_dt;
@@ -388,7 +388,7 @@ int run_lod_error_experiment(const LodExperimentOptions& options) {
       sim.enable_lod(p, c);
       sim.step();
       const RunSummary s = sim.summary();
-      const Errors e = errors(model, sim.full_state().u, reference, c, p.k1 * model.h);
+      const Errors e = errors(model, sim.state().u, reference, c, p.k1 * model.h);
       Simulation dyn(model, scene.solver, options.threads);
       dyn.enable_lod(p, c);
       const Timing t = time_steps(dyn, options.seconds / 2);

@@ -42,8 +42,8 @@ struct RunOptions {
 };
 
 void print_summary(ph::Simulation& sim, const ph::RunSummary& s, double setup_s) {
-  const ph::Model& m = sim.full_model();
-  const ph::State& st = sim.full_state();
+  const ph::Model& m = sim.model();
+  const ph::State& st = sim.state();
   Eigen::Index worst = 0;
   const double max_u = m.n_points ? st.u.colwise().norm().maxCoeff(&worst) : 0.0;
   fmt::print("points          {} ({} held), h = {:.4g} m, {:.1f} neighbours per point (min {}), kernel {}\n", m.n_points,
@@ -126,7 +126,7 @@ int run_command(const RunOptions& opt) {
   ph::Simulation& sim = *session.simulation;
   const double setup_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (vtk) ph::add_vtk_frame(*vtk, sim);  // the initial state
-  const double start_time = sim.state().time;
+  const double start_time = sim.time();
   const bool options_real_time = !opt.deterministic;
   interrupted.store(false);
   std::signal(SIGINT, on_interrupt);
@@ -202,7 +202,7 @@ int run_command(const RunOptions& opt) {
     summary.haptic_period_p99_us = interactive.haptic.period_p99_us;
     summary.haptic_max_force_n = interactive.haptic.max_force_n;
   }
-  if (!opt.json.empty()) errors.attempt([&] { ph::write_result_json(opt.json, sim.full_model(), sim.full_state(), summary); });
+  if (!opt.json.empty()) errors.attempt([&] { ph::write_result_json(opt.json, sim.model(), sim.state(), summary); });
   if (!opt.quiet) {
     print_summary(sim, summary, setup_s);
     if (scene.probe.present) {
@@ -214,7 +214,7 @@ int run_command(const RunOptions& opt) {
                  interactive.max_contacts, interactive.simulation_steps);
       if (options_real_time && interactive.simulation_wall_s > 0) {
         // a real-time run whose simulation could not keep up with the wall clock says by how much
-        const double simulated = sim.state().time - start_time;
+        const double simulated = sim.time() - start_time;
         if (simulated < 0.95 * interactive.simulation_wall_s)
           fmt::print("warning         the simulation fell behind the wall clock: {:.3g} s simulated in {:.3g} s ({:.0f}% of real "
                      "time); the hand felt a slower object (fewer points, levels of detail, or the implicit solver)\n",
@@ -228,7 +228,7 @@ int run_command(const RunOptions& opt) {
   for (const std::string& message : errors.messages) fmt::print(stderr, "pointhaptics: error: {}\n", message);
   if (summary.interrupted) {
     fmt::print(stderr, "pointhaptics: {}: interrupted at t = {:.6g} s; the outputs hold the state reached\n", opt.scene,
-               sim.state().time);
+               sim.time());
     return 130;
   }
   if (!errors.messages.empty()) return 1;

@@ -85,7 +85,7 @@ std::unique_ptr<Prepared> prepare(const Scene& scene_in, ProbeSource source, int
   SceneSession session = open_scene(scene, session_options);
   p->simulation = std::move(session.simulation);
   p->options = session.interactive;
-  const Model& model = p->simulation->full_model();
+  const Model& model = p->simulation->model();
   p->reference = model.X;
   p->fixed = model.fixed;
   p->point_radius = 0.5 * model.spacing;
@@ -106,7 +106,7 @@ std::unique_ptr<Prepared> prepare(const Scene& scene_in, ProbeSource source, int
   initial.u = Points::Zero(3, p->reference.cols());
   initial.probe = p->options.mapping.origin;
   initial.device = p->options.mapping.origin;
-  initial.simulated = p->simulation->model().n_points;
+  initial.simulated = p->simulation->simulated_model().n_points;
   p->display = std::make_unique<TripleBuffer<DisplayFrame>>(initial);
   return p;
 }

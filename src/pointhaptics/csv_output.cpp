@@ -20,8 +20,8 @@ void write_points_csv(const std::string& path, Simulation& sim) {
   const std::vector<double>& w = field("strain_energy_density");
   const std::vector<double>& active = field("active");
   const std::vector<double>& fixed = field("fixed");
-  const Model& m = sim.full_model();
-  const State& s = sim.full_state();
+  const Model& m = sim.model();
+  const State& s = sim.state();
   write_text_file(path, "--csv", [&](TextOutput& out) {
     out.print("index,x,y,z,ux,uy,uz,von_mises,strain_energy_density,active,fixed\n");
     for (index_t i = 0; i < m.n_points; ++i) {

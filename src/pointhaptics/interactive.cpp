@@ -16,21 +16,20 @@ namespace {
 void publish_display(Simulation& sim, const HapticFrame& haptic, long long step, TripleBuffer<DisplayFrame>& display) {
   const ProbeTool& probe = *sim.probe();
   DisplayFrame& d = display.back();
-  d.time = sim.state().time;
+  d.time = sim.time();
   d.step = step;
-  d.u = sim.full_state().u;  // same size every time: no allocation
+  d.u = sim.state().u;  // same size every time: no allocation
   d.probe = probe.probe();
   d.device = haptic.device;
   d.force = haptic.force;
   d.haptic_ticks = haptic.tick;
   d.contacts = probe.contact_model().contacts;
   const ActiveSet* active = sim.active_set();
-  d.simulated = active ? active->n_selected : sim.model().n_points;
-  d.grabbed.clear();
-  for (const index_t i : probe.contact().grabbed()) d.grabbed.push_back(active ? active->full_of[i] : i);
+  d.simulated = active ? active->n_selected : sim.simulated_model().n_points;
+  sim.grabbed_points(d.grabbed);
   if (active && d.lod_selections != sim.lod_selections()) {  // a new active set (rare): each slot catches up once
     const Selection& selection = *sim.lod_selection();
-    d.lod_band.assign(sim.full_model().n_points, -1);
+    d.lod_band.assign(sim.model().n_points, -1);
     for (const index_t i : selection.selected) d.lod_band[i] = selection.band[i];
     d.lod_selections = sim.lod_selections();
   }
@@ -55,7 +54,7 @@ int simulation_step(Simulation& sim, HapticLoop& loop) {
 InteractiveResult run_interactive(Simulation& sim, Device& device, const InteractiveOptions& options) {
   if (!(options.duration >= 0) || !(options.haptic_rate > 0)) throw Error("interactive run: bad duration or haptic rate");
   if (sim.solver().kind == SolverKind::STATIC) throw Error("interactive run: needs a dynamic solver (explicit or implicit)");
-  if (options.display && options.display->back().u.cols() != sim.full_model().n_points)
+  if (options.display && options.display->back().u.cols() != sim.model().n_points)
     throw Error("interactive run: the display frames must be sized for the model's points (3 x n)");
   const CouplingGains gains = coupling_budget(device.specs(), options.mapping.scale, options.coupling_safety);
   // in real time levels of detail are built on a worker thread and taken over at the first step after they
@@ -78,7 +77,7 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
   };
   const auto stopped = [&options] { return options.stop && options.stop->load(std::memory_order_acquire); };
   const auto start = std::chrono::steady_clock::now();
-  const double t0 = sim.state().time;
+  const double t0 = sim.time();
   // display frames: at most one per display_period (of wall time in real time, else of simulated time),
   // and the last step's
   double last_display = -std::numeric_limits<double>::infinity();
@@ -86,7 +85,7 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
   const auto display = [&](bool last) {
     if (!options.display || result.simulation_steps == 0 || last_display_step == result.simulation_steps) return;
     const double t = options.real_time ? std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
-                                       : sim.state().time;
+                                       : sim.time();
     if (!last && t - last_display < options.display_period) return;
     last_display = t;
     last_display_step = result.simulation_steps;
@@ -97,8 +96,8 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
     for (;;) {
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       if (wall >= options.duration || loop.device_failed() || stopped() || sim.diagnostics().failed) break;
-      if (sim.state().time - t0 > wall) {  // ahead of the wall clock: wait for it
-        std::this_thread::sleep_for(std::chrono::duration<double>(sim.state().time - t0 - wall));
+      if (sim.time() - t0 > wall) {  // ahead of the wall clock: wait for it
+        std::this_thread::sleep_for(std::chrono::duration<double>(sim.time() - t0 - wall));
         continue;
       }
       result.max_contacts = std::max(result.max_contacts, simulation_step(sim, loop));
@@ -116,7 +115,7 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
       const double t = k * h;
       if (!loop.tick(t, h)) break;
       take_log();
-      while (sim.state().time - t0 < t - 1e-12 && !sim.diagnostics().failed) {
+      while (sim.time() - t0 < t - 1e-12 && !sim.diagnostics().failed) {
         result.max_contacts = std::max(result.max_contacts, simulation_step(sim, loop));
         ++result.simulation_steps;
         display(false);

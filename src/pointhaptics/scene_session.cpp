@@ -17,9 +17,9 @@ SceneSession open_scene(Scene scene, const SessionOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   SceneSession s;
   s.simulation = std::make_unique<Simulation>(build_scene_model(scene, options.max_memory), scene.solver, options.threads);
-  if (scene.lod.present) s.simulation->enable_lod(scene.lod.params, scene_lod_contact(scene, s.simulation->full_model()));
+  if (scene.lod.present) s.simulation->enable_lod(scene.lod.params, scene_lod_contact(scene, s.simulation->model()));
   if (scene.probe.present) {
-    s.interactive = scene_interactive_options(scene, s.simulation->full_model());
+    s.interactive = scene_interactive_options(scene, s.simulation->model());
     if (options.make_device) s.device = make_scene_device(scene);
   }
   s.scene = std::move(scene);

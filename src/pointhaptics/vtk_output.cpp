@@ -5,8 +5,8 @@
 namespace pointhaptics {
 
 std::vector<VtkArray> vtk_arrays(Simulation& sim) {
-  const Model& m = sim.full_model();
-  const State& s = sim.full_state();
+  const Model& m = sim.model();
+  const State& s = sim.state();
   const index_t n = m.n_points;
   const PointFields f = point_fields(m, s.u);
   std::vector<VtkArray> arrays;
@@ -26,8 +26,8 @@ std::vector<VtkArray> vtk_arrays(Simulation& sim) {
 
 void add_vtk_frame(VtkSeries& series, Simulation& sim) {
   std::vector<VtkArray> arrays = vtk_arrays(sim);
-  const Points x = sim.full_model().X + sim.full_state().u;
-  series.add(sim.full_state().time, x, arrays);
+  const Points x = sim.model().X + sim.state().u;
+  series.add(sim.state().time, x, arrays);
 }
 
 }  // namespace pointhaptics

@@ -1,0 +1,198 @@
+#include <pointhaptics/levels_of_detail.hpp>
+
+#include <pointhaptics/core/error.hpp>
+#include <pointhaptics/mechanics/energy.hpp>
+#include <pointhaptics/solvers/explicit_solver.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <random>
+
+namespace pointhaptics {
+namespace {
+
+LodBuild build_lod(const Model& full, const LodParams& params, const Vec3& centre, SolverKind solver) {
+  const auto start = std::chrono::steady_clock::now();
+  LodBuild b;
+  std::mt19937_64 rng(params.seed);  // a fresh generator: every point keeps its draw across selections
+  b.selection = select_points(full, centre, params, rng);
+  b.active = build_active_set(full, b.selection, params);
+  b.centre = centre;
+  if (solver == SolverKind::EXPLICIT) b.stable_dt = stable_time_step(b.active.model, 0.8, 20);
+  b.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return b;
+}
+
+// A re-selection must not add energy. The new active set sees the same displacement field through other
+// points, volumes and stencils, and measured on a probe sliding over the half-sphere its strain energy came
+// out 30-100% above the old set's, its kinetic energy about 10% (mass moves between points, absorbed points
+// follow by extrapolation). Re-selecting every few tens of milliseconds, as a slow real-time session does,
+// pumped the object up until it diverged (issue 21). What the new state holds beyond the old one is taken
+// out of its kinetic energy (down to rest, at most): the take-over is passive.
+void remove_added_energy(const Model& model, double energy_before, State& state) {
+  const double kinetic = kinetic_energy(model, state.velocity);
+  const double added = strain_energy(model, state.u).total() + kinetic - energy_before;
+  if (!(added > 0) || !(kinetic > 0)) return;
+  state.velocity *= std::sqrt(std::max(0.0, kinetic - added) / kinetic);
+}
+
+}  // namespace
+
+LevelsOfDetail::LevelsOfDetail(ModelSimulation&& object, const LodParams& params, const Vec3& contact)
+    : solver_(object.solver_), n_threads_(object.n_threads_), params_(params), contact_(contact) {
+  validate(params);
+  if (!contact.allFinite()) throw Error("lod: the contact point is not finite");
+  full_ = std::move(object.model_);
+  full_state_ = object.state_;
+  tree_ = std::make_unique<KdTree>(full_.X);
+  // the first active set: built here, before any step (set-up, not a stall); the object's diagnostics,
+  // inputs and probe carry over
+  LodBuild first = build_lod(full_, params_, snap(contact), solver_.kind);
+  StepDiagnostics diagnostics = std::move(object.diagnostics_);
+  std::optional<ProbeAttachment> probe = std::move(object.probe_);
+  const StepInputs inputs = object.inputs_;
+  active_ = std::make_unique<ModelSimulation>(first.active.model, solver_, n_threads_, first.stable_dt);
+  active_->diagnostics_ = std::move(diagnostics);
+  active_->inputs_ = inputs;
+  active_->probe_ = std::move(probe);
+  take_over(std::move(first), true);
+}
+
+LevelsOfDetail::~LevelsOfDetail() {
+  if (pending_.valid()) pending_.wait();  // the worker reads full_
+}
+
+Vec3 LevelsOfDetail::snap(const Vec3& c) const {
+  index_t nearest = 0;
+  double d2 = 0;
+  tree_->index().knnSearch(c.data(), 1, &nearest, &d2);
+  return full_.X.col(nearest);
+}
+
+const State& LevelsOfDetail::object_state() const {
+  if (!object_state_current_) {
+    active_set_.prolong_state(active_->state(), full_state_);
+    object_state_current_ = true;
+  }
+  return full_state_;
+}
+
+void LevelsOfDetail::set_object_state(const State& state) {
+  if (state.u.cols() != full_.n_points || state.velocity.cols() != full_.n_points)
+    throw Error("simulation: the state is for another model");
+  full_state_.u = state.u;
+  full_state_.velocity = state.velocity;
+  full_state_.time = state.time;
+  State active = active_set_.restrict_state(full_state_);
+  active.time = state.time;
+  active_->set_state(active);
+  object_state_current_ = false;  // unsimulated points' values are the object's own; selected ones come back
+}
+
+Vec3 LevelsOfDetail::contact_of_probe(const Vec3& probe, const std::vector<index_t>& grabbed,
+                                      const std::vector<index_t>& touched) const {
+  const Model& model = active_->model();
+  // grabbing: where the grabbed points are in the object, however far they were dragged
+  if (!grabbed.empty()) {
+    Vec3 sum = Vec3::Zero();
+    for (index_t i : grabbed) sum += model.X.col(i);
+    return sum / static_cast<double>(grabbed.size());
+  }
+  // pushing: the probe carried back by the mean displacement of the touched points, so that pressing in
+  // does not move the contact point (the touched material stays where it is in the object). The mean of
+  // many points moves smoothly as the probe slides, unlike the nearest point
+  if (!touched.empty()) {
+    Vec3 sum = Vec3::Zero();
+    for (index_t i : touched) sum += active_->state().u.col(i);
+    return probe - sum / static_cast<double>(touched.size());
+  }
+  return probe;
+}
+
+void LevelsOfDetail::follow_probe() {
+  const std::optional<ProbeAttachment>& attached = active_->probe();
+  if (!attached || active_->diagnostics().steps == 0) return;
+  const ProbeTool& p = attached->tool;
+  const bool onset = p.contacts_before_step() == 0 && p.contact_model().contacts > 0;
+  update(contact_of_probe(p.probe(), p.contact().grabbed(), p.contact().touched()), onset, attached->asynchronous_lod);
+}
+
+std::vector<index_t> LevelsOfDetail::update(const Vec3& contact, bool onset, bool asynchronous) {
+  if (pending_.valid()) {
+    // a re-selection in flight: take it over once it is built (waiting for it unless asynchronous)
+    if (asynchronous && pending_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return {};
+    return take_over(pending_.get(), false);
+  }
+  if (!contact.allFinite()) return {};
+  // the distance is the contact point's own, not its snapped point's: a probe that trembles between two
+  // points of the lattice must not re-select at every step
+  const double moved = (contact - contact_).norm();
+  if (onset ? moved < 0.25 * params_.reselect * full_.h : moved <= params_.reselect * full_.h) return {};
+  if (!onset && active_->state().time - last_selection_time_ < params_.reselect_interval) return {};
+  contact_ = contact;
+  if (!asynchronous) return take_over(build_lod(full_, params_, snap(contact), solver_.kind), true);
+  // the worker only reads the object's model, which nothing writes while levels of detail are on
+  pending_ = std::async(std::launch::async, build_lod, std::cref(full_), params_, snap(contact), solver_.kind);
+  return {};
+}
+
+std::vector<index_t> LevelsOfDetail::take_over(LodBuild build, bool built_here) {
+  const auto start = std::chrono::steady_clock::now();
+  const bool first = selections_ == 0;  // the constructor's, before any step: set-up, not a stall
+  ActiveSet& next = build.active;
+  std::vector<index_t> new_index(static_cast<std::size_t>(active_->model().n_points), -1);
+  double energy_before = 0;
+  State carried = full_state_;
+  if (!first) {
+    for (index_t k = 0; k < active_set_.n_selected; ++k) {
+      const index_t now = next.active_of[active_set_.full_of[k]];
+      new_index[k] = now < next.n_selected ? now : -1;
+    }
+    const ModelSimulation& old = *active_;
+    energy_before = strain_energy(old.model(), old.state().u).total() + kinetic_energy(old.model(), old.state().velocity);
+    carried = object_state();  // the active state so far, back on the object
+  }
+  const double time = carried.time;
+  State state = next.restrict_state(carried);
+  state.time = time;
+  if (!first) remove_added_energy(next.model, energy_before, state);
+  if (!first) {
+    // a new simulation of the new active model; what the pipeline carries (diagnostics, inputs, the probe,
+    // renumbered: grabbed points follow their new numbers) moves over
+    auto sim = std::make_unique<ModelSimulation>(next.model, solver_, n_threads_, build.stable_dt);
+    sim->diagnostics_ = std::move(active_->diagnostics_);
+    sim->inputs_ = active_->inputs_;
+    sim->probe_ = std::move(active_->probe_);
+    active_ = std::move(sim);
+  }
+  if (active_->probe_) active_->probe_->tool.remap(active_->model(), new_index);
+  active_->set_state(state);
+  active_set_ = std::move(next);
+  selection_ = std::move(build.selection);
+  centre_ = build.centre;
+  object_state_current_ = false;
+  if (!first) last_selection_time_ = time;
+  ++selections_;
+  const double stall = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  last_build_ms_ = build.ms - selection_.milliseconds;
+  // the time the simulation's thread was held: the swap, and the build too when it was made there
+  if (!first) max_reselect_ms_ = std::max(max_reselect_ms_, stall + (built_here ? build.ms : 0.0));
+  return first ? std::vector<index_t>{} : new_index;
+}
+
+void LevelsOfDetail::fill(LodSummary& o) const {
+  o.enabled = true;
+  o.selected = active_set_.n_selected;
+  o.frozen = active_set_.model.n_points - active_set_.n_selected;
+  o.widened = active_set_.widened;
+  o.band_count = selection_.band_count;
+  o.band_selected = selection_.band_selected;
+  o.active.assign(static_cast<std::size_t>(full_.n_points), 0);
+  for (index_t k = 0; k < active_set_.n_selected; ++k) o.active[active_set_.full_of[k]] = 1;
+  o.selections = selections_;
+  o.selection_ms = selection_.milliseconds;
+  o.build_ms = last_build_ms_;
+  o.max_reselect_ms = max_reselect_ms_;
+}
+
+}  // namespace pointhaptics

@@ -1,0 +1,75 @@
+#include <pointhaptics/model_simulation.hpp>
+
+#include <pointhaptics/core/error.hpp>
+#include <pointhaptics/solvers/explicit_solver.hpp>
+
+#include <fmt/format.h>
+
+#include <chrono>
+
+namespace pointhaptics {
+
+ModelSimulation::ModelSimulation(Model model, const SolverSpec& solver, int n_threads, double stable_dt)
+    : model_(std::move(model)), solver_(solver), state_(State::at_rest(model_)), ws_(model_, n_threads), n_threads_(n_threads) {
+  stable_dt_ = stable_dt > 0 ? stable_dt : stable_time_step(model_);  // reported for every kind; explicit steps below it
+  solver_impl_ = make_solver(model_, solver_, stable_dt_);
+  hold_points(model_, 0.0, state_.u);  // held points start at their prescribed displacement at t = 0
+}
+
+void ModelSimulation::set_state(const State& state) {
+  if (state.u.cols() != model_.n_points || state.velocity.cols() != model_.n_points)
+    throw Error("simulation: the state is for another model");
+  state_.u = state.u;  // copied into the state's buffers: views of them stay valid
+  state_.velocity = state.velocity;
+  state_.time = state.time;
+}
+
+// ---- the step pipeline below the active set: each stage is one function, in the order step() calls them ----
+
+const StepReport& ModelSimulation::step() {
+  if (diagnostics_.failed)
+    throw Error(fmt::format("simulation: no step after a failed one (t = {:.6g} s: {})", state_.time, diagnostics_.failure));
+  using clock = std::chrono::steady_clock;
+  const auto start = clock::now();
+  // the tools take their place for this step, from the inputs
+  place_tools();
+  const auto placed = clock::now();
+  // the solver: internal, external and tool forces, time integration or equilibrium, held points
+  report_ = solver_impl_->step(model_, state_, ws_, probe_ ? &probe_->tool : nullptr);
+  const auto solved = clock::now();
+  // a state that is not finite is not a result, whatever the solver said
+  check_finite(report_);
+  const auto seconds = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
+  diagnostics_.tools_seconds += seconds(start, placed);
+  diagnostics_.solve_seconds += seconds(placed, solved);
+  record(report_, seconds(start, clock::now()));
+  return report_;
+}
+
+void ModelSimulation::place_tools() {
+  if (probe_) probe_->tool.place(model_, state_, inputs_.device, inputs_.button);
+}
+
+void ModelSimulation::check_finite(StepReport& report) const {
+  if (report.status == StepStatus::FAILED || state_.u.allFinite()) return;
+  report.status = StepStatus::FAILED;
+  report.failure = fmt::format("the state is not finite at t = {:.6g} s", state_.time);
+}
+
+void ModelSimulation::record(const StepReport& report, double seconds) {
+  StepDiagnostics& d = diagnostics_;
+  ++d.steps;
+  d.substeps += report.substeps;
+  d.iterations += report.iterations;
+  d.cg_iterations += report.cg_iterations;
+  if (solver_.kind != SolverKind::EXPLICIT) d.residual = report.residual;
+  if (report.status == StepStatus::AT_BUDGET) ++d.budget_steps;
+  d.status = report.status;
+  if (report.status == StepStatus::FAILED) {
+    d.failed = true;
+    d.failure = report.failure;
+  }
+  d.step_seconds += seconds;
+}
+
+}  // namespace pointhaptics

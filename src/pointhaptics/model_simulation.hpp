@@ -1,0 +1,91 @@
+#pragma once
+/// @file An ordinary simulation of one model: its State, the solver's Workspace and the Solver, the tools
+/// that act on it, and the step pipeline. It knows nothing of levels of detail: the layer above
+/// (levels_of_detail.hpp) drives one of these over the active model. Most users want Simulation.
+#include <pointhaptics/core/state.hpp>
+#include <pointhaptics/core/workspace.hpp>
+#include <pointhaptics/haptics/probe_tool.hpp>
+#include <pointhaptics/solvers/solver.hpp>
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace pointhaptics {
+
+/// What a step takes from outside the object. The caller fills it between steps (MuJoCo's step1/step2:
+/// read the last step's outputs, set the inputs, step); the step reads it in its first stage.
+struct StepInputs {
+  Vec3 device = Vec3::Constant(NAN);  ///< the probe's device point in the scene, m (NaN: the probe is lifted off)
+  bool button = false;                ///< the device's button (grab)
+};
+
+/// Counters and timers of the steps so far: the simulation's diagnostics, read by summary().
+struct StepDiagnostics {
+  long long steps = 0;          ///< steps taken (a static solve is one)
+  long long substeps = 0;       ///< explicit sub-steps, static load increments
+  long long iterations = 0;     ///< Newton iterations (explicit: sub-steps)
+  long long cg_iterations = 0;
+  long long budget_steps = 0;   ///< implicit steps the iteration budget ended above the tolerance
+  double residual = 0;          ///< the last Newton residual
+  StepStatus status = StepStatus::CONVERGED;  ///< of the last step
+  bool failed = false;          ///< a step failed: the state is not a result, and no step follows
+  std::string failure;          ///< why
+  double step_seconds = 0;      ///< wall time in steps, s, and in its stages:
+  double active_set_seconds = 0, tools_seconds = 0, solve_seconds = 0;
+};
+
+/// The probe's tool and its settings, as a simulation holds them (carried to the next active model).
+struct ProbeAttachment {
+  ProbeTool tool;
+  bool asynchronous_lod = false;  ///< levels of detail re-selected on a worker thread (real time)
+};
+
+class ModelSimulation {
+ public:
+  /// Take the model (never written again) and prepare the solver; n_threads = 0: all hardware threads.
+  /// stable_dt: the model's explicit stable step if already known (0: compute it). Held points start at
+  /// their prescribed displacement unless a state is given.
+  ModelSimulation(Model model, const SolverSpec& solver, int n_threads, double stable_dt = 0);
+
+  /// The pipeline's stages from the tools on: tools placed (inputs) -> solver (forces, integration, held
+  /// points) -> finite check -> diagnostics. Never throws for a step that fails numerically (the report
+  /// says so); throws Error for a step after a failed one.
+  const StepReport& step();
+
+  const Model& model() const { return model_; }
+  const State& state() const { return state_; }
+  /// Replace the state (same model). Throws Error for a state of another size.
+  void set_state(const State& state);
+  StepInputs& inputs() { return inputs_; }
+  const SolverSpec& solver() const { return solver_; }
+  double stable_dt() const { return stable_dt_; }
+  int n_threads() const { return n_threads_; }
+  Workspace& workspace() { return ws_; }
+
+  StepDiagnostics& diagnostics() { return diagnostics_; }
+  const StepDiagnostics& diagnostics() const { return diagnostics_; }
+  std::optional<ProbeAttachment>& probe() { return probe_; }
+  const std::optional<ProbeAttachment>& probe() const { return probe_; }
+
+ private:
+  friend class LevelsOfDetail;  // takes the object's model, state, diagnostics and probe over
+  void place_tools();
+  void check_finite(StepReport& report) const;
+  void record(const StepReport& report, double seconds);
+
+  Model model_;
+  SolverSpec solver_;
+  State state_;
+  Workspace ws_;
+  int n_threads_ = 0;
+  double stable_dt_ = 0;
+  std::unique_ptr<Solver> solver_impl_;
+  StepInputs inputs_;
+  StepReport report_;
+  StepDiagnostics diagnostics_;
+  std::optional<ProbeAttachment> probe_;
+};
+
+}  // namespace pointhaptics
