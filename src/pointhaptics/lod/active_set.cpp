@@ -12,18 +12,20 @@
 
 namespace pointhaptics {
 
-ActiveSet build_active_set(const Model& full, const Selection& selection, const LodParams& params) {
-  const auto start = std::chrono::steady_clock::now();
-  if (selection.selected.empty()) throw Error("lod: the selection is empty");
-  if (static_cast<index_t>(selection.band.size()) != full.n_points) throw Error("lod: the selection is for another model");
-  ActiveSet a;
-  const index_t n_full = full.n_points;
-  a.active_of.assign(n_full, -1);
-  a.follows.assign(n_full, -1);
-  a.follow_offset = Points::Zero(3, n_full);
-  // the simulated points: the selected ones in the bands; held points selected beyond the bands are
-  // held anyway, so they join the frozen ring below where the active set reaches them, and are left out
-  // elsewhere (a clamped base far from the contact costs nothing)
+namespace {
+
+// The active points before the model is built: their cloud (volumes with the absorbed ones added), masses,
+// loads and supports, one column per active point (selected first, then the ring's candidates).
+struct ActiveCloud {
+  PointCloud cloud;
+  Eigen::VectorXd mass, support;
+  Points f_ext;
+};
+
+// Phase 1, the simulated points: the selected ones in the bands. Held points selected beyond the bands are
+// held anyway, so they join the frozen ring (phase 2) where the active set reaches them, and are left out
+// elsewhere (a clamped base far from the contact costs nothing).
+void take_selected(const Selection& selection, ActiveSet& a) {
   for (index_t i : selection.selected)
     if (selection.band[i] >= 0) {
       a.active_of[i] = static_cast<index_t>(a.full_of.size());
@@ -31,10 +33,15 @@ ActiveSet build_active_set(const Model& full, const Selection& selection, const 
     }
   a.n_selected = static_cast<index_t>(a.full_of.size());
   if (a.n_selected == 0) throw Error("lod: no point of the selection lies in its bands");
-  const double h = full.h, reach = params.max_widening * h;
-  const double candidate_radius = selection.outer_radius + reach;
+}
 
-  // the nearest selected point of every unselected one (a k-d tree over the selected)
+// Phase 2, every unselected point by its nearest selected one (a k-d tree over the selected): inside the
+// bands it is absorbed by it and follows it; beyond them, within the widest support, it is a candidate for
+// the frozen ring. Returns, per object point, the selected point that absorbs it (-1: none).
+std::vector<index_t> absorb_and_find_ring(const Model& full, const Selection& selection, const LodParams& params, ActiveSet& a) {
+  const index_t n_full = full.n_points;
+  const double reach = params.max_widening * full.h;
+  const double candidate_radius = selection.outer_radius + reach;
   Points selected_X(3, a.n_selected);
   for (index_t k = 0; k < a.n_selected; ++k) selected_X.col(k) = full.X.col(a.full_of[k]);
   const KdTree tree(selected_X);
@@ -51,81 +58,95 @@ ActiveSet build_active_set(const Model& full, const Selection& selection, const 
   });
   for (index_t j = 0; j < n_full; ++j) {
     const index_t nearest = nearest_of[j];
-    const double d2 = nearest_d2[j];
     if (nearest < 0) continue;
     if (selection.band[j] >= 0) {
-      absorbed_by[j] = nearest;  // inside the bands: absorbed by, and following, its nearest selected point
+      absorbed_by[j] = nearest;
       a.follows[j] = nearest;
       a.follow_offset.col(j) = full.X.col(j) - selected_X.col(nearest);
-    } else if (d2 < reach * reach) {
-      a.active_of[j] = static_cast<index_t>(a.full_of.size());  // the frozen ring
+    } else if (nearest_d2[j] < reach * reach) {
+      a.active_of[j] = static_cast<index_t>(a.full_of.size());  // a ring candidate
       a.full_of.push_back(j);
     }
   }
-  const index_t n = static_cast<index_t>(a.full_of.size());
+  return absorbed_by;
+}
 
-  // the active cloud: volumes (absorbed ones added), per-point supports
-  PointCloud cloud;
-  cloud.spacing = full.spacing;
-  cloud.X.resize(3, n);
-  cloud.volume.resize(n);
+// Phase 3, the active points' cloud: each keeps its own volume, mass and load and adds those of the points
+// it absorbs (the active set keeps the region's mass and load).
+ActiveCloud gather_cloud(const Model& full, const ActiveSet& a, const std::vector<index_t>& absorbed_by) {
+  const index_t n = static_cast<index_t>(a.full_of.size());
+  ActiveCloud c;
+  c.cloud.spacing = full.spacing;
+  c.cloud.X.resize(3, n);
+  c.cloud.volume.resize(n);
+  c.mass.resize(n);
+  c.f_ext.resize(3, n);
   for (index_t k = 0; k < n; ++k) {
-    cloud.X.col(k) = full.X.col(a.full_of[k]);
-    cloud.volume[k] = full.volume[a.full_of[k]];
+    c.cloud.X.col(k) = full.X.col(a.full_of[k]);
+    c.cloud.volume[k] = full.volume[a.full_of[k]];
+    c.mass[k] = full.mass[a.full_of[k]];
+    c.f_ext.col(k) = full.f_ext.col(a.full_of[k]);
   }
-  Eigen::VectorXd mass(n), absorbed_volume = Eigen::VectorXd::Zero(n);
-  for (index_t k = 0; k < n; ++k) mass[k] = full.mass[a.full_of[k]];
-  Points f_ext(3, n);
-  for (index_t k = 0; k < n; ++k) f_ext.col(k) = full.f_ext.col(a.full_of[k]);
-  for (index_t j = 0; j < n_full; ++j)
+  for (index_t j = 0; j < full.n_points; ++j)
     if (absorbed_by[j] >= 0) {
-      cloud.volume[absorbed_by[j]] += full.volume[j];
-      mass[absorbed_by[j]] += full.mass[j];
-      f_ext.col(absorbed_by[j]) += full.f_ext.col(j);
+      c.cloud.volume[absorbed_by[j]] += full.volume[j];
+      c.mass[absorbed_by[j]] += full.mass[j];
+      c.f_ext.col(absorbed_by[j]) += full.f_ext.col(j);
     }
-  // widen sparse supports: the smallest h_i in steps of h/4 that reaches min_neighbours active points
-  Eigen::VectorXd support = Eigen::VectorXd::Constant(n, h);
+  c.support = Eigen::VectorXd::Constant(n, full.h);
+  return c;
+}
+
+// Phase 4, sparse supports widened: the smallest h_i in steps of h/4 that reaches min_neighbours active
+// points (never more than the point had in the object; at most max_widening h). Returns per active point
+// whether the ring is needed there: 1 for ring points a selected point's support reaches, 2 for their own
+// neighbours (passive: neighbours only, so that the ring points next to the active set have the whole
+// neighbourhood, M_i and d_ij, they have in the object), 0 for candidates not needed.
+std::vector<char> widen_supports(const Model& full, const LodParams& params, ActiveSet& a, ActiveCloud& c) {
+  const index_t n = static_cast<index_t>(a.full_of.size());
+  const double h = full.h, reach = params.max_widening * h;
   std::vector<char> ring_needed(n, 0);
-  {
-    const KdTree active_tree(cloud.X);
-    std::vector<std::pair<index_t, double>> found;
-    nanoflann::SearchParams search;
-    search.sorted = false;
-    std::vector<index_t> knn_index(static_cast<std::size_t>(params.min_neighbours) + 1);
-    std::vector<double> knn_d2(knn_index.size());
-    for (index_t k = 0; k < a.n_selected; ++k) {
-      // the distance to the needed-th nearest active point (the point itself comes first); a point never
-      // needs more neighbours than it had in the full model (surface points have fewer)
-      const std::size_t needed =
-          static_cast<std::size_t>(std::min<index_t>(params.min_neighbours, full.neighbours.row_size(a.full_of[k]))) + 1;
-      const std::size_t got = active_tree.index().knnSearch(cloud.X.col(k).data(), needed, knn_index.data(), knn_d2.data());
-      if (got < needed || knn_d2[needed - 1] >= reach * reach) {
-        support[k] = reach;
-      } else {
-        const double r = std::sqrt(knn_d2[needed - 1]);
-        double hk = h;
-        while (hk <= r * (1 + 1e-9) && hk < reach) hk = std::min(reach, hk + 0.25 * h);
-        support[k] = hk;
-      }
-      a.widened += support[k] > h * (1 + 1e-12);
-      // the frozen points this one reaches are the ring that holds the active set
-      found.clear();
-      active_tree.index().radiusSearch(cloud.X.col(k).data(), support[k] * support[k], found, search);
-      for (const auto& [j, d2] : found)
-        if (j >= a.n_selected) ring_needed[j] = 1;
+  const KdTree active_tree(c.cloud.X);
+  std::vector<std::pair<index_t, double>> found;
+  nanoflann::SearchParams search;
+  search.sorted = false;
+  std::vector<index_t> knn_index(static_cast<std::size_t>(params.min_neighbours) + 1);
+  std::vector<double> knn_d2(knn_index.size());
+  for (index_t k = 0; k < a.n_selected; ++k) {
+    // the distance to the needed-th nearest active point (the point itself comes first); a point never
+    // needs more neighbours than it had in the full model (surface points have fewer)
+    const std::size_t needed =
+        static_cast<std::size_t>(std::min<index_t>(params.min_neighbours, full.neighbours.row_size(a.full_of[k]))) + 1;
+    const std::size_t got = active_tree.index().knnSearch(c.cloud.X.col(k).data(), needed, knn_index.data(), knn_d2.data());
+    if (got < needed || knn_d2[needed - 1] >= reach * reach) {
+      c.support[k] = reach;
+    } else {
+      const double r = std::sqrt(knn_d2[needed - 1]);
+      double hk = h;
+      while (hk <= r * (1 + 1e-9) && hk < reach) hk = std::min(reach, hk + 0.25 * h);
+      c.support[k] = hk;
     }
-    // ... and their own neighbours, so that the ring points next to the active set have the whole
-    // neighbourhood (M_i, d_ij) they have in the object; these outer ones are passive (no stencil)
-    const std::vector<char> touching = ring_needed;
-    for (index_t k = a.n_selected; k < n; ++k) {
-      if (!touching[k]) continue;
-      found.clear();
-      active_tree.index().radiusSearch(cloud.X.col(k).data(), h * h, found, search);
-      for (const auto& [j, d2] : found)
-        if (j >= a.n_selected && !ring_needed[j]) ring_needed[j] = 2;
-    }
+    a.widened += c.support[k] > h * (1 + 1e-12);
+    found.clear();
+    active_tree.index().radiusSearch(c.cloud.X.col(k).data(), c.support[k] * c.support[k], found, search);
+    for (const auto& [j, d2] : found)
+      if (j >= a.n_selected) ring_needed[j] = 1;
   }
-  // keep the ring the active set reaches (1), then the passive outer ring (2); drop the other candidates
+  const std::vector<char> touching = ring_needed;
+  for (index_t k = a.n_selected; k < n; ++k) {
+    if (!touching[k]) continue;
+    found.clear();
+    active_tree.index().radiusSearch(c.cloud.X.col(k).data(), h * h, found, search);
+    for (const auto& [j, d2] : found)
+      if (j >= a.n_selected && !ring_needed[j]) ring_needed[j] = 2;
+  }
+  return ring_needed;
+}
+
+// Phase 5, the ring kept: the points the active set reaches (1), then the passive outer ring (2), in that
+// order after the selected points; the other candidates dropped. Returns the number of passive points.
+index_t keep_needed_ring(const std::vector<char>& ring_needed, ActiveSet& a, ActiveCloud& c) {
+  const index_t n = static_cast<index_t>(a.full_of.size());
   std::vector<index_t> order;
   for (char pass : {1, 2})
     for (index_t k = a.n_selected; k < n; ++k)
@@ -133,37 +154,40 @@ ActiveSet build_active_set(const Model& full, const Selection& selection, const 
   for (index_t k = a.n_selected; k < n; ++k)
     if (!ring_needed[k]) a.active_of[a.full_of[k]] = -1;
   const std::vector<index_t> old_full_of = a.full_of;
-  const PointCloud old_cloud = cloud;
-  const Eigen::VectorXd old_mass = mass, old_support = support;
-  const Points old_f_ext = f_ext;
+  const ActiveCloud old = c;
   const index_t kept = a.n_selected + static_cast<index_t>(order.size());
   a.full_of.resize(kept);
-  cloud.X.conservativeResize(3, kept);
-  cloud.volume.conservativeResize(kept);
-  mass.conservativeResize(kept);
-  f_ext.conservativeResize(3, kept);
-  support.conservativeResize(kept);
+  c.cloud.X.conservativeResize(3, kept);
+  c.cloud.volume.conservativeResize(kept);
+  c.mass.conservativeResize(kept);
+  c.f_ext.conservativeResize(3, kept);
+  c.support.conservativeResize(kept);
   index_t n_passive = 0;
   for (std::size_t r = 0; r < order.size(); ++r) {
     const index_t from = order[r], to = a.n_selected + static_cast<index_t>(r);
     a.full_of[to] = old_full_of[from];
     a.active_of[old_full_of[from]] = to;
-    cloud.X.col(to) = old_cloud.X.col(from);
-    cloud.volume[to] = old_cloud.volume[from];
-    mass[to] = old_mass[from];
-    f_ext.col(to) = old_f_ext.col(from);
-    support[to] = old_support[from];
+    c.cloud.X.col(to) = old.cloud.X.col(from);
+    c.cloud.volume[to] = old.cloud.volume[from];
+    c.mass[to] = old.mass[from];
+    c.f_ext.col(to) = old.f_ext.col(from);
+    c.support[to] = old.support[from];
     n_passive += ring_needed[from] == 2;
   }
-  cloud.support = support;
-  MaterialParams material = full.material;
+  return n_passive;
+}
+
+// Phase 6, the active model: built from the cloud like any model, with the region's masses and loads, the
+// ring held where it is, and the object's held groups restricted to the active points.
+void build_model_of(const Model& full, ActiveCloud& c, index_t n_passive, ActiveSet& a) {
+  c.cloud.support = c.support;
   KernelParams kernel = full.kernel;
-  kernel.support = h;
-  a.model = build_model(cloud, material, kernel);
-  a.model.mass = mass;  // kernel-volume mode included: the region's mass is what it was
-  a.model.f_ext = f_ext;
+  kernel.support = full.h;
+  a.model = build_model(c.cloud, full.material, kernel);
+  a.model.mass = c.mass;  // kernel-volume mode included: the region's mass is what it was
+  a.model.f_ext = c.f_ext;
   a.model.n_passive = n_passive;
-  // held points: the full model's groups (restricted), and the frozen ring held where it is
+  const index_t kept = static_cast<index_t>(a.full_of.size());
   for (index_t k = 0; k < kept; ++k)
     if (k >= a.n_selected || full.fixed[a.full_of[k]]) a.model.fixed[k] = 1;
   for (const FixedGroup& g : full.fixed_groups) {
@@ -173,6 +197,24 @@ ActiveSet build_active_set(const Model& full, const Selection& selection, const 
       if (a.active_of[i] >= 0) sub.points.push_back(a.active_of[i]);
     if (!sub.points.empty()) a.model.fixed_groups.push_back(sub);
   }
+}
+
+}  // namespace
+
+ActiveSet build_active_set(const Model& full, const Selection& selection, const LodParams& params) {
+  const auto start = std::chrono::steady_clock::now();
+  if (selection.selected.empty()) throw Error("lod: the selection is empty");
+  if (static_cast<index_t>(selection.band.size()) != full.n_points) throw Error("lod: the selection is for another model");
+  ActiveSet a;
+  a.active_of.assign(full.n_points, -1);
+  a.follows.assign(full.n_points, -1);
+  a.follow_offset = Points::Zero(3, full.n_points);
+  take_selected(selection, a);
+  const std::vector<index_t> absorbed_by = absorb_and_find_ring(full, selection, params, a);
+  ActiveCloud cloud = gather_cloud(full, a, absorbed_by);
+  const std::vector<char> ring_needed = widen_supports(full, params, a, cloud);
+  const index_t n_passive = keep_needed_ring(ring_needed, a, cloud);
+  build_model_of(full, cloud, n_passive, a);
   a.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return a;
 }
