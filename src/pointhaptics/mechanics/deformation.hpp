@@ -23,7 +23,7 @@ inline Mat3 displacement_gradient(const Model& model, const Points& u, index_t i
 /// Green strain E = 0.5 (F^T F - I) = 0.5 (G + G^T + G^T G) from the displacement gradient G (seed Eq. 2).
 /// Written in G: forming F^T F - I cancels catastrophically at small strain (at |G| ~ 1e-9 only 7 digits
 /// survive, which puts a floor under Newton's residual).
-inline Mat3 green_strain(const Mat3& G) { return 0.5 * (G + G.transpose() + G.transpose() * G); }
+PH_ALWAYS_INLINE inline Mat3 green_strain(const Mat3& G) { return 0.5 * (G + G.transpose() + G.transpose() * G); }
 
 /// Cofactor matrix cof F = det(F) F^-T; its rows are (r1 x r2, r2 x r0, r0 x r1) for rows r_a of F.
 inline Mat3 cofactor(const Mat3& F) {

@@ -1,7 +1,7 @@
 #pragma once
 /// @file The registry of materials, and a point's elastic energy: its material plus the volume term.
-/// Adding a material is one file beside svk.hpp (energy_density, stress, Linearisation, linearise,
-/// stress_derivative, stiffness_block, stiffening), a value of MaterialModel with its name
+/// Adding a material is one file beside svk.hpp (energy_density, scaled_stress and stress, Linearisation
+/// with F, linearise, stress_derivative, stiffness_block, stiffening), a value of MaterialModel with its name
 /// (core/parameters.hpp), and a case in with_material() below; the force loop, the energy, the tangent, the
 /// stable step and the point fields then use it, each compiled for it.
 #include <pointhaptics/mechanics/energies/svk.hpp>
@@ -18,12 +18,13 @@ struct PointEnergy {
   double energy_density(const Mat3& G) const {
     return material.energy_density(G) + (volume.active() ? volume.energy_density(G) : 0.0);
   }
-  /// First Piola-Kirchhoff stress P = dW/dF, Pa.
-  PH_ALWAYS_INLINE Mat3 stress(const Mat3& G) const {
-    Mat3 P = material.stress(G);
-    if (volume.active()) P += volume.stress(G);
+  /// First Piola-Kirchhoff stress P = dW/dF, Pa, times `scale` (the force loop's v_i).
+  PH_ALWAYS_INLINE Mat3 scaled_stress(const Mat3& G, double scale) const {
+    Mat3 P = material.scaled_stress(G, scale);
+    if (volume.active()) P += scale * volume.stress(G);
     return P;
   }
+  PH_ALWAYS_INLINE Mat3 stress(const Mat3& G) const { return scaled_stress(G, 1.0); }
   using Linearisation = typename Material::Linearisation;
   /// `projected`: the positive semi-definite part (the material's projection, the volume's Gauss-Newton part).
   Linearisation linearise(const Mat3& G, bool projected) const { return material.linearise(G, projected); }
