@@ -13,7 +13,7 @@ struct Workspace::ThreadPool {
   tbb::task_arena arena;
 };
 
-Workspace::Workspace(const Model& model, int n_threads) {
+Workspace::Workspace(const Model& model, int n_threads) : n_points_(model.n_points) {
   if (n_threads <= 0) n_threads = std::max(1u, std::thread::hardware_concurrency());
   // a chunk per thread, but never a chunk without points
   n_threads_ = std::max(1, std::min<int>(n_threads, std::max<index_t>(1, model.n_points)));
@@ -46,6 +46,19 @@ Workspace::Workspace(const Model& model, int n_threads) {
 }
 
 Workspace::~Workspace() = default;
+SolverScratch& Workspace::solver_scratch() {
+  if (!solver_sized_) {
+    SolverScratch& s = solver_;
+    for (Points* p : {&s.r, &s.dx, &s.trial, &s.cg_r, &s.cg_z, &s.cg_p, &s.cg_q, &s.anchor, &s.next, &s.load, &s.start, &s.tool_forces})
+      p->setZero(3, n_points_);
+    s.blocks.setZero(9, n_points_);
+    s.springs.setZero(9, n_points_);
+    s.gradients.resize(static_cast<std::size_t>(n_points_));
+    solver_sized_ = true;
+  }
+  return solver_;
+}
+
 Workspace::Workspace(Workspace&&) noexcept = default;
 Workspace& Workspace::operator=(Workspace&&) noexcept = default;
 

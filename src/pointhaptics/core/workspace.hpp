@@ -12,7 +12,19 @@ using PaddedPoints = Eigen::Matrix<double, 4, Eigen::Dynamic>;
 /// A 3x3 matrix per point as its three columns, each padded to 4 doubles  (12 x n)
 using PaddedGradients = Eigen::Matrix<double, 12, Eigen::Dynamic>;
 
-/// Scratch buffers and the thread pool of the force evaluation and the solvers.
+/// Scratch of Newton's method and of the implicit and static steps (3 x n each unless noted).
+struct SolverScratch {
+  Points r, dx, trial;                               ///< Newton: residual, step, line-search iterate
+  Points cg_r, cg_z, cg_p, cg_q;                     ///< its conjugate gradients
+  Eigen::Matrix<double, 9, Eigen::Dynamic> blocks;   ///< the inverted diagonal blocks of the preconditioner (9 x n)
+  std::vector<Mat3> gradients;                       ///< every G_i of an energy evaluation (n)
+  Points anchor, next, load, start, tool_forces;     ///< implicit: the inertia's anchor, the iterate, the load, u_n,
+                                                     ///< the tools' forces; static: the increment's load and iterate
+  Eigen::Matrix<double, 9, Eigen::Dynamic> springs;  ///< implicit: the tools' springs (9 x n)
+};
+
+/// Scratch buffers and the thread pool of the force evaluation and the solvers: the one owner of every
+/// buffer a step writes besides the state.
 /// Not shared between threads that step different simulations.
 class Workspace {
  public:
@@ -40,10 +52,16 @@ class Workspace {
   PaddedGradients gradients;              ///< G_i of the last stencil pass, by columns
   std::vector<PaddedPoints> chunk_forces; ///< per-chunk scatter targets, summed into the result  (n_threads)
   std::vector<double> chunk_scalars;      ///< one value per chunk for reductions without atomics  (n_threads)
+  /// The solvers' scratch, sized for the model on the first call (explicit dynamics never pays for it);
+  /// after that no call allocates.
+  SolverScratch& solver_scratch();
 
  private:
   void run_chunks(void (*call)(void*, int), void* context);
   int n_threads_ = 1;
+  index_t n_points_ = 0;
+  SolverScratch solver_;
+  bool solver_sized_ = false;
   std::vector<index_t> chunk_offset_;
   std::vector<index_t> scatter_range_;
   struct ThreadPool;                ///< a TBB arena of n_threads, kept out of this header

@@ -5,42 +5,38 @@
 namespace pointhaptics {
 
 ImplicitSolver::ImplicitSolver(const Model& model, double dt, const NewtonSettings& settings)
-    : dt_(dt),
-      settings_(settings),
-      newton_(model),
-      anchor_(Points::Zero(3, model.n_points)),
-      u_next_(Points::Zero(3, model.n_points)),
-      load_(Points::Zero(3, model.n_points)),
-      u_start_(Points::Zero(3, model.n_points)),
-      tool_forces_(Points::Zero(3, model.n_points)),
-      springs_(Eigen::Matrix<double, 9, Eigen::Dynamic>::Zero(9, model.n_points)) {}
+    : dt_(dt), settings_(settings), newton_(model) {}
 
 StepReport ImplicitSolver::step(const Model& model, State& state, Workspace& ws, DynamicForces* forces) {
   const double dt = dt_;
   const double c = model.material.damping;
   const double k = 1.0 / (dt * dt) + c / dt;
+  SolverScratch& scratch = ws.solver_scratch();
+  Points &anchor = scratch.anchor, &next = scratch.next, &load = scratch.load, &start = scratch.start,
+         &tool_forces = scratch.tool_forces;
+  Eigen::Matrix<double, 9, Eigen::Dynamic>& springs = scratch.springs;
   // the two quadratic terms combine into 0.5 k |u' - a|_M^2 with a = ((u + dt v)/dt^2 + c u/dt) / k
-  anchor_ = (state.u + dt * state.velocity) * (1.0 / (dt * dt * k)) + state.u * (c / (dt * k));
-  u_next_ = state.u + dt * state.velocity;  // warm start
+  anchor = (state.u + dt * state.velocity) * (1.0 / (dt * dt * k)) + state.u * (c / (dt * k));
+  next = state.u + dt * state.velocity;  // warm start
   const double t_next = state.time + dt;
-  hold_points(model, t_next, u_next_);
+  hold_points(model, t_next, next);
   NewtonProblem problem;
   problem.load = &model.f_ext;
   problem.inertia = k;
-  problem.anchor = &anchor_;
+  problem.anchor = &anchor;
   if (forces) {
-    tool_forces_.setZero();
-    forces->add(model, state, tool_forces_);
-    load_ = model.f_ext + tool_forces_;
-    problem.load = &load_;
-    springs_.setZero();
-    if (forces->add_stiffness(model, state, springs_)) {
-      u_start_ = state.u;
-      problem.springs = &springs_;
-      problem.spring_anchor = &u_start_;
+    tool_forces.setZero();
+    forces->add(model, state, tool_forces);
+    load = model.f_ext + tool_forces;
+    problem.load = &load;
+    springs.setZero();
+    if (forces->add_stiffness(model, state, springs)) {
+      start = state.u;
+      problem.springs = &springs;
+      problem.spring_anchor = &start;
     }
   }
-  const NewtonStats stats = newton_.solve(model, problem, u_next_, ws, settings_);
+  const NewtonStats stats = newton_.solve(model, problem, next, ws, settings_);
   StepReport report;
   report.iterations = stats.iterations;
   report.cg_iterations = stats.cg_iterations;
@@ -54,8 +50,8 @@ StepReport ImplicitSolver::step(const Model& model, State& state, Workspace& ws,
   }
   // a step the iteration budget ended keeps its iterate, as the scene asked (real time): counted, not a failure
   if (settings_.accept_at_budget && stats.residual > settings_.tolerance) report.status = StepStatus::AT_BUDGET;
-  state.velocity = (u_next_ - state.u) / dt;
-  state.u = u_next_;  // copied, not swapped: NumPy views point into the state's buffer
+  state.velocity = (next - state.u) / dt;
+  state.u = next;  // copied, not swapped: NumPy views point into the state's buffer
   state.time = t_next;
   return report;
 }

@@ -23,9 +23,7 @@ class ImplicitSolver final : public Solver {
  private:
   double dt_;
   NewtonSettings settings_;
-  NewtonSolver newton_;
-  Points anchor_, u_next_, load_, u_start_, tool_forces_;
-  Eigen::Matrix<double, 9, Eigen::Dynamic> springs_;
+  NewtonSolver newton_;  // its vectors and the step's are the workspace's (Workspace::solver_scratch())
 };
 
 }  // namespace pointhaptics

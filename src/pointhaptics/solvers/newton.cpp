@@ -13,22 +13,23 @@ namespace {
 
 double dot(const Points& a, const Points& b) { return (a.array() * b.array()).sum(); }
 
+// z = B r with B the preconditioner's inverted diagonal blocks
+void precondition(const Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks, const Points& r, Points& z) {
+  for (Eigen::Index i = 0; i < r.cols(); ++i) z.col(i) = Eigen::Map<const Mat3>(blocks.col(i).data()) * r.col(i);
+}
+
 }  // namespace
 
-NewtonSolver::NewtonSolver(const Model& model) {
-  const index_t n = model.n_points;
-  for (Points* p : {&r_, &dx_, &trial_, &cg_r_, &cg_z_, &cg_p_, &cg_q_}) p->setZero(3, n);
-  blocks_.setZero(9, n);
-  energy_gradients_.resize(static_cast<std::size_t>(n));
-}
+NewtonSolver::NewtonSolver(const Model&) {}
 
 void NewtonSolver::mask_held(const Model& model, Points& x) const {
   for (index_t i = 0; i < model.n_points; ++i)
     if (model.fixed[i]) x.col(i).setZero();
 }
 
-double NewtonSolver::energy(const Model& model, const NewtonProblem& problem, const Points& u) const {
-  double pi = strain_energy(model, u, &energy_gradients_).total();
+double NewtonSolver::energy(const Model& model, const NewtonProblem& problem, const Points& u,
+                            std::vector<Mat3>& gradients) const {
+  double pi = strain_energy(model, u, &gradients).total();
   for (index_t i = 0; i < model.n_points; ++i) {
     if (model.fixed[i]) continue;
     pi -= problem.load->col(i).dot(u.col(i));
@@ -63,9 +64,10 @@ double NewtonSolver::residual(const Model& model, const NewtonProblem& problem, 
 
 void NewtonSolver::build_preconditioner(const Model& model, const NewtonProblem& problem, Workspace& ws) {
   const double inertia = problem.inertia;
-  tangent_.diagonal_blocks(model, blocks_, &ws);
+  Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks = ws.solver_scratch().blocks;
+  tangent_.diagonal_blocks(model, blocks, &ws);
   for (index_t i = 0; i < model.n_points; ++i) {
-    Eigen::Map<Mat3> B(blocks_.col(i).data());
+    Eigen::Map<Mat3> B(blocks.col(i).data());
     if (model.fixed[i]) {
       B.setZero();
       continue;
@@ -84,36 +86,34 @@ void NewtonSolver::build_preconditioner(const Model& model, const NewtonProblem&
   }
 }
 
-void NewtonSolver::precondition(const Points& r, Points& z) const {
-  for (Eigen::Index i = 0; i < r.cols(); ++i) z.col(i) = Eigen::Map<const Mat3>(blocks_.col(i).data()) * r.col(i);
-}
-
 bool NewtonSolver::conjugate_gradients(const Model& model, const NewtonProblem& problem, const Points& r, double eta,
                                        int max_iterations, Workspace& ws, Points& x, long long& iterations) {
   const double inertia = problem.inertia;
+  SolverScratch& s = ws.solver_scratch();
+  Points &cg_r = s.cg_r, &cg_z = s.cg_z, &cg_p = s.cg_p, &cg_q = s.cg_q;
   x.setZero();
-  cg_r_ = r;
-  precondition(cg_r_, cg_z_);
-  cg_p_ = cg_z_;
-  double rz = dot(cg_r_, cg_z_);
+  cg_r = r;
+  precondition(s.blocks, cg_r, cg_z);
+  cg_p = cg_z;
+  double rz = dot(cg_r, cg_z);
   const double target = eta * r.norm();
   for (int k = 0; k < max_iterations; ++k) {
-    tangent_.apply(model, cg_p_, ws, cg_q_);
-    if (inertia > 0) cg_q_ += inertia * (cg_p_.array().rowwise() * model.mass.transpose().array()).matrix();
+    tangent_.apply(model, cg_p, ws, cg_q);
+    if (inertia > 0) cg_q += inertia * (cg_p.array().rowwise() * model.mass.transpose().array()).matrix();
     if (problem.springs)
       for (index_t i = 0; i < model.n_points; ++i)
-        cg_q_.col(i) += Eigen::Map<const Mat3>(problem.springs->col(i).data()) * cg_p_.col(i);
-    mask_held(model, cg_q_);
-    const double curvature = dot(cg_p_, cg_q_);
+        cg_q.col(i) += Eigen::Map<const Mat3>(problem.springs->col(i).data()) * cg_p.col(i);
+    mask_held(model, cg_q);
+    const double curvature = dot(cg_p, cg_q);
     ++iterations;
     if (!(curvature > 0)) return false;  // negative curvature: the caller switches to the projected tangent
     const double alpha = rz / curvature;
-    x += alpha * cg_p_;
-    cg_r_ -= alpha * cg_q_;
-    if (cg_r_.norm() <= target) break;
-    precondition(cg_r_, cg_z_);
-    const double rz_next = dot(cg_r_, cg_z_);
-    cg_p_ = cg_z_ + (rz_next / rz) * cg_p_;
+    x += alpha * cg_p;
+    cg_r -= alpha * cg_q;
+    if (cg_r.norm() <= target) break;
+    precondition(s.blocks, cg_r, cg_z);
+    const double rz_next = dot(cg_r, cg_z);
+    cg_p = cg_z + (rz_next / rz) * cg_p;
     rz = rz_next;
   }
   return true;
@@ -122,11 +122,13 @@ bool NewtonSolver::conjugate_gradients(const Model& model, const NewtonProblem& 
 NewtonStats NewtonSolver::solve(const Model& model, const NewtonProblem& problem, Points& u, Workspace& ws,
                                 const NewtonSettings& settings) {
   NewtonStats stats;
-  double rel = residual(model, problem, u, ws, r_);
+  SolverScratch& s = ws.solver_scratch();
+  Points &r = s.r, &dx = s.dx, &trial = s.trial;
+  double rel = residual(model, problem, u, ws, r);
   // Pi at the current iterate, evaluated only when a line search needs it (NaN: not yet)
   double pi = NAN;
   auto current_pi = [&] {
-    if (std::isnan(pi)) pi = energy(model, problem, u);
+    if (std::isnan(pi)) pi = energy(model, problem, u, s.gradients);
     return pi;
   };
   for (;;) {
@@ -156,37 +158,37 @@ NewtonStats NewtonSolver::solve(const Model& model, const NewtonProblem& problem
       if (stats.iterations == 1 || mode != preconditioner_mode_) build_preconditioner(model, problem, ws);
       preconditioner_mode_ = mode;
       const bool positive =
-          conjugate_gradients(model, problem, r_, eta, settings.max_cg_iterations, ws, dx_, stats.cg_iterations);
-      if (positive && dot(dx_, r_) > 0) {
+          conjugate_gradients(model, problem, r, eta, settings.max_cg_iterations, ws, dx, stats.cg_iterations);
+      if (positive && dot(dx, r) > 0) {
         descent = true;
         break;
       }
       ++stats.projected;
     }
     if (!descent) {
-      precondition(r_, dx_);  // preconditioned steepest descent, a descent direction for SPD blocks
-      if (!(dot(dx_, r_) > 0)) dx_ = r_;
+      precondition(s.blocks, r, dx);  // preconditioned steepest descent, a descent direction for SPD blocks
+      if (!(dot(dx, r) > 0)) dx = r;
     }
     // backtracking line search: a step is taken when it lowers Pi (Armijo) or the residual. Near
     // convergence Pi's change is below its round-off (~1e-11 relative here, sums of cancelling
     // terms) while the residual still falls quadratically, so both are needed.
-    const double slope = dot(dx_, r_);  // -dPi/dalpha at alpha = 0
+    const double slope = dot(dx, r);  // -dPi/dalpha at alpha = 0
     double alpha = 1.0;
     bool accepted = false;
     for (int k = 0; k < 30 && !accepted; ++k, alpha *= 0.5) {
-      trial_ = u + alpha * dx_;
-      Points& r_trial = cg_r_;  // scratch: CG is done for this iteration
-      const double rel_trial = residual(model, problem, trial_, ws, r_trial);
+      trial = u + alpha * dx;
+      Points& r_trial = s.cg_r;  // scratch: CG is done for this iteration
+      const double rel_trial = residual(model, problem, trial, ws, r_trial);
       if (!std::isfinite(rel_trial)) continue;
       // the residual test first: it costs nothing more, and Pi is only needed when it fails
       const bool lowers_residual = rel_trial <= (1.0 - 1e-4 * alpha) * rel;
-      const double pi_trial = lowers_residual ? NAN : energy(model, problem, trial_);
+      const double pi_trial = lowers_residual ? NAN : energy(model, problem, trial, s.gradients);
       const double pi_now = lowers_residual ? NAN : current_pi();
       const bool armijo = !lowers_residual && std::isfinite(pi_trial) && pi_trial <= pi_now - 1e-4 * alpha * slope &&
                           std::abs(pi_trial - pi_now) > 1e-9 * std::max(std::abs(pi_now), 1e-300);
       if (armijo || lowers_residual) {
-        u = trial_;  // copied, not swapped: u is often the state, whose buffer NumPy views point into
-        r_.swap(r_trial);
+        u = trial;  // copied, not swapped: u is often the state, whose buffer NumPy views point into
+        r.swap(r_trial);
         rel = rel_trial;
         pi = pi_trial;  // NaN when not computed: current_pi() evaluates it if it is ever needed
         accepted = true;

@@ -40,7 +40,7 @@ struct NewtonStats {
   const char* failure = "";      ///< why it stopped without converging
 };
 
-/// Owns the solver's buffers (sized once per model) and the tangent.
+/// Newton's method with its tangent; its vectors are the workspace's (Workspace::solver_scratch()).
 class NewtonSolver {
  public:
   explicit NewtonSolver(const Model& model);
@@ -50,7 +50,7 @@ class NewtonSolver {
                     const NewtonSettings& settings);
 
  private:
-  double energy(const Model& model, const NewtonProblem& problem, const Points& u) const;
+  double energy(const Model& model, const NewtonProblem& problem, const Points& u, std::vector<Mat3>& gradients) const;
   /// r = -grad Pi at u, zero at held points; returns the relative residual
   double residual(const Model& model, const NewtonProblem& problem, const Points& u, Workspace& ws, Points& r) const;
   void build_preconditioner(const Model& model, const NewtonProblem& problem, Workspace& ws);
@@ -58,14 +58,10 @@ class NewtonSolver {
   /// a direction of non-positive curvature (an indefinite tangent).
   bool conjugate_gradients(const Model& model, const NewtonProblem& problem, const Points& r, double eta,
                            int max_iterations, Workspace& ws, Points& x, long long& iterations);
-  void precondition(const Points& r, Points& z) const;
   void mask_held(const Model& model, Points& x) const;
 
   Tangent tangent_;
   TangentMode preconditioner_mode_ = TangentMode::EXACT;
-  Eigen::Matrix<double, 9, Eigen::Dynamic> blocks_;  ///< inverted diagonal blocks of K + k M
-  Points r_, dx_, trial_, cg_r_, cg_z_, cg_p_, cg_q_;
-  mutable std::vector<Mat3> energy_gradients_;  ///< scratch of energy(): every G_i  (n)
 };
 
 }  // namespace pointhaptics

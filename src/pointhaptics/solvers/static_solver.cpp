@@ -52,15 +52,14 @@ StaticStats load_stepping(const Model& model, State& state, Workspace& ws, Newto
 
 StaticStats solve_static(const Model& model, State& state, Workspace& ws, NewtonSolver& newton,
                          const NewtonSettings& settings) {
-  Points load(3, model.n_points), trial(3, model.n_points);
-  return load_stepping(model, state, ws, newton, settings, load, trial);
+  SolverScratch& scratch = ws.solver_scratch();
+  return load_stepping(model, state, ws, newton, settings, scratch.load, scratch.next);
 }
 
-StaticSolver::StaticSolver(const Model& model, const NewtonSettings& settings)
-    : settings_(settings), newton_(model), load_(Points::Zero(3, model.n_points)), trial_(Points::Zero(3, model.n_points)) {}
+StaticSolver::StaticSolver(const Model& model, const NewtonSettings& settings) : settings_(settings), newton_(model) {}
 
 StepReport StaticSolver::step(const Model& model, State& state, Workspace& ws, DynamicForces*) {
-  const StaticStats stats = load_stepping(model, state, ws, newton_, settings_, load_, trial_);
+  const StaticStats stats = solve_static(model, state, ws, newton_, settings_);
   StepReport report;
   report.status = stats.converged ? StepStatus::CONVERGED : StepStatus::FAILED;
   report.substeps = stats.load_steps;

@@ -24,8 +24,8 @@ struct StaticStats {
 StaticStats solve_static(const Model& model, State& state, Workspace& ws, NewtonSolver& newton,
                          const NewtonSettings& settings);
 
-/// solve_static() as a Solver, with its Newton solver and load-stepping buffers sized once for the model,
-/// so that a solve allocates nothing. A solve that does not reach the full load is FAILED (the state holds
+/// solve_static() as a Solver; its buffers are the workspace's, sized once for the model, so that a solve
+/// allocates nothing. A solve that does not reach the full load is FAILED (the state holds
 /// the last converged equilibrium).
 class StaticSolver final : public Solver {
  public:
@@ -34,8 +34,7 @@ class StaticSolver final : public Solver {
 
  private:
   NewtonSettings settings_;
-  NewtonSolver newton_;
-  Points load_, trial_;  ///< the load of the increment and Newton's iterate  (3 x n)
+  NewtonSolver newton_;  // its vectors and the increment's are the workspace's (Workspace::solver_scratch())
 };
 
 }  // namespace pointhaptics
