@@ -112,8 +112,9 @@ void stencil_loop(const Model& model, const PaddedPoints& u, const PaddedGradien
         const double* gj = Gall + 12 * static_cast<std::ptrdiff_t>(j);
         const double x0 = X[3 * j] - Xi0, x1 = X[3 * j + 1] - Xi1, x2 = X[3 * j + 2] - Xi2;
         // k r = k (u_j - u_i) - (k/2) (G_i + G_j) X_ij  (energies/hourglass.hpp)
-        const Lane4 r = hourglass_pair_force(k[e], Lane4(load4(U + 4 * j) - ui), Lane4(Gi0 + load4(gj)), Lane4(Gi1 + load4(gj + 4)),
-                                             Lane4(Gi2 + load4(gj + 8)), x0, x1, x2);
+        Lane4 r;
+        hourglass_pair_force(r, k[e], Lane4(load4(U + 4 * j) - ui), Lane4(Gi0 + load4(gj)), Lane4(Gi1 + load4(gj + 4)),
+                             Lane4(Gi2 + load4(gj + 8)), x0, x1, x2);
         Q0 += r * x0;
         Q1 += r * x1;
         Q2 += r * x2;
