@@ -16,6 +16,11 @@ struct Aabb {
 };
 
 enum class ShapeKind { BOX, SPHERE, HALF_SPHERE, FILE };
+template <>
+struct EnumNames<ShapeKind> {
+  static constexpr std::array<std::pair<ShapeKind, std::string_view>, 4> table{
+      {{ShapeKind::BOX, "box"}, {ShapeKind::SPHERE, "sphere"}, {ShapeKind::HALF_SPHERE, "half_sphere"}, {ShapeKind::FILE, "file"}}};
+};
 
 struct ObjectSpec {
   ShapeKind shape = ShapeKind::BOX;
@@ -36,6 +41,11 @@ struct FixedSpec {
 };
 
 enum class LoadKind { TRACTION, GRAVITY, POINT };
+template <>
+struct EnumNames<LoadKind> {
+  static constexpr std::array<std::pair<LoadKind, std::string_view>, 3> table{
+      {{LoadKind::TRACTION, "traction"}, {LoadKind::GRAVITY, "gravity"}, {LoadKind::POINT, "point"}}};
+};
 
 struct LoadSpec {
   LoadKind kind = LoadKind::TRACTION;

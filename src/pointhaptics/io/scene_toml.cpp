@@ -201,8 +201,7 @@ auto positive = [](double x) { return x > 0; };
 auto non_negative = [](double x) { return x >= 0; };
 
 void read_object(TableReader& r, ObjectSpec& o, const Context& ctx) {
-  const std::string shape = r.choice("shape", "box", {"box", "sphere", "half_sphere", "file"});
-  o.shape = shape == "box" ? ShapeKind::BOX : shape == "sphere" ? ShapeKind::SPHERE : shape == "half_sphere" ? ShapeKind::HALF_SPHERE : ShapeKind::FILE;
+  o.shape = r.enumeration("shape", o.shape);
   o.spacing = r.number("spacing", o.spacing, positive, "must be > 0 (m)");
   if (o.shape == ShapeKind::BOX) {
     if (!r.find("size")) r.fail_table("size", "a box needs size = [lx, ly, lz] (m)");
@@ -281,17 +280,14 @@ FixedSpec read_fixed(TableReader& r) {
 LoadSpec read_load(TableReader& r) {
   LoadSpec l;
   l.line = r.line();
-  const std::string kind = r.choice("kind", "traction", {"traction", "gravity", "point"});
-  if (kind == "traction") {
-    l.kind = LoadKind::TRACTION;
+  l.kind = r.enumeration("kind", l.kind);
+  if (l.kind == LoadKind::TRACTION) {
     l.box = r.box("box", true);
     if (!r.find("total")) r.fail_table("total", "a traction load needs total = [fx, fy, fz] (N)");
     l.total = r.vec3("total", l.total);
-  } else if (kind == "gravity") {
-    l.kind = LoadKind::GRAVITY;
+  } else if (l.kind == LoadKind::GRAVITY) {
     l.g = r.vec3("g", l.g);
   } else {
-    l.kind = LoadKind::POINT;
     if (!r.find("point")) r.fail_table("point", "a point load needs point = <index>");
     l.point = r.integer("point", 0);
     if (l.point < 0) r.fail_at(*r.find("point"), "point", "must be a point index >= 0");
