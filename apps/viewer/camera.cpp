@@ -83,4 +83,21 @@ Vec3 on_view_plane(const OrbitCamera& camera, const Ray& ray, const Vec3& point)
   return ray.origin + s * ray.direction;
 }
 
+Vec3 CursorAnchor::follow(const OrbitCamera& camera, const Viewport& vp, double cx, double cy, const Vec3& target) {
+  if (!target.allFinite()) return target;
+  if (!moved_) {
+    // the first cursor position seen is where the pointer happened to be: wait for it to move
+    if (std::isnan(start_x_)) {
+      start_x_ = cx;
+      start_y_ = cy;
+    }
+    if (cx == start_x_ && cy == start_y_) return target;
+    moved_ = true;
+  }
+  const Vec3 q = on_view_plane(camera, camera.ray(cx, cy, vp), target);
+  if (!q.allFinite()) return target;
+  if (!offset_.allFinite()) offset_ = target - q;  // anchored: no jump
+  return q + offset_;
+}
+
 }  // namespace pointhaptics::viewer

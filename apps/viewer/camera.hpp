@@ -57,4 +57,20 @@ class OrbitCamera {
 /// Where the ray meets the plane through `point` facing the camera (NaN if it never does).
 Vec3 on_view_plane(const OrbitCamera& camera, const Ray& ray, const Vec3& point);
 
+/// How the mouse moves the probe's hand target: nothing until the cursor first moves, then the target
+/// follows the cursor's motion in the plane facing the camera through it, anchored where it was (issue 21:
+/// following the cursor's absolute position put the probe into the object at start, wherever the pointer
+/// happened to be). reset() re-anchors (after the camera or the target's depth changed).
+class CursorAnchor {
+ public:
+  /// The new target for the cursor at pixel (cx, cy) of `vp`.
+  Vec3 follow(const OrbitCamera& camera, const Viewport& vp, double cx, double cy, const Vec3& target);
+  void reset() { offset_ = Vec3::Constant(NAN); }
+
+ private:
+  Vec3 offset_ = Vec3::Constant(NAN);  ///< target minus the cursor's point on the plane
+  double start_x_ = NAN, start_y_ = NAN;
+  bool moved_ = false;
+};
+
 }  // namespace pointhaptics::viewer

@@ -67,6 +67,7 @@ struct ImGuiContextGuard {
 // depth, the left button grabs.
 struct MouseProbe {
   Vec3 target = Vec3::Constant(NAN);  ///< scene position the hand aims at
+  CursorAnchor anchor;                 ///< moves it with the cursor's motion (from the first motion on)
   bool follow = true;
   double scroll = 0;                   ///< wheel clicks since the last frame (from the GLFW callback)
   std::vector<int> keys;               ///< keys pressed since the last frame (from the callback: a tap
@@ -172,6 +173,7 @@ int run_window(const ViewerOptions& o) {
       view.camera.frame(session.current().lo, session.current().hi);
       state.edit = session.current().scene;
       mouse.target = session.current().options.mapping.origin;
+      mouse.anchor.reset();
     }
     Prepared& p = session.current();
     const DisplayFrame& frame = session.frame();
@@ -199,28 +201,36 @@ int run_window(const ViewerOptions& o) {
     if (over_view && glfwGetMouseButton(window.handle(), GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS) {
       if (shift) view.camera.pan(dx, dy, vp);
       else view.camera.orbit(dx, dy, vp);
+      mouse.anchor.reset();  // the plane the probe moves in turned
     }
-    if (over_view && glfwGetMouseButton(window.handle(), GLFW_MOUSE_BUTTON_MIDDLE) == GLFW_PRESS) view.camera.pan(dx, dy, vp);
+    if (over_view && glfwGetMouseButton(window.handle(), GLFW_MOUSE_BUTTON_MIDDLE) == GLFW_PRESS) {
+      view.camera.pan(dx, dy, vp);
+      mouse.anchor.reset();
+    }
     if (over_view && mouse.scroll != 0) {
       if (shift || ctrl) view.camera.zoom(std::pow(0.9, mouse.scroll));
       else if (mouse.target.allFinite()) mouse.target += view.camera.forward() * (-0.5 * p.options.probe.radius * mouse.scroll);
+      mouse.anchor.reset();
     }
     mouse.scroll = 0;
     bool save_key = false;
     for (const int key : mouse.keys) {
       if (io.WantCaptureKeyboard) break;  // typing into a panel
-      if (key == GLFW_KEY_SPACE) mouse.follow = !mouse.follow;
-      if (key == GLFW_KEY_R) view.camera = initial_view(o, p).camera;
+      if (key == GLFW_KEY_SPACE) {
+        mouse.follow = !mouse.follow;
+        mouse.anchor.reset();
+      }
+      if (key == GLFW_KEY_R) {
+        view.camera = initial_view(o, p).camera;
+        mouse.anchor.reset();
+      }
       if (key == GLFW_KEY_Q || key == GLFW_KEY_ESCAPE) glfwSetWindowShouldClose(window.handle(), 1);
       if (key == GLFW_KEY_S) save_key = true;
     }
     mouse.keys.clear();
     // the probe follows the cursor in the plane through the hand's target
     if (p.mouse) {
-      if (over_view && mouse.follow) {
-        const Vec3 q = on_view_plane(view.camera, view.camera.ray(cx, cy, vp), mouse.target);
-        if (q.allFinite()) mouse.target = q;
-      }
+      if (over_view && mouse.follow) mouse.target = mouse.anchor.follow(view.camera, vp, cx, cy, mouse.target);
       const bool grab = over_view && glfwGetMouseButton(window.handle(), GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
       p.mouse->set_target(session.device_of_scene(mouse.target), grab ? 1u : 0u);
     }

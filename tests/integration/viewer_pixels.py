@@ -201,9 +201,14 @@ try:
             subprocess.run(["xdotool", "mousemove", str(int(p[0])), str(int(p[1]))], env=env, check=True)
             time.sleep(0.4)
 
-        # the cursor moves the probe in the view plane through its origin: down into the top face, then
-        # press, lift, and hold there until the window closes
+        # the probe stays at its origin, above the object, until the cursor moves (issue 21: it used to jump
+        # to wherever the pointer was); then it follows the cursor's motion in the view plane through it,
+        # anchored where it was: the cursor is put over the origin first, so that positions below are
+        # where the probe goes. Down into the top face, then press, lift, and hold there until the window
+        # closes
+        time.sleep(0.5)
         down = origin + np.array([0.0, -2.3 * r, 0.0])
+        move_to(origin)
         move_to(origin + np.array([0.0, -0.5 * r, 0.0]))
         move_to(down)
         subprocess.run(["xdotool", "mousedown", "1"], env=env, check=True)

@@ -93,5 +93,27 @@ TEST(OrbitCamera, TheViewPlaneThroughAPointHoldsItsDepth) {
   EXPECT_FALSE(on_view_plane(c, c.ray(600, 300, vp), c.eye() - c.forward()).allFinite());
 }
 
+TEST(CursorAnchor, TheTargetStaysUntilTheCursorMovesThenFollowsItsMotionWithoutAJump) {
+  OrbitCamera c;
+  c.frame(Vec3(0, 0, 0), Vec3(0.135, 0.03, 0.03));
+  const Vec3 start(0.0675, 0.05, 0.015);  // above the beam
+  CursorAnchor anchor;
+  // the pointer rests over the middle of the beam: the target does not jump there
+  const Eigen::Vector2d over_beam = c.project(Vec3(0.0675, 0.015, 0.015), vp);
+  EXPECT_EQ(anchor.follow(c, vp, over_beam.x(), over_beam.y(), start), start);
+  EXPECT_EQ(anchor.follow(c, vp, over_beam.x(), over_beam.y(), start), start);
+  // the first motion anchors it where it is; 40 pixels more move it right by 40 pixels' worth at its depth
+  Vec3 t = anchor.follow(c, vp, over_beam.x() + 1, over_beam.y(), start);
+  EXPECT_LE((t - start).norm(), 1e-12);
+  t = anchor.follow(c, vp, over_beam.x() + 41, over_beam.y(), t);
+  const double depth = (start - c.eye()).dot(c.forward());
+  EXPECT_NEAR((t - start).dot(c.right()), 40 / c.pixels_per_metre(depth, vp), 1e-6);
+  EXPECT_NEAR((t - start).dot(c.up()), 0.0, 1e-6);
+  EXPECT_NEAR((t - start).dot(c.forward()), 0.0, 1e-9);  // in the plane facing the camera
+  // re-anchored after a reset: the next position is kept
+  anchor.reset();
+  EXPECT_LE((anchor.follow(c, vp, 10, 10, t) - t).norm(), 1e-12);
+}
+
 }  // namespace
 }  // namespace pointhaptics::viewer
