@@ -10,7 +10,10 @@ import sys
 import matplotlib
 
 matplotlib.use("Agg")
+import math  # noqa: E402
+
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.ticker import FixedLocator, NullLocator, ScalarFormatter  # noqa: E402
 
 
 def rows(path):
@@ -28,8 +31,6 @@ def main(out):
 
     # seed Fig. 4: grouped bars of the tip deflection per load case, normalised by CalculiX
     series = [("CalculiX NLGEOM", lambda c: ref[c])]
-    for r in (r for r in data if r["method"] == "timoshenko"):
-        pass
     series.append(("Timoshenko", lambda c: next(float(r["d_centre_m"]) for r in data if r["case"] == c and r["method"] == "timoshenko")))
     series.append(("seed h = 0.1 m, s = 15 mm", lambda c: next(float(r["d_centre_m"]) for r in data if r["case"] == c and r["method"] == "point_seed_h")))
     for s in spacings:
@@ -49,18 +50,33 @@ def main(out):
     fig.savefig(os.path.join(out, "deflection-bars.png"), dpi=120)
     plt.close(fig)
 
-    # convergence: |relative error| against spacing, log-log, per support factor and load case
-    fig, ax = plt.subplots(figsize=(6, 4.5))
+    # convergence: |relative error| against spacing, log-log, per support factor and load case; the axes in
+    # mm and % with plain tick labels at the spacings run, and the observed order of each line in its label
+    fig, ax = plt.subplots(figsize=(6.5, 4.8))
     for f in factors:
         for c in cases:
-            pts = sorted((float(r["spacing_m"]), abs(float(r["error_centre_pct"])))
+            pts = sorted((float(r["spacing_m"]) * 1e3, abs(float(r["error_centre_pct"])))
                          for r in points if r["case"] == c and float(r["support_factor"]) == f)
+            if not pts:
+                continue
+            order = ""
+            if len(pts) >= 2 and pts[0][1] > 0 and pts[-1][1] > 0:
+                order = f", order {math.log(pts[-1][1] / pts[0][1]) / math.log(pts[-1][0] / pts[0][0]):.1f}"
             ax.loglog([p[0] for p in pts], [max(p[1], 1e-3) for p in pts], "o-" if f == 2.0 else "s--",
-                      label=f"h = {f:g}s, {c}", lw=1, ms=3)
-    ax.set_xlabel("spacing (m)")
-    ax.set_ylabel("|error| vs CalculiX (%)")
-    ax.set_title("Convergence under refinement")
-    ax.legend(fontsize=6)
+                      label=f"h = {f:g}s, {c}{order}", lw=1, ms=4)
+    ticks = sorted({s * 1e3 for s in spacings})
+    ax.xaxis.set_major_locator(FixedLocator(ticks))
+    ax.xaxis.set_minor_locator(NullLocator())
+    ax.xaxis.set_major_formatter(ScalarFormatter())
+    ax.yaxis.set_major_formatter(ScalarFormatter())
+    ax.yaxis.set_minor_formatter(ScalarFormatter())
+    ax.tick_params(axis="y", which="minor", labelsize=7)
+    ax.set_xlabel("spacing s (mm)")
+    ax.set_ylabel("|error| of the tip deflection vs CalculiX (%)")
+    note = " (--quick: two spacings)" if len(ticks) < 3 else ""
+    ax.set_title("Convergence under refinement" + note)
+    ax.grid(True, which="both", lw=0.3, alpha=0.5)
+    ax.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(os.path.join(out, "convergence.png"), dpi=120)
     plt.close(fig)
@@ -83,16 +99,19 @@ def main(out):
     fig.savefig(os.path.join(out, "deformed.png"), dpi=120)
     plt.close(fig)
 
-    # the point-load profile down the depth
+    # the point-load profile down the depth, in mm
     profile = rows(os.path.join(out, "point-load.csv"))
-    fig, ax = plt.subplots(figsize=(5, 4))
-    ys = [float(r["y_m"]) for r in profile]
-    ax.plot([-float(r["point_uy_m"]) for r in profile], ys, "o-", label="point model")
-    ax.plot([-float(r["calculix_uy_m"]) for r in profile], ys, "s--", label="CalculiX (load on one cell)")
-    ax.set_xlabel("downward displacement (m)")
-    ax.set_ylabel("y (m)")
+    fig, ax = plt.subplots(figsize=(5.5, 4.2))
+    ys = [float(r["y_m"]) * 1e3 for r in profile]
+    ax.plot([-float(r["point_uy_m"]) * 1e3 for r in profile], ys, "o-", label="point model")
+    ax.plot([-float(r["calculix_uy_m"]) * 1e3 for r in profile], ys, "s--", label="CalculiX (load on one cell)")
+    ax.xaxis.set_major_locator(plt.MaxNLocator(5))
+    ax.xaxis.set_major_formatter(ScalarFormatter(useOffset=False))
+    ax.set_xlabel("downward displacement (mm)")
+    ax.set_ylabel("height y (mm), the load on the top face")
     ax.set_title("Point load at mid-span: profile below the load")
-    ax.legend()
+    ax.grid(True, lw=0.3, alpha=0.5)
+    ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(os.path.join(out, "point-load.png"), dpi=120)
     plt.close(fig)

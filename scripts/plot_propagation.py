@@ -31,25 +31,38 @@ def main(out):
     fig.tight_layout()
     fig.savefig(os.path.join(out, "propagation.png"), dpi=120)
 
+    # the object per run: a grid of panels that fill the figure (2 rows from 4 runs up), each a full-size 3-D
+    # view; the colour scale is logarithmic from 1% of the largest displacement, so that the pulled point
+    # does not saturate it and the propagation into the object shows
     x = [float(r["x"]) for r in rows]
     y = [float(r["y"]) for r in rows]
     z = [float(r["z"]) for r in rows]
+    from matplotlib.colors import LogNorm  # noqa: E402
+
     vmax = max(float(r["u_" + n]) for r in rows for n in runs) * 1e3
-    fig = plt.figure(figsize=(3.2 * len(runs), 3.6))
+    norm = LogNorm(vmin=max(vmax * 1e-2, 1e-12), vmax=max(vmax, 1e-12), clip=True)
+    ncols = len(runs) if len(runs) <= 3 else (len(runs) + 1) // 2
+    nrows = (len(runs) + ncols - 1) // ncols
+    fig = plt.figure(figsize=(4.2 * ncols + 1.2, 4.0 * nrows))
+    grid = fig.add_gridspec(nrows, ncols + 1, width_ratios=[1] * ncols + [0.06], wspace=0.02, hspace=0.08,
+                            left=0.01, right=0.93, top=0.93, bottom=0.02)
+    sc = None
     for k, name in enumerate(runs):
-        ax = fig.add_subplot(1, len(runs), k + 1, projection="3d")
-        u = [1e3 * float(r["u_" + name]) for r in rows]
+        ax = fig.add_subplot(grid[k // ncols, k % ncols], projection="3d")
+        u = [max(1e3 * float(r["u_" + name]), 1e-15) for r in rows]
         sel = [r["selected_" + name] == "1" for r in rows]
         sc = ax.scatter([a for a, s in zip(x, sel) if s], [c for c, s in zip(z, sel) if s], [b for b, s in zip(y, sel) if s],
-                        c=[v for v, s in zip(u, sel) if s], cmap="viridis", vmin=0, vmax=vmax, s=14, depthshade=False)
+                        c=[v for v, s in zip(u, sel) if s], cmap="viridis", norm=norm, s=30, depthshade=False)
         ax.scatter([a for a, s in zip(x, sel) if not s], [c for c, s in zip(z, sel) if not s],
-                   [b for b, s in zip(y, sel) if not s], c="0.8", s=4, depthshade=False)
-        ax.set_title(name.replace("_", " weight "), fontsize=9)
+                   [b for b, s in zip(y, sel) if not s], c="0.75", s=8, depthshade=False)
+        ax.set_title(name.replace("_", " weight "), fontsize=12)
         ax.set_xticks([])
         ax.set_yticks([])
         ax.set_zticks([])
+        ax.set_box_aspect((max(x) - min(x), max(z) - min(z), max(y) - min(y)), zoom=1.25)
         ax.view_init(elev=25, azim=-60)
-    fig.colorbar(sc, ax=fig.axes, shrink=0.6, label="|u| (mm); grey: not simulated")
+    fig.colorbar(sc, cax=fig.add_subplot(grid[:, ncols]), label="|u| (mm, log scale); grey: not simulated")
+    fig.suptitle("The pulled half-sphere, coloured by displacement (seed Fig. 8-9)", fontsize=13)
     fig.savefig(os.path.join(out, "propagation-3d.png"), dpi=110)
 
 
