@@ -11,6 +11,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.ticker import FixedLocator, NullFormatter, NullLocator, StrMethodFormatter  # noqa: E402
 
 
 def main(out):
@@ -33,6 +34,13 @@ def main(out):
                     label=f"seed Table 1 (fps, Pentium 4), {tr1}h, {tr2}h")
     ax.set_xscale("log")
     ax.set_yscale("log")
+    # plain labels at the object sizes run (not 3 x 10^2), thousands separated
+    ax.xaxis.set_major_locator(FixedLocator(sizes))
+    ax.xaxis.set_minor_locator(NullLocator())
+    ax.xaxis.set_major_formatter(StrMethodFormatter("{x:,.0f}"))
+    ax.yaxis.set_major_formatter(StrMethodFormatter("{x:,.0f}"))
+    ax.yaxis.set_minor_formatter(NullFormatter())
+    plt.setp(ax.get_xticklabels(), rotation=30, ha="right")
     ax.set_xlabel("points in the object")
     ax.set_ylabel("explicit steps per second")
     ax.set_title("Levels of detail: steps per second (seed Table 1)")
