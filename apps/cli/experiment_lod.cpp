@@ -10,8 +10,8 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <optional>
 
@@ -142,6 +142,16 @@ int run_lod_table_experiment(const LodExperimentOptions& options) {
       "evaluation and update. `selected`: points simulated; `active`: with the frozen ring that holds them. "
       "The seed's frame rates (3 GHz Pentium 4) for comparison.\n\n"
       "| points | T_r1, T_r2 | selected | active | steps/s | x full | seed fps | real-time factor |\n|---|---|---|---|---|---|---|---|\n";
+  // progress: one line per timed configuration, with the time so far (the 100k-point object takes most of it)
+  const auto started = std::chrono::steady_clock::now();
+  const std::size_t n_configs = 4 * targets.size();
+  std::size_t done = 0;
+  const auto progress = [&](index_t n, const std::string& config, double steps_per_s) {
+    ++done;
+    fmt::print("lod-table: [{}/{}] {} points, {}: {:.0f} steps/s ({:.0f} s so far)\n", done, n_configs, n, config, steps_per_s,
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+    std::fflush(stdout);
+  };
   for (std::size_t o = 0; o < targets.size(); ++o) {
     const double spacing = spacing_for(targets[o]);
     Model model = build_scene_model(half_sphere(spacing));
@@ -151,6 +161,7 @@ int run_lod_table_experiment(const LodExperimentOptions& options) {
     fmt::print("lod-table: {} points (spacing {:.3g} m)\n", model.n_points, spacing);
     Simulation full(model, solver, options.threads);
     const Timing tf = time_steps(full, options.seconds);
+    progress(model.n_points, "full model", tf.steps_per_s);
     csv.print("{},,,full,{},{:.6g},,{},{:.6g},{:.6g},,,{}\n", model.n_points, model.n_points, tf.steps_per_s, model.n_points,
               tf.realtime, tf.stable_dt, options.threads);
     md += fmt::format("| {} | full model | {} | {} | {:.0f} | 1 | | {:.3f} |\n", model.n_points, model.n_points, model.n_points,
@@ -159,6 +170,7 @@ int run_lod_table_experiment(const LodExperimentOptions& options) {
       Simulation sim(model, solver, options.threads);
       sim.enable_lod(bands(tr[b][0], tr[b][1]), model.X.col(pole));
       const Timing t = time_steps(sim, options.seconds);
+      progress(model.n_points, fmt::format("T_r1 = {}h, T_r2 = {}h", tr[b][0], tr[b][1]), t.steps_per_s);
       const RunSummary s = sim.summary();
       const std::optional<double> fps = o < 3 ? std::optional<double>(seed_fps[o][b]) : std::nullopt;
       csv.print("{},{},{},lod,{},{:.6g},{},{},{:.6g},{:.6g},{:.4g},{:.4g},{}\n", model.n_points, tr[b][0], tr[b][1], s.lod.selected,
