@@ -31,7 +31,7 @@ double estimated_stable_time_step(const Model& model, double safety) {
   return safety * a / std::sqrt(modulus / rho);
 }
 
-double stable_time_step(const Model& model, double safety, int lanczos_steps) {
+double stable_time_step(const Model& model, double safety, int lanczos_steps, int n_threads) {
   // Lanczos on M^-1/2 K M^-1/2 over the free points at rest: its largest Ritz value approaches the
   // largest omega^2 from below, and symplectic Euler is stable for h < 2 / omega_max
   const Eigen::Index n = 3 * static_cast<Eigen::Index>(model.n_points);
@@ -40,7 +40,7 @@ double stable_time_step(const Model& model, double safety, int lanczos_steps) {
     for (int a = 0; a < 3; ++a) scale[3 * i + a] = model.fixed[i] || !(model.mass[i] > 0) ? 0.0 : 1.0 / std::sqrt(model.mass[i]);
   const double fallback = estimated_stable_time_step(model, 0.7);
   if (scale.squaredNorm() == 0) return fallback;
-  Workspace ws(model, 1);
+  Workspace ws(model, n_threads);
   Tangent K;
   K.linearise(model, Points::Zero(3, model.n_points), TangentMode::EXACT, &ws);
   std::mt19937 rng(12345);

@@ -10,7 +10,9 @@ namespace pointhaptics {
 /// On the shipped scenes this is 1.25-1.4x the older estimate below; costs ~40 tangent products, once.
 /// `lanczos_steps`: 40 by default; 20 already lands within 0.2% of it on the models measured (a 13k-point
 /// half-sphere) and halves the cost, which level-of-detail re-selection uses.
-double stable_time_step(const Model& model, double safety = 0.8, int lanczos_steps = 40);
+/// `n_threads`: for the tangent products (1 by default: a level-of-detail build on a worker thread must not
+/// take the simulation's cores; 0: all).
+double stable_time_step(const Model& model, double safety = 0.8, int lanczos_steps = 40, int n_threads = 1);
 
 /// The older, cheaper estimate: safety x a / c_p with a the smallest point distance and c_p the p-wave
 /// speed sqrt((lambda + 2 mu + k_v + alpha E) / rho) of the densest point. Used when Lanczos cannot run.

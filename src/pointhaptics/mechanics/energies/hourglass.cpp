@@ -2,6 +2,10 @@
 
 #include <pointhaptics/mechanics/kernels.hpp>
 
+#include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/enumerable_thread_specific.h>
+#include <oneapi/tbb/parallel_for.h>
+
 #include <cmath>
 
 namespace pointhaptics {
@@ -22,28 +26,40 @@ void build_hourglass(Model& model, const Eigen::VectorXd& w, const std::vector<d
     }
   model.hg_diagonal = Eigen::VectorXd::Zero(n);
   if (!(model.material.hourglass > 0)) return;
-  std::vector<double> weight(n, 0.0);
-  std::vector<index_t> touched;
-  for (index_t i = 0; i < n; ++i)
-    for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
-      const index_t j = nbr.index[e];
-      const Vec3 xij = model.X.col(j) - model.X.col(i);
-      auto add = [&](index_t m, double value) {
-        if (weight[m] == 0.0) touched.push_back(m);
-        weight[m] += value;
-      };
-      add(j, 1.0);
-      add(i, -1.0);
-      for (index_t s : {i, j}) {  // the two gradients G_i and G_j
-        add(s, -0.5 * model.d_self.col(s).dot(xij));
-        for (index_t f = nbr.begin(s); f < nbr.end(s); ++f) add(nbr.index[f], -0.5 * model.d.col(f).dot(xij));
+  // in parallel over stencils (it took a sixth of a 10^6-point set-up serially): each thread accumulates its
+  // own diagonal, summed at the end (no atomics)
+  struct Scratch {
+    std::vector<double> weight, diagonal;
+    std::vector<index_t> touched;
+  };
+  tbb::enumerable_thread_specific<Scratch> scratch([n] { return Scratch{std::vector<double>(n, 0.0), std::vector<double>(n, 0.0), {}}; });
+  tbb::parallel_for(tbb::blocked_range<index_t>(0, n, 2048), [&](const tbb::blocked_range<index_t>& range) {
+    Scratch& local = scratch.local();
+    std::vector<double>& weight = local.weight;
+    std::vector<index_t>& touched = local.touched;
+    for (index_t i = range.begin(); i != range.end(); ++i)
+      for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
+        const index_t j = nbr.index[e];
+        const Vec3 xij = model.X.col(j) - model.X.col(i);
+        auto add = [&](index_t m, double value) {
+          if (weight[m] == 0.0) touched.push_back(m);
+          weight[m] += value;
+        };
+        add(j, 1.0);
+        add(i, -1.0);
+        for (index_t s : {i, j}) {  // the two gradients G_i and G_j
+          add(s, -0.5 * model.d_self.col(s).dot(xij));
+          for (index_t f = nbr.begin(s); f < nbr.end(s); ++f) add(nbr.index[f], -0.5 * model.d.col(f).dot(xij));
+        }
+        for (index_t m : touched) {
+          local.diagonal[m] += model.hg_coef[e] * weight[m] * weight[m];
+          weight[m] = 0.0;
+        }
+        touched.clear();
       }
-      for (index_t m : touched) {
-        model.hg_diagonal[m] += model.hg_coef[e] * weight[m] * weight[m];
-        weight[m] = 0.0;
-      }
-      touched.clear();
-    }
+  });
+  for (const Scratch& local : scratch)
+    model.hg_diagonal += Eigen::Map<const Eigen::VectorXd>(local.diagonal.data(), n);
 }
 
 

@@ -37,8 +37,8 @@ PH_ALWAYS_INLINE inline void hourglass_pair_force(V& force, double k, const V& d
 /// The pair coefficients k_ij (model.hg_coef) from the kernel weights w (per pair) and their sums per point,
 /// and the exact diagonal of the constant Hessian (model.hg_diagonal). The weight of u_m in r_ij is
 ///   [m = j] - [m = i] - (a_im + a_jm) / 2,  a_im = d_im . X_ij (m in N(i)), a_ii = d_ii . X_ij,
-/// so diag_m = sum over pairs of k_ij (weight)^2, over the two stencils of each pair (serial;
-/// O(pairs x stencil)). Needs model.d, d_self, volume, X, kernel and material.
+/// so diag_m = sum over pairs of k_ij (weight)^2, over the two stencils of each pair (O(pairs x stencil), in
+/// parallel on TBB's threads). Needs model.d, d_self, volume, X, kernel and material.
 void build_hourglass(Model& model, const Eigen::VectorXd& w, const std::vector<double>& weight_sum);
 
 }  // namespace pointhaptics
