@@ -1,5 +1,6 @@
-// Tests for levels of detail inside Simulation and interactive runs: the active set replaces the model,
-// re-selection carries the state over without a jump in the force felt, and runs report it.
+// Tests for levels_of_detail (the layer between Simulation and the pipeline) and interactive runs with it: the
+// active set replaces what is simulated, re-selection carries the state over without a jump in the force
+// felt or added energy, re-selection on a worker thread, and runs report it.
 #include <pointhaptics/haptics/contact.hpp>
 #include <pointhaptics/haptics/devices/virtual_device.hpp>
 #include <pointhaptics/pointhaptics.hpp>
@@ -46,7 +47,7 @@ index_t point_at(const Model& m, const Vec3& x) {
   return best;
 }
 
-TEST(LodSimulation, SelectingEverythingSolvesLikeTheFullModel) {
+TEST(LevelsOfDetail, SelectingEverythingSolvesLikeTheFullModel) {
   Model probe_model = build_scene_model(block_scene(Vec3::Zero(), 0));
   const index_t top = point_at(probe_model, Vec3(0.06, 0.04, 0.03));
   const Scene scene = block_scene(Vec3(0, -0.01, 0), top);
@@ -67,7 +68,7 @@ TEST(LodSimulation, SelectingEverythingSolvesLikeTheFullModel) {
   EXPECT_LE((a - b).norm(), 1e-6 * a.norm());
 }
 
-TEST(LodSimulation, RunsOnTheActiveSetAndReportsIt) {
+TEST(LevelsOfDetail, RunsOnTheActiveSetAndReportsIt) {
   Model m0 = build_scene_model(block_scene(Vec3::Zero(), 0));
   const index_t top = point_at(m0, Vec3(0.06, 0.04, 0.03));
   Scene scene = block_scene(Vec3(0, -0.01, 0), top);
@@ -95,7 +96,7 @@ TEST(LodSimulation, RunsOnTheActiveSetAndReportsIt) {
   EXPECT_NE(json.find("\"selections\": 1"), std::string::npos);
 }
 
-TEST(LodSimulation, ReselectionCarriesTheStateWithoutAJumpInTheContactForce) {
+TEST(LevelsOfDetail, ReselectionCarriesTheStateWithoutAJumpInTheContactForce) {
   Scene scene = block_scene(Vec3::Zero(), 0);
   scene.loads.clear();
   scene.solver.kind = SolverKind::EXPLICIT;
@@ -189,7 +190,7 @@ struct PressedBlock {
   }
 };
 
-TEST(LodSimulation, ATakeOverAddsNoEnergy) {
+TEST(LevelsOfDetail, ATakeOverAddsNoEnergy) {
   // issue 21: seen through the new active set the same field held 30-100% more strain energy, and a slow
   // real-time session that re-selected often was pumped up until it diverged; the excess now comes out of
   // the kinetic energy
@@ -206,7 +207,7 @@ TEST(LodSimulation, ATakeOverAddsNoEnergy) {
   EXPECT_EQ(reselected, 4);
 }
 
-TEST(LodSimulation, NoReselectionSoonerThanTheIntervalAfterTheLast) {
+TEST(LevelsOfDetail, NoReselectionSoonerThanTheIntervalAfterTheLast) {
   PressedBlock b(0.05);
   const double h = b.sim.model().h;
   ASSERT_FALSE(b.sim.update_lod(Vec3(0.03 + h, 0.04, 0.03)).empty());
@@ -220,7 +221,7 @@ TEST(LodSimulation, NoReselectionSoonerThanTheIntervalAfterTheLast) {
   EXPECT_EQ(b.sim.lod_selections(), 3);
 }
 
-TEST(LodSimulation, AsynchronousReselectionKeepsSteppingUntilTheNewSetTakesOver) {
+TEST(LevelsOfDetail, AsynchronousReselectionKeepsSteppingUntilTheNewSetTakesOver) {
   Scene scene = block_scene(Vec3::Zero(), 0);
   scene.loads.clear();
   scene.solver.kind = SolverKind::EXPLICIT;
@@ -299,7 +300,7 @@ double max_force_change(const std::vector<HapticLogRow>& log) {
   return m;
 }
 
-TEST(LodSimulation, InteractiveRunsFollowTheProbe) {
+TEST(LevelsOfDetail, InteractiveRunsFollowTheProbe) {
   const SlideResult lod = slide(true, LodScheme::DITHER), full = slide(false), seed = slide(true, LodScheme::RANDOM);
   EXPECT_GT(lod.run.max_contacts, 0);
   EXPECT_GE(lod.summary.lod.selections, 3);  // 2 h of sliding, re-selecting every 0.5 h
