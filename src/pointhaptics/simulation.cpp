@@ -122,6 +122,9 @@ RunSummary Simulation::summary() {
   s.wall_s = d.step_seconds;
   s.step_ms_mean = d.steps > 0 ? 1e3 * d.step_seconds / static_cast<double>(d.steps) : 0;
   s.steps_per_s = d.step_seconds > 0 ? static_cast<double>(d.steps) / d.step_seconds : 0;
+  s.active_set_s = d.active_set_seconds;
+  s.tools_s = d.tools_seconds;
+  s.solve_s = d.solve_seconds;
   if (lod_) lod_->fill(s.lod);
   return s;
 }

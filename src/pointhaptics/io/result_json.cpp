@@ -39,7 +39,10 @@ std::string result_json(const Model& model, const State& state, const RunSummary
   if (s.interrupted) doc["solver"]["interrupted"] = true;
   if (s.solver_kind == "implicit") doc["solver"]["budget_steps"] = s.budget_steps;
   doc["energy"] = {{"strain", s.strain_energy}, {"kinetic", s.kinetic_energy}};
-  doc["timing"] = {{"wall_s", s.wall_s}, {"step_ms_mean", s.step_ms_mean}, {"steps_per_s", s.steps_per_s}};
+  doc["timing"] = {{"wall_s", s.wall_s},
+                   {"step_ms_mean", s.step_ms_mean},
+                   {"steps_per_s", s.steps_per_s},
+                   {"stages", {{"active_set_s", s.active_set_s}, {"tools_s", s.tools_s}, {"solve_s", s.solve_s}}}};
   json constraints = json::array();
   for (size_t g = 0; g < model.fixed_groups.size(); ++g)
     constraints.push_back({{"points", model.fixed_groups[g].points.size()},

@@ -32,6 +32,9 @@ struct RunSummary {
   long long steps = 0;          ///< solver steps of dt
   double strain_energy = 0, kinetic_energy = 0;  ///< J
   double wall_s = 0, step_ms_mean = 0, steps_per_s = 0;
+  /// wall time in the step pipeline's stages, s: following the contact (levels of detail), placing the
+  /// tools, the solver
+  double active_set_s = 0, tools_s = 0, solve_s = 0;
   double stable_dt = 0;         ///< explicit: the stable sub-step, s
   long long substeps = 0;       ///< explicit: sub-steps taken in all; static: load increments
   long long cg_iterations = 0;  ///< static, implicit: conjugate-gradient iterations in all
