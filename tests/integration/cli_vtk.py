@@ -69,7 +69,7 @@ def check(scene, extra, name):
     assert len(u) == 3 * n
     assert max(abs(a - b) for a, b in zip(u, arrays["displacement"][1])) <= 1e-8 * max(1e-12, max(map(abs, u))) + 1e-15
     rows = list(csv.DictReader(open(table)))
-    assert len(rows) == n and list(rows[0]) == ["index", "x", "y", "z", "ux", "uy", "uz", "von_mises", "strain_energy_density",
+    assert len(rows) == n and list(rows[0]) == ["index", "x_ref", "y_ref", "z_ref", "ux", "uy", "uz", "von_mises", "strain_energy_density",
                                                  "active", "fixed"], list(rows[0])
     assert max(abs(float(r[k]) - u[3 * i + c]) for i, r in enumerate(rows) for c, k in enumerate(("ux", "uy", "uz"))) < 1e-8 * max(map(abs, u))
     assert [int(r["active"]) for r in rows] == [int(v) for v in arrays["active"][1]]
