@@ -81,21 +81,21 @@ def main(out):
     fig.savefig(os.path.join(out, "convergence.png"), dpi=120)
     plt.close(fig)
 
-    # seed Fig. 3: the deformed beams side by side (largest tip load)
+    # seed Fig. 3: the deformed beams side by side (largest tip load), in mm, the colour bar beside them
     deformed = rows(os.path.join(out, "deformed.csv"))
-    fig, axes = plt.subplots(1, 2, figsize=(11, 3.8), sharey=True)
+    fig, axes = plt.subplots(1, 2, figsize=(11, 3.4), sharey=True, layout="constrained")
     for ax, model, title in ((axes[0], "point", "point model (s = 7.5 mm)"), (axes[1], "calculix", "CalculiX NLGEOM")):
         sel = [r for r in deformed if r["model"] == model]
-        x = [float(r["x"]) + float(r["ux"]) for r in sel]
-        y = [float(r["y"]) + float(r["uy"]) for r in sel]
-        mag = [(float(r["ux"]) ** 2 + float(r["uy"]) ** 2 + float(r["uz"]) ** 2) ** 0.5 for r in sel]
-        ax.scatter([float(r["x"]) for r in sel], [float(r["y"]) for r in sel], s=3, c="0.8")
+        x = [1e3 * (float(r["x"]) + float(r["ux"])) for r in sel]
+        y = [1e3 * (float(r["y"]) + float(r["uy"])) for r in sel]
+        mag = [1e3 * (float(r["ux"]) ** 2 + float(r["uy"]) ** 2 + float(r["uz"]) ** 2) ** 0.5 for r in sel]
+        ax.scatter([1e3 * float(r["x"]) for r in sel], [1e3 * float(r["y"]) for r in sel], s=3, c="0.8")
         sc = ax.scatter(x, y, s=6, c=mag, cmap="viridis")
         ax.set_title(title)
         ax.set_aspect("equal")
-        ax.set_xlabel("x (m)")
-    axes[0].set_ylabel("y (m)")
-    fig.colorbar(sc, ax=axes, label="|u| (m)")
+        ax.set_xlabel("x (mm)")
+    axes[0].set_ylabel("y (mm)")
+    fig.colorbar(sc, ax=axes, label="|u| (mm); grey: the beam at rest", shrink=0.9)
     fig.savefig(os.path.join(out, "deformed.png"), dpi=120)
     plt.close(fig)
 
