@@ -23,15 +23,15 @@ inline double hourglass_pair_energy(double k, const Vec3& du, const Mat3& G_sum,
   return 0.5 * k * hourglass_residual(du, G_sum, x).squaredNorm();
 }
 
-/// k r_ij, the pair's force on u_i (and minus it on u_j), into `force`, generic over the vector type: Vec3,
-/// or the stencil loop's padded 4-lane vectors (written through a reference, not returned: GCC builds
-/// without AVX warn that returning a 4-lane vector changes the ABI). g0..g2 are the columns of G_i + G_j,
-/// x = X_j - X_i.
+/// k r_ij, the pair's force on u_i (and minus it on u_j), generic over the vector type: Vec3, or the stencil
+/// loop's padded 4-lane vectors. g0..g2 are the columns of G_i + G_j, x = X_j - X_i. (GCC builds without AVX
+/// note that returning a 4-lane vector changes the ABI: stencil_loop.hpp silences that for its translation
+/// units; the function is always inlined.)
 template <class V>
-PH_ALWAYS_INLINE inline void hourglass_pair_force(V& force, double k, const V& du, const V& g0, const V& g1, const V& g2,
-                                                  double x0, double x1, double x2) {
+PH_ALWAYS_INLINE inline V hourglass_pair_force(double k, const V& du, const V& g0, const V& g1, const V& g2, double x0,
+                                               double x1, double x2) {
   const double kh = 0.5 * k;
-  force = k * du - (g0 * (kh * x0) + g1 * (kh * x1) + g2 * (kh * x2));
+  return k * du - (g0 * (kh * x0) + g1 * (kh * x1) + g2 * (kh * x2));
 }
 
 /// The pair coefficients k_ij (model.hg_coef) from the kernel weights w (per pair) and their sums per point,
