@@ -22,6 +22,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <type_traits>
 
 namespace pointhaptics::detail {
 
@@ -92,6 +93,9 @@ void stencil_loop(const Model& model, const PaddedPoints& u, const PaddedGradien
   const double* U = u.data();
   const double* Gall = gradients.data();
   double* out = y.data();
+  // a local copy of the stress map: its constants (a material's moduli, pointers) cannot alias the forces
+  // written below, so they stay in registers instead of being reloaded for every stencil (5% of the loop)
+  const std::decay_t<StressMap> stress_map = stress;
 
   for (index_t i = first; i < last; ++i) {
     const index_t e0 = nbr.begin(i), e1 = nbr.end(i);
@@ -99,7 +103,7 @@ void stencil_loop(const Model& model, const PaddedPoints& u, const PaddedGradien
     const Lane4 Gi0 = load4(gi), Gi1 = load4(gi + 4), Gi2 = load4(gi + 8);
     Mat3 G;
     G << Gi0[0], Gi1[0], Gi2[0], Gi0[1], Gi1[1], Gi2[1], Gi0[2], Gi1[2], Gi2[2];
-    const Mat3 A = stress(i, G);
+    const Mat3 A = stress_map(i, G);
     Lane4 A0 = {A(0, 0), A(1, 0), A(2, 0), 0.0}, A1 = {A(0, 1), A(1, 1), A(2, 1), 0.0},
           A2 = {A(0, 2), A(1, 2), A(2, 2), 0.0};
     Lane4 self = {};
