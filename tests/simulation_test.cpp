@@ -40,6 +40,38 @@ TEST(SceneBuilder, EmptyBoxesAndBadPointsAreNamedErrors) {
   EXPECT_THROW(build_scene_model(parse_scene(point)), Error);
 }
 
+TEST(SceneBuilder, FixedTablesSelectBySphereOrCylinder) {
+  // the cantilever's 21 x 5 x 5 lattice, 7.5 mm apart, held by a sphere around its tip-face centre and by a
+  // cylinder along its axis (issue 17 asks for both, e.g. a punch on the top face)
+  std::string text = cantilever;
+  const std::string box = "box = { min = [-1.0, -1.0, -1.0], max = [0.0, 1.0, 1.0] }";
+  text.replace(text.find(box), box.size(), "sphere = { centre = [0.15, 0.015, 0.015], radius = 0.0075 }");
+  const Model ball = build_scene_model(parse_scene(text));
+  ASSERT_EQ(ball.fixed_groups.size(), 1u);
+  EXPECT_EQ(ball.fixed_groups[0].points.size(), 6u);  // the centre and its 5 lattice neighbours (faces included)
+  text = cantilever;
+  text.replace(text.find(box), box.size(),
+               "cylinder = { centre = [0.075, 0.015, 0.015], axis = [1, 0, 0], radius = 0.0075, half_length = 0.0375 }");
+  const Model rod = build_scene_model(parse_scene(text));
+  EXPECT_EQ(rod.fixed_groups[0].points.size(), 11u * 5u);  // 11 cross-sections of the centre and its 4 neighbours
+  for (const index_t i : rod.fixed_groups[0].points) {
+    EXPECT_LE(std::abs(rod.X(0, i) - 0.075), 0.0375 + 1e-12);
+    EXPECT_LE(std::hypot(rod.X(1, i) - 0.015, rod.X(2, i) - 0.015), 0.0075 + 1e-12);
+  }
+  // exactly one selector, and an empty one is named
+  text = cantilever;
+  text.replace(text.find(box), box.size(), box + "\nsphere = { centre = [0.15, 0.015, 0.015], radius = 0.0075 }");
+  EXPECT_THROW(parse_scene(text), Error);
+  text = cantilever;
+  text.replace(text.find(box), box.size(), "sphere = { centre = [5.0, 0.0, 0.0], radius = 0.001 }");
+  try {
+    build_scene_model(parse_scene(text, "c.toml"));
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("fixed[0].sphere: holds no point"), std::string::npos) << e.what();
+  }
+}
+
 double tip_deflection(const Simulation& sim) {
   double tip = 0;
   int n = 0;

@@ -53,7 +53,10 @@ int run_beam_experiment(const BeamOptions& options) {
     p.poisson = scene.material.poisson;
     p.density = scene.material.density;
     p.nlgeom = true;
-    for (const FixedSpec& f : scene.fixed) p.clamps.push_back({f.box.min, f.box.max});
+    for (const FixedSpec& f : scene.fixed) {
+      if (f.sphere || f.cylinder) throw Error(fmt::format("beam-4x1x1: {}: the CalculiX model takes [[fixed]] boxes only", scene.path));
+      p.clamps.push_back({f.box.min, f.box.max});
+    }
     for (const LoadSpec& l : scene.loads) {
       if (l.kind == LoadKind::GRAVITY) p.gravity = l.g;
       else throw Error(fmt::format("{}: the beam experiment supports gravity loads only", options.scene));

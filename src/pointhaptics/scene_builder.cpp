@@ -93,15 +93,40 @@ PointCloud sample_object(const Scene& scene) {
 
 namespace {
 
+// a relative tolerance so that a region drawn on a face catches the points on it
+double region_tolerance(const Model& model) { return 1e-9 * std::max(model.h, 1e-12); }
+
 std::vector<index_t> points_in(const Model& model, const Aabb& box) {
-  // a relative tolerance so that a box drawn on a face catches the points on it
-  const double tol = 1e-9 * std::max(model.h, 1e-12);
+  const double tol = region_tolerance(model);
   Aabb grown{box.min.array() - tol, box.max.array() + tol};
   std::vector<index_t> inside;
   for (index_t i = 0; i < model.n_points; ++i)
     if (grown.contains(model.X.col(i))) inside.push_back(i);
   return inside;
 }
+
+// the points a [[fixed]] table selects: its box, sphere or cylinder
+std::vector<index_t> points_in(const Model& model, const FixedSpec& spec) {
+  if (!spec.sphere && !spec.cylinder) return points_in(model, spec.box);
+  const double tol = region_tolerance(model);
+  std::vector<index_t> inside;
+  for (index_t i = 0; i < model.n_points; ++i) {
+    const Vec3 x = model.X.col(i);
+    bool in = false;
+    if (spec.sphere) {
+      in = (x - spec.sphere->centre).norm() <= spec.sphere->radius + tol;
+    } else {
+      const CylinderRegion& c = *spec.cylinder;
+      const Vec3 d = x - c.centre;
+      const double along = d.dot(c.axis);
+      in = std::abs(along) <= c.half_length + tol && (d - along * c.axis).norm() <= c.radius + tol;
+    }
+    if (in) inside.push_back(i);
+  }
+  return inside;
+}
+
+const char* region_key(const FixedSpec& spec) { return spec.sphere ? "sphere" : spec.cylinder ? "cylinder" : "box"; }
 
 }  // namespace
 
@@ -119,9 +144,9 @@ Model build_scene_model(const Scene& scene, double max_memory) {
     group.name = fmt::format("fixed[{}]", k);
     group.displacement = spec.displacement;
     group.ramp = spec.ramp;
-    group.points = points_in(model, spec.box);
+    group.points = points_in(model, spec);
     if (group.points.empty())
-      throw Error(fmt::format("{}:{}: fixed[{}].box: holds no point of the object", scene.path, spec.line, k));
+      throw Error(fmt::format("{}:{}: fixed[{}].{}: holds no point of the object", scene.path, spec.line, k, region_key(spec)));
     for (index_t i : group.points) model.fixed[i] = 1;
     model.fixed_groups.push_back(std::move(group));
   }

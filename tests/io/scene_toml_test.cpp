@@ -143,6 +143,25 @@ TEST(SceneToml, UnknownChoicesListTheAllowedOnes) {
   EXPECT_EQ(parse_scene(svk).material.model, MaterialModel::SVK);
 }
 
+TEST(SceneToml, FixedRegionsAreCheckedAndNamed) {
+  const std::string box = "box = { min = [-1.0, -1.0, -1.0], max = [0.0, 1.0, 1.0] }";
+  EXPECT_NE(error_of(box, "ramp = 0.0").find("give exactly one of box"), std::string::npos);
+  EXPECT_NE(error_of(box, "sphere = { centre = [0, 0, 0] }").find("a sphere needs centre"), std::string::npos);
+  EXPECT_NE(error_of(box, "sphere = { centre = [0, 0, 0], radius = -1 }").find("radius"), std::string::npos);
+  EXPECT_NE(error_of(box, "cylinder = { centre = [0, 0, 0], axis = [0, 0, 0], radius = 1, half_length = 1 }")
+                .find("axis: must not be zero"),
+            std::string::npos);
+  EXPECT_NE(error_of(box, "cylinder = { centre = [0, 0, 0], axis = [0, 1, 0], radius = 1 }").find("half_length"),
+            std::string::npos);
+  EXPECT_NE(error_of(box, "sphere = { centre = [0, 0, 0], radius = 1, colour = 2 }").find("colour"), std::string::npos);
+  std::string text = full_scene;
+  text.replace(text.find(box), box.size(), "cylinder = { centre = [0, 0, 0], axis = [0, 2, 0], radius = 0.01, half_length = 0.02 }");
+  const Scene s = parse_scene(text);
+  ASSERT_TRUE(s.fixed[0].cylinder.has_value());
+  EXPECT_LE((s.fixed[0].cylinder->axis - Vec3::UnitY()).norm(), 1e-15);  // normalised
+  EXPECT_FALSE(s.fixed[0].sphere.has_value());
+}
+
 TEST(SceneToml, MissingRequiredKeys) {
   EXPECT_NE(error_of("total = [0.0, -0.01, 0.0]", "").find("load[0].total"), std::string::npos);
   EXPECT_NE(error_of("size    = [0.15, 0.03, 0.03]", "").find("object.size"), std::string::npos);

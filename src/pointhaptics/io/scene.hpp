@@ -4,6 +4,7 @@
 #include <pointhaptics/core/types.hpp>
 
 #include <array>
+#include <optional>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -33,8 +34,24 @@ struct ObjectSpec {
   int line = 0;                        ///< of the [object] table, for messages
 };
 
+/// A ball of points: |X - centre| <= radius.
+struct SphereRegion {
+  Vec3 centre = Vec3::Zero();
+  double radius = 0;  ///< m
+};
+/// A solid cylinder of points: |a| <= half_length and |d - a axis| <= radius, d = X - centre, a = d . axis.
+struct CylinderRegion {
+  Vec3 centre = Vec3::Zero();
+  Vec3 axis = Vec3::UnitY();  ///< unit
+  double radius = 0, half_length = 0;  ///< m
+};
+
 struct FixedSpec {
-  Aabb box;                                ///< points inside (faces included) are held
+  /// Which points are held (faces included): those in `box`, or in `sphere` or `cylinder` when one is given
+  /// (a scene gives exactly one of the three).
+  Aabb box;
+  std::optional<SphereRegion> sphere;
+  std::optional<CylinderRegion> cylinder;
   Vec3 displacement = Vec3::Zero();        ///< prescribed displacement, m
   double ramp = 0;                         ///< ramp-in time, s
   int line = 0;                            ///< line of the [[fixed]] table, for messages

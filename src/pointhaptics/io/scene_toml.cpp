@@ -271,7 +271,31 @@ void read_solver(TableReader& r, SolverSpec& s) {
 FixedSpec read_fixed(TableReader& r) {
   FixedSpec f;
   f.line = r.line();
-  f.box = r.box("box", true);
+  const int selectors = (r.find("box") != nullptr) + (r.find("sphere") != nullptr) + (r.find("cylinder") != nullptr);
+  if (selectors != 1)
+    r.fail_table("box", "give exactly one of box = { min, max }, sphere = { centre, radius } or "
+                        "cylinder = { centre, axis, radius, half_length } (m)");
+  if (r.find("box")) f.box = r.box("box", true);
+  if (const toml::table* t = r.subtable("sphere")) {
+    TableReader s(r.context(), *t, r.name("sphere"));
+    if (!t->get("centre") || !t->get("radius")) s.fail_table("centre", "a sphere needs centre = [x, y, z] and radius (m)");
+    f.sphere = SphereRegion{s.vec3("centre", Vec3::Zero()), s.number("radius", 0.0, positive, "must be > 0 (m)")};
+    s.finish();
+  }
+  if (const toml::table* t = r.subtable("cylinder")) {
+    TableReader c(r.context(), *t, r.name("cylinder"));
+    for (const char* key : {"centre", "axis", "radius", "half_length"})
+      if (!t->get(key)) c.fail_table(key, "a cylinder needs centre, axis, radius and half_length (m)");
+    CylinderRegion cyl;
+    cyl.centre = c.vec3("centre", cyl.centre);
+    const Vec3 axis = c.vec3("axis", cyl.axis);
+    if (!(axis.norm() > 0)) c.fail_at(*t->get("axis"), "axis", "must not be zero");
+    cyl.axis = axis.normalized();
+    cyl.radius = c.number("radius", 0.0, positive, "must be > 0 (m)");
+    cyl.half_length = c.number("half_length", 0.0, positive, "must be > 0 (m)");
+    c.finish();
+    f.cylinder = cyl;
+  }
   f.displacement = r.vec3("displacement", f.displacement);
   f.ramp = r.number("ramp", 0.0, non_negative, "must be >= 0 (s)");
   return f;
