@@ -45,17 +45,10 @@ LevelsOfDetail::LevelsOfDetail(ModelSimulation&& object, const LodParams& params
   full_ = std::move(object.model_);
   full_state_ = object.state_;
   tree_ = std::make_unique<KdTree>(full_.X);
-  // the first active set: built here, before any step (set-up, not a stall); the object's diagnostics,
-  // inputs and probe carry over
-  LodBuild first = build_lod(full_, params_, snap(contact), solver_.kind);
-  StepDiagnostics diagnostics = std::move(object.diagnostics_);
-  std::optional<ProbeAttachment> probe = std::move(object.probe_);
-  const StepInputs inputs = object.inputs_;
-  active_ = std::make_unique<ModelSimulation>(first.active.model, solver_, n_threads_, first.stable_dt);
-  active_->diagnostics_ = std::move(diagnostics);
-  active_->inputs_ = inputs;
-  active_->probe_ = std::move(probe);
-  take_over(std::move(first), true);
+  // the object's simulation, its model taken, hands its diagnostics, inputs and probe to the first active
+  // set like any re-selection; built here, before any step (set-up, not a stall)
+  active_ = std::make_unique<ModelSimulation>(std::move(object));
+  take_over(build_lod(full_, params_, snap(contact), solver_.kind), true);
 }
 
 LevelsOfDetail::~LevelsOfDetail() {
@@ -140,7 +133,7 @@ std::vector<index_t> LevelsOfDetail::take_over(LodBuild build, bool built_here) 
   const auto start = std::chrono::steady_clock::now();
   const bool first = selections_ == 0;  // the constructor's, before any step: set-up, not a stall
   ActiveSet& next = build.active;
-  std::vector<index_t> new_index(static_cast<std::size_t>(active_->model().n_points), -1);
+  std::vector<index_t> new_index(first ? 0 : static_cast<std::size_t>(active_->model().n_points), -1);
   double energy_before = 0;
   State carried = full_state_;
   if (!first) {
@@ -156,15 +149,13 @@ std::vector<index_t> LevelsOfDetail::take_over(LodBuild build, bool built_here) 
   State state = next.restrict_state(carried);
   state.time = time;
   if (!first) remove_added_energy(next.model, energy_before, state);
-  if (!first) {
-    // a new simulation of the new active model; what the pipeline carries (diagnostics, inputs, the probe,
-    // renumbered: grabbed points follow their new numbers) moves over
-    auto sim = std::make_unique<ModelSimulation>(next.model, solver_, n_threads_, build.stable_dt);
-    sim->diagnostics_ = std::move(active_->diagnostics_);
-    sim->inputs_ = active_->inputs_;
-    sim->probe_ = std::move(active_->probe_);
-    active_ = std::move(sim);
-  }
+  // a new simulation of the new active model; what the pipeline carries (diagnostics, inputs, the probe,
+  // renumbered: grabbed points follow their new numbers, none at the first selection) moves over
+  auto sim = std::make_unique<ModelSimulation>(next.model, solver_, n_threads_, build.stable_dt);
+  sim->diagnostics_ = std::move(active_->diagnostics_);
+  sim->inputs_ = active_->inputs_;
+  sim->probe_ = std::move(active_->probe_);
+  active_ = std::move(sim);
   if (active_->probe_) active_->probe_->tool.remap(active_->model(), new_index);
   active_->set_state(state);
   active_set_ = std::move(next);
