@@ -110,7 +110,6 @@ struct OutputErrors {
 };
 
 int run_command(const RunOptions& opt) {
-  const auto start = std::chrono::steady_clock::now();
   // the ParaView folder first (made with its parents, so other outputs may go beside it), then every output
   // is checked before anything is computed: a long run must not end in "cannot write"
   std::optional<ph::VtkSeries> vtk;
@@ -124,7 +123,7 @@ int run_command(const RunOptions& opt) {
   ph::SceneSession session = ph::open_scene_file(opt.scene, session_options);
   const ph::Scene& scene = session.scene;
   ph::Simulation& sim = *session.simulation;
-  const double setup_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double setup_s = session.setup_seconds;
   if (vtk) ph::add_vtk_frame(*vtk, sim);  // the initial state
   const double start_time = sim.time();
   const bool options_real_time = !opt.deterministic;

@@ -22,7 +22,7 @@ struct SceneSession {
   std::unique_ptr<Device> device;
   /// With a [probe]: the probe, workspace mapping and duration of the scene (scene_interactive_options()).
   InteractiveOptions interactive;
-  double setup_seconds = 0;  ///< building the model, the solver and the first active set, s
+  double setup_seconds = 0;  ///< reading the scene file (open_scene_file), building the model, the solver and the first active set, s
 };
 
 /// Build `scene`: its model (refused beyond options.max_memory), its simulation, levels of detail around
