@@ -1,6 +1,7 @@
 #include <pointhaptics/model_simulation.hpp>
 
 #include <pointhaptics/core/error.hpp>
+#include <pointhaptics/mechanics/inversion.hpp>
 #include <pointhaptics/solvers/explicit_solver.hpp>
 
 #include <fmt/format.h>
@@ -39,8 +40,9 @@ const StepReport& ModelSimulation::step() {
   // the solver: internal, external and tool forces, time integration or equilibrium, held points
   report_ = solver_impl_->step(model_, state_, ws_, probe_ ? &probe_->tool : nullptr);
   const auto solved = clock::now();
-  // a state that is not finite is not a result, whatever the solver said
+  // a state that is not finite is not a result, whatever the solver said; nor is an inverted one (counted)
   check_finite(report_);
+  count_inverted_neighbourhoods();
   const auto seconds = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
   diagnostics_.tools_seconds += seconds(start, placed);
   diagnostics_.solve_seconds += seconds(placed, solved);
@@ -56,6 +58,13 @@ void ModelSimulation::check_finite(StepReport& report) const {
   if (report.status == StepStatus::FAILED || state_.u.allFinite()) return;
   report.status = StepStatus::FAILED;
   report.failure = fmt::format("the state is not finite at t = {:.6g} s", state_.time);
+}
+
+void ModelSimulation::count_inverted_neighbourhoods() {
+  StepDiagnostics& d = diagnostics_;
+  d.inverted = count_inverted(model_, ws_);
+  d.inverted_steps += d.inverted > 0;
+  d.max_inverted = std::max(d.max_inverted, d.inverted);
 }
 
 void ModelSimulation::record(const StepReport& report, double seconds) {

@@ -29,6 +29,10 @@ struct StepDiagnostics {
   long long cg_iterations = 0;
   long long budget_steps = 0;   ///< implicit steps the iteration budget ended above the tolerance
   double residual = 0;          ///< the last Newton residual
+  long long inverted_steps = 0; ///< steps that ended with inverted neighbourhoods (det F <= 0)
+  index_t inverted = 0;         ///< inverted neighbourhoods at the end of the last step (of its last force
+                                ///< evaluation: explicit steps one sub-step before the end)
+  index_t max_inverted = 0;     ///< the most at the end of any step
   StepStatus status = StepStatus::CONVERGED;  ///< of the last step
   bool failed = false;          ///< a step failed: the state is not a result, and no step follows
   std::string failure;          ///< why
@@ -73,6 +77,7 @@ class ModelSimulation {
   friend class LevelsOfDetail;  // takes the object's model, state, diagnostics and probe over
   void place_tools();
   void check_finite(StepReport& report) const;
+  void count_inverted_neighbourhoods();
   void record(const StepReport& report, double seconds);
 
   Model model_;

@@ -96,37 +96,40 @@ namespace {
 // a relative tolerance so that a region drawn on a face catches the points on it
 double region_tolerance(const Model& model) { return 1e-9 * std::max(model.h, 1e-12); }
 
-std::vector<index_t> points_in(const Model& model, const Aabb& box) {
-  const double tol = region_tolerance(model);
-  Aabb grown{box.min.array() - tol, box.max.array() + tol};
+// the points of X a selector (a [[fixed]] or [[region]] table, a load's box) takes
+std::vector<index_t> points_in(const Points& X, const PointSelector& where, double tol) {
   std::vector<index_t> inside;
-  for (index_t i = 0; i < model.n_points; ++i)
-    if (grown.contains(model.X.col(i))) inside.push_back(i);
+  for (index_t i = 0; i < X.cols(); ++i)
+    if (where.contains(X.col(i), tol)) inside.push_back(i);
   return inside;
 }
+std::vector<index_t> points_in(const Model& model, const Aabb& box) { return points_in(model.X, PointSelector{box, {}, {}}, region_tolerance(model)); }
 
-// the points a [[fixed]] table selects: its box, sphere or cylinder
-std::vector<index_t> points_in(const Model& model, const FixedSpec& spec) {
-  if (!spec.sphere && !spec.cylinder) return points_in(model, spec.box);
-  const double tol = region_tolerance(model);
-  std::vector<index_t> inside;
-  for (index_t i = 0; i < model.n_points; ++i) {
-    const Vec3 x = model.X.col(i);
-    bool in = false;
-    if (spec.sphere) {
-      in = (x - spec.sphere->centre).norm() <= spec.sphere->radius + tol;
-    } else {
-      const CylinderRegion& c = *spec.cylinder;
-      const Vec3 d = x - c.centre;
-      const double along = d.dot(c.axis);
-      in = std::abs(along) <= c.half_length + tol && (d - along * c.axis).norm() <= c.radius + tol;
-    }
-    if (in) inside.push_back(i);
+// [[region]] tables: each point's material, the object's unless a region (the last one that holds it) says
+// otherwise; none without regions
+void assign_region_materials(const Scene& scene, const Points& X, std::vector<MaterialParams>& materials,
+                             std::vector<std::uint8_t>& material_of) {
+  if (scene.regions.empty()) return;
+  if (scene.regions.size() + 1 > max_point_materials)
+    throw Error(fmt::format("{}:{}: region: {} [[region]] tables; at most {}", scene.path, scene.regions.back().line,
+                            scene.regions.size(), max_point_materials - 1));
+  materials = {scene.material};
+  material_of.assign(static_cast<std::size_t>(X.cols()), 0);
+  const double tol = 1e-9 * std::max(scene.object.spacing, 1e-12);
+  for (std::size_t k = 0; k < scene.regions.size(); ++k) {
+    const RegionSpec& r = scene.regions[k];
+    MaterialParams m = scene.material;
+    if (r.model) m.model = *r.model;
+    if (r.young) m.young = *r.young;
+    if (r.poisson) m.poisson = *r.poisson;
+    if (r.density) m.density = *r.density;
+    materials.push_back(m);
+    const std::vector<index_t> inside = points_in(X, r, tol);
+    if (inside.empty())
+      throw Error(fmt::format("{}:{}: region[{}].{}: holds no point of the object", scene.path, r.line, k, r.key()));
+    for (const index_t i : inside) material_of[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(k + 1);
   }
-  return inside;
 }
-
-const char* region_key(const FixedSpec& spec) { return spec.sphere ? "sphere" : spec.cylinder ? "cylinder" : "box"; }
 
 }  // namespace
 
@@ -135,7 +138,10 @@ Model build_scene_model(const Scene& scene, double max_memory) {
   check_model_fits(estimated_points(scene), scene, max_memory);
   const PointCloud cloud = sample_object(scene);
   check_model_fits(static_cast<double>(cloud.X.cols()), scene, max_memory);
-  Model model = build_model(cloud, scene.material, scene.kernel);
+  std::vector<MaterialParams> materials;
+  std::vector<std::uint8_t> material_of;
+  assign_region_materials(scene, cloud.X, materials, material_of);
+  Model model = build_model(cloud, scene.material, scene.kernel, std::move(materials), std::move(material_of));
 
   // held points, one group per [[fixed]] table
   for (size_t k = 0; k < scene.fixed.size(); ++k) {
@@ -144,9 +150,9 @@ Model build_scene_model(const Scene& scene, double max_memory) {
     group.name = fmt::format("fixed[{}]", k);
     group.displacement = spec.displacement;
     group.ramp = spec.ramp;
-    group.points = points_in(model, spec);
+    group.points = points_in(model.X, spec, region_tolerance(model));
     if (group.points.empty())
-      throw Error(fmt::format("{}:{}: fixed[{}].{}: holds no point of the object", scene.path, spec.line, k, region_key(spec)));
+      throw Error(fmt::format("{}:{}: fixed[{}].{}: holds no point of the object", scene.path, spec.line, k, spec.key()));
     for (index_t i : group.points) model.fixed[i] = 1;
     model.fixed_groups.push_back(std::move(group));
   }

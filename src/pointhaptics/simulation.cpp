@@ -3,7 +3,10 @@
 #include <pointhaptics/core/error.hpp>
 #include <pointhaptics/mechanics/energy.hpp>
 #include <pointhaptics/mechanics/forces.hpp>
+#include <pointhaptics/mechanics/inversion.hpp>
 #include <pointhaptics/solvers/reactions.hpp>
+
+#include <fmt/format.h>
 
 #include <chrono>
 #include <cmath>
@@ -97,6 +100,33 @@ const ActiveSet* Simulation::active_set() const { return lod_ ? &lod_->active_se
 const Selection* Simulation::lod_selection() const { return lod_ ? &lod_->selection() : nullptr; }
 long long Simulation::lod_selections() const { return lod_ ? lod_->selections() : 0; }
 
+namespace {
+
+// The end state is no result when neighbourhoods are inverted, or when a held group with a prescribed
+// displacement is pulled along by the body instead of pushing it (its support force against its motion: the
+// body gives work back, as a collapsed block does). ws holds the end state's gradients and s its reactions.
+void check_physical(const Model& model, Workspace& ws, const StepDiagnostics& d, RunSummary& s) {
+  s.inverted = count_inverted(model, ws);
+  s.inverted_steps = d.inverted_steps;
+  for (std::size_t g = 0; g < model.fixed_groups.size() && g < s.reactions.size(); ++g) {
+    const Vec3 motion = model.fixed_groups[g].displacement;
+    const Vec3& reaction = s.reactions[g];
+    if (motion.norm() > 0 && reaction.dot(motion) < -1e-6 * reaction.norm() * motion.norm())
+      s.collapsed.push_back(model.fixed_groups[g].name);
+  }
+  if (s.inverted == 0 && s.collapsed.empty()) return;
+  s.converged = false;
+  if (!s.failure.empty()) return;
+  if (s.inverted > 0)
+    s.failure = fmt::format("{} of {} neighbourhoods are inverted (det F <= 0): the state is not physical (try "
+                            "model = \"neo_hookean\", a finer load ramp or a finer spacing)", s.inverted, model.stencil_end());
+  else
+    s.failure = fmt::format("{}: the support force opposes the prescribed motion (the body collapsed: its stress fell "
+                            "instead of rising; try model = \"neo_hookean\")", s.collapsed.front());
+}
+
+}  // namespace
+
 RunSummary Simulation::summary() {
   ModelSimulation& sim = core();
   const Model& model = sim.model();
@@ -115,6 +145,7 @@ RunSummary Simulation::summary() {
   s.stable_dt = sim.stable_dt();
   compute_internal_forces(model, state.u, ws);
   s.reactions = support_reactions(model, ws.f_int);
+  check_physical(model, ws, d, s);
   // dynamics is out of balance by the inertia; its Newton residual includes it
   s.residual = sim.solver().kind == SolverKind::IMPLICIT ? d.residual : relative_residual(model, ws.f_int);
   s.strain_energy = strain_energy(model, state.u).total();

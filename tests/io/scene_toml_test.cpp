@@ -136,11 +136,48 @@ TEST(SceneToml, UnknownChoicesListTheAllowedOnes) {
   EXPECT_NE(error_of("shape   = \"box\"", "shape = \"cube\"").find("object.shape"), std::string::npos);
   EXPECT_NE(error_of("kind = \"explicit\"", "kind = \"rk4\"").find("solver.kind"), std::string::npos);
   // the material model: one table of names (core/parameters.hpp) for the scene, the CLI and Python
-  EXPECT_NE(error_of("young = 1e5", "model = \"jelly\"\nyoung = 1e5").find("material.model: unknown value \"jelly\" (expected svk)"),
+  EXPECT_NE(error_of("young = 1e5", "model = \"jelly\"\nyoung = 1e5").find("material.model: unknown value \"jelly\" (expected svk | neo_hookean | mooney_rivlin | corotated)"),
             std::string::npos);
   std::string svk = full_scene;
   svk.replace(svk.find("young = 1e5"), 11, "model = \"svk\"\nyoung = 1e5");
   EXPECT_EQ(parse_scene(svk).material.model, MaterialModel::SVK);
+}
+
+TEST(SceneToml, MooneyRivlinTakesC10C01AndBulkInsteadOfYoungAndPoisson) {
+  const std::string material = "young = 1e5\npoisson = 0.4";
+  std::string text = full_scene;
+  text.replace(text.find(material), material.size(), "model = \"mooney_rivlin\"\nc10 = 3000\nc01 = 1000\nbulk = 2e5");
+  const MaterialParams m = parse_scene(text).material;
+  EXPECT_EQ(m.model, MaterialModel::MOONEY_RIVLIN);
+  EXPECT_DOUBLE_EQ(m.c10, 3000);
+  EXPECT_NEAR(m.mu(), 2 * (3000 + 1000), 1e-9);  // young and poisson follow: the small-strain moduli
+  EXPECT_NEAR(m.bulk_modulus(), 2e5, 1e-6);
+  EXPECT_NE(error_of(material, "c10 = 3000\nc01 = 1000\nbulk = 2e5").find("material.c10: c10, c01 and bulk are Mooney-Rivlin's"),
+            std::string::npos);
+  EXPECT_NE(error_of(material, "model = \"mooney_rivlin\"\nc10 = 3000").find("give all of c10, c01 and bulk"), std::string::npos);
+  EXPECT_NE(error_of(material, "model = \"mooney_rivlin\"\nyoung = 1e5\nc10 = 3000\nc01 = 1\nbulk = 2e5").find("not both"),
+            std::string::npos);
+}
+
+TEST(SceneToml, RegionsTakeASelectorAndAnyOfTheMaterialKeys) {
+  std::string text = std::string(full_scene) + "\n[[region]]\nsphere = { centre = [0.05, 0.015, 0.015], radius = 0.01 }\nyoung = 1e6\n"
+                                  "model = \"neo_hookean\"\n\n[[region]]\nbox = { min = [0, 0, 0], max = [0.01, 0.03, 0.03] }\ndensity = 2000\n";
+  const Scene s = parse_scene(text);
+  ASSERT_EQ(s.regions.size(), 2u);
+  EXPECT_EQ(*s.regions[0].young, 1e6);
+  EXPECT_EQ(*s.regions[0].model, MaterialModel::NEO_HOOKEAN);
+  EXPECT_FALSE(s.regions[0].poisson.has_value());
+  EXPECT_EQ(*s.regions[1].density, 2000);
+  EXPECT_FALSE(s.regions[1].young.has_value());
+  const std::string bad = std::string(full_scene) + "\n[[region]]\nsphere = { centre = [0, 0, 0], radius = 0.01 }\nyoung = -3\n";
+  try {
+    parse_scene(bad, "bad.toml");
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("region[0].young"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(parse_scene(std::string(full_scene) + "\n[[region]]\nyoung = 1e6\n"), Error);  // no selector
+  EXPECT_THROW(parse_scene(std::string(full_scene) + "\n[[region]]\nbox = { min = [0, 0, 0], max = [1, 1, 1] }\nstiffness = 3\n"), Error);
 }
 
 TEST(SceneToml, FixedRegionsAreCheckedAndNamed) {

@@ -5,6 +5,8 @@
 #include <pointhaptics/core/parameters.hpp>
 #include <pointhaptics/core/types.hpp>
 
+#include <algorithm>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -30,8 +32,12 @@ struct Model {
   Eigen::VectorXd support;          ///< per-point support h_i, m, when they differ (levels of detail); else empty
   double extent = 0;                ///< diagonal of the reference bounding box plus h, m (scale for divergence checks)
   KernelParams kernel;
-  MaterialParams material;
-  double lambda = 0, mu = 0;        ///< Lame parameters, Pa
+  MaterialParams material;          ///< the object's material (its points' unless material_of says otherwise)
+  double lambda = 0, mu = 0;        ///< Lame parameters of `material`, Pa
+  /// per-point materials ([[region]] tables, a stiffness map): the point i has point_materials[material_of[i]]
+  /// (point_materials[0] is `material`); both empty when every point has `material`
+  std::vector<MaterialParams> point_materials;
+  std::vector<std::uint8_t> material_of;
 
   /// stencils: the neighbours j != i with |X_j - X_i| < h of each point i, as CSR (pairs e = (i, j)),
   /// each row sorted; symmetric (j is in i's row when i is in j's)
@@ -55,6 +61,15 @@ struct Model {
   /// are there only as neighbours of the others: the outer frozen ring of a level-of-detail active set,
   /// which completes the neighbourhoods (M_i, d_ij) of the held points next to the simulated ones.
   index_t n_passive = 0;
+
+  /// The material of point i.
+  const MaterialParams& material_at(index_t i) const { return material_of.empty() ? material : point_materials[material_of[i]]; }
+  /// The largest P-wave modulus lambda + 2 mu over the object's materials, Pa (the explicit stable step).
+  double max_p_wave_modulus() const {
+    double m = material.lambda() + 2 * material.mu();
+    for (const MaterialParams& p : point_materials) m = std::max(m, p.lambda() + 2 * p.mu());
+    return m;
+  }
 
   index_t n_pairs() const { return neighbours.n_entries(); }
   /// Points [0, stencil_end()) carry a stencil.

@@ -26,7 +26,10 @@ enum class VolumeMode {
 
 /// The constitutive models (mechanics/energies/: one file each, and a line in material.hpp's registry).
 enum class MaterialModel {
-  SVK,  ///< St. Venant-Kirchhoff, the seed's (Green strain, seed Eq. 2)
+  SVK,            ///< St. Venant-Kirchhoff, the seed's (Green strain, seed Eq. 2)
+  NEO_HOOKEAN,    ///< compressible neo-Hookean, CalculiX's NEO HOOKE (energies/neo_hookean.hpp)
+  MOONEY_RIVLIN,  ///< compressible Mooney-Rivlin, CalculiX's MOONEY-RIVLIN (energies/mooney_rivlin.hpp)
+  COROTATED,      ///< linear corotated (energies/corotated.hpp)
 };
 
 struct MaterialParams {
@@ -38,11 +41,16 @@ struct MaterialParams {
   double damping = 0.0;            ///< mass-proportional damping, 1/s
   double hourglass = 0.3;          ///< alpha of the zero-energy-mode penalty (averaged-gradient form, docs/mechanics.md); 0: off
   VolumeMode volume = VolumeMode::CELL;
+  /// Mooney-Rivlin's split of the shear modulus mu = 2 (c10 + c01), Pa: when given (the scene's c10, c01 and
+  /// bulk), young and poisson are set from them; otherwise both are mu / 4
+  double c10 = 0, c01 = 0;
 
   /// Lame's first parameter lambda = E nu / ((1 + nu)(1 - 2 nu)), Pa.
   double lambda() const { return young * poisson / ((1.0 + poisson) * (1.0 - 2.0 * poisson)); }
   /// Shear modulus mu = E / (2 (1 + nu)), Pa.
   double mu() const { return young / (2.0 * (1.0 + poisson)); }
+  /// Bulk modulus K = E / (3 (1 - 2 nu)), Pa.
+  double bulk_modulus() const { return young / (3.0 * (1.0 - 2.0 * poisson)); }
   /// P-wave speed sqrt((lambda + 2 mu + k_v) / rho), m/s: sets the explicit stable step.
   double p_wave_speed() const;
 };
@@ -107,7 +115,10 @@ struct EnumNames<KernelType> {
 };
 template <>
 struct EnumNames<MaterialModel> {
-  static constexpr std::array<std::pair<MaterialModel, std::string_view>, 1> table{{{MaterialModel::SVK, "svk"}}};
+  static constexpr std::array<std::pair<MaterialModel, std::string_view>, 4> table{{{MaterialModel::SVK, "svk"},
+                                                                                    {MaterialModel::NEO_HOOKEAN, "neo_hookean"},
+                                                                                    {MaterialModel::MOONEY_RIVLIN, "mooney_rivlin"},
+                                                                                    {MaterialModel::COROTATED, "corotated"}}};
 };
 template <>
 struct EnumNames<VolumeMode> {

@@ -36,6 +36,9 @@ std::string result_json(const Model& model, const State& state, const RunSummary
                    {"residual", s.residual},    {"steps", s.steps},         {"substeps", s.substeps},
                    {"stable_dt", s.stable_dt}, {"cg_iterations", s.cg_iterations}};
   if (!s.failure.empty()) doc["solver"]["failure"] = s.failure;
+  doc["solver"]["inverted"] = s.inverted;
+  doc["solver"]["inverted_steps"] = s.inverted_steps;
+  doc["solver"]["collapsed"] = s.collapsed;
   if (s.interrupted) doc["solver"]["interrupted"] = true;
   if (s.solver_kind == "implicit") doc["solver"]["budget_steps"] = s.budget_steps;
   doc["energy"] = {{"strain", s.strain_energy}, {"kinetic", s.kinetic_energy}};

@@ -42,6 +42,11 @@ struct RunSummary {
   std::string failure;          ///< static: why it did not converge (empty when it did)
   bool interrupted = false;     ///< the run was stopped (SIGINT, SIGTERM) before its end: the state reached
   std::vector<Vec3> reactions;  ///< per fixed group, N
+  /// not a physical result, whatever the residual: neighbourhoods inverted (det F <= 0) at the end, steps
+  /// that ended with some, and held groups whose support force opposes their prescribed motion (the body
+  /// pulls a plate that pushes it: a collapse); any of them makes `converged` false
+  long long inverted = 0, inverted_steps = 0;
+  std::vector<std::string> collapsed;  ///< the groups' names
   // haptic loop (runs with a probe)
   long long haptic_ticks = 0;
   double haptic_rate_hz = 0, haptic_period_p99_us = 0, haptic_max_force_n = 0;

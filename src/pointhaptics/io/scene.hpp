@@ -46,15 +46,39 @@ struct CylinderRegion {
   double radius = 0, half_length = 0;  ///< m
 };
 
-struct FixedSpec {
-  /// Which points are held (faces included): those in `box`, or in `sphere` or `cylinder` when one is given
-  /// (a scene gives exactly one of the three).
+/// Which points a [[fixed]] or [[region]] table selects (faces included): those in `box`, or in `sphere` or
+/// `cylinder` when one is given (a scene gives exactly one of the three).
+struct PointSelector {
   Aabb box;
   std::optional<SphereRegion> sphere;
   std::optional<CylinderRegion> cylinder;
+
+  /// The scene key that selects: "box", "sphere" or "cylinder".
+  const char* key() const { return sphere ? "sphere" : cylinder ? "cylinder" : "box"; }
+  /// Whether x lies in the region grown by tol (m).
+  bool contains(const Vec3& x, double tol) const {
+    if (sphere) return (x - sphere->centre).norm() <= sphere->radius + tol;
+    if (cylinder) {
+      const Vec3 d = x - cylinder->centre;
+      const double along = d.dot(cylinder->axis);
+      return std::abs(along) <= cylinder->half_length + tol && (d - along * cylinder->axis).norm() <= cylinder->radius + tol;
+    }
+    return (x.array() >= box.min.array() - tol).all() && (x.array() <= box.max.array() + tol).all();
+  }
+};
+
+struct FixedSpec : PointSelector {
   Vec3 displacement = Vec3::Zero();        ///< prescribed displacement, m
   double ramp = 0;                         ///< ramp-in time, s
   int line = 0;                            ///< line of the [[fixed]] table, for messages
+};
+
+/// [[region]]: a part of the object with its own material (a stiff nodule in soft tissue); the keys it
+/// omits are the object's [material]'s. Later tables win where regions overlap.
+struct RegionSpec : PointSelector {
+  std::optional<MaterialModel> model;
+  std::optional<double> young, poisson, density;  ///< Pa, -, kg/m^3
+  int line = 0;
 };
 
 enum class LoadKind { TRACTION, GRAVITY, POINT };
@@ -110,6 +134,7 @@ struct Scene {
   MaterialParams material;
   KernelParams kernel;
   std::vector<FixedSpec> fixed;
+  std::vector<RegionSpec> regions;
   std::vector<LoadSpec> loads;
   SolverSpec solver;
   ProbeSpec probe;

@@ -231,12 +231,45 @@ void read_object(TableReader& r, ObjectSpec& o, const Context& ctx) {
   o.line = r.line();
 }
 
+// the material keys a [material] table and a [[region]] share, with their ranges
+double read_young(TableReader& r, double fallback) {
+  // beyond any solid (steel is 2e11 Pa, air 1.2 kg/m^3): 1e300 Pa or 1e-320 kg/m^3 made the solver "diverge"
+  return r.number("young", fallback, [](double x) { return x > 0 && x <= 1e13; }, "must lie in (0, 1e13] (Pa)");
+}
+double read_poisson(TableReader& r, double fallback) {
+  return r.number("poisson", fallback, [](double x) { return x > -1 && x < 0.5; }, "must lie in (-1, 0.5)");
+}
+double read_density(TableReader& r, double fallback) {
+  return r.number("density", fallback, [](double x) { return x >= 1e-3 && x <= 1e5; }, "must lie in [1e-3, 1e5] (kg/m^3)");
+}
+
+// Mooney-Rivlin's c10, c01 and bulk (Pa), all three, instead of young and poisson, which are set from them
+// (mu = 2 (c10 + c01), K = bulk: E = 9 K mu / (3 K + mu), nu = (3 K - 2 mu) / (2 (3 K + mu)))
+void read_mooney_rivlin(TableReader& r, MaterialParams& m) {
+  const bool any = r.find("c10") || r.find("c01") || r.find("bulk");
+  if (!any) return;
+  const char* first = r.find("c10") ? "c10" : r.find("c01") ? "c01" : "bulk";
+  if (m.model != MaterialModel::MOONEY_RIVLIN)
+    r.fail_at(*r.find(first), first, "c10, c01 and bulk are Mooney-Rivlin's: set model = \"mooney_rivlin\" (or give young and poisson)");
+  if (!r.find("c10") || !r.find("c01") || !r.find("bulk")) r.fail_table(first, "give all of c10, c01 and bulk (Pa), or young and poisson");
+  if (r.find("young") || r.find("poisson"))
+    r.fail_at(*r.find(r.find("young") ? "young" : "poisson"), r.find("young") ? "young" : "poisson",
+              "give either young and poisson or c10, c01 and bulk, not both");
+  m.c10 = r.number("c10", 0.0, non_negative, "must be >= 0 (Pa)");
+  m.c01 = r.number("c01", 0.0, non_negative, "must be >= 0 (Pa)");
+  const double bulk = r.number("bulk", 0.0, positive, "must be > 0 (Pa)");
+  const double mu = 2 * (m.c10 + m.c01);
+  if (!(mu > 0)) r.fail_at(*r.find("c10"), "c10", "c10 + c01 must be > 0 (Pa)");
+  m.young = 9 * bulk * mu / (3 * bulk + mu);
+  m.poisson = (3 * bulk - 2 * mu) / (2 * (3 * bulk + mu));
+}
+
 void read_material(TableReader& r, MaterialParams& m) {
   m.model = r.enumeration("model", m.model);  // the registry: mechanics/energies/material.hpp
-  // beyond any solid (steel is 2e11 Pa, air 1.2 kg/m^3): 1e300 Pa or 1e-320 kg/m^3 made the solver "diverge"
-  m.young = r.number("young", m.young, [](double x) { return x > 0 && x <= 1e13; }, "must lie in (0, 1e13] (Pa)");
-  m.poisson = r.number("poisson", m.poisson, [](double x) { return x > -1 && x < 0.5; }, "must lie in (-1, 0.5)");
-  m.density = r.number("density", m.density, [](double x) { return x >= 1e-3 && x <= 1e5; }, "must lie in [1e-3, 1e5] (kg/m^3)");
+  m.young = read_young(r, m.young);
+  m.poisson = read_poisson(r, m.poisson);
+  m.density = read_density(r, m.density);
+  read_mooney_rivlin(r, m);
   m.volume_stiffness =
       r.number("volume_stiffness", m.volume_stiffness, [](double x) { return x >= 0 && x <= 1e13; }, "must lie in [0, 1e13] (Pa)");
   m.damping = r.number("damping", m.damping, non_negative, "must be >= 0 (1/s)");
@@ -268,9 +301,8 @@ void read_solver(TableReader& r, SolverSpec& s) {
   s.iteration_budget = count("iteration_budget", s.iteration_budget, 0, 1000);
 }
 
-FixedSpec read_fixed(TableReader& r) {
-  FixedSpec f;
-  f.line = r.line();
+// box = { min, max }, sphere = { centre, radius } or cylinder = { centre, axis, radius, half_length }: exactly one
+void read_selector(TableReader& r, PointSelector& f) {
   const int selectors = (r.find("box") != nullptr) + (r.find("sphere") != nullptr) + (r.find("cylinder") != nullptr);
   if (selectors != 1)
     r.fail_table("box", "give exactly one of box = { min, max }, sphere = { centre, radius } or "
@@ -296,10 +328,28 @@ FixedSpec read_fixed(TableReader& r) {
     c.finish();
     f.cylinder = cyl;
   }
+}
+
+FixedSpec read_fixed(TableReader& r) {
+  FixedSpec f;
+  f.line = r.line();
+  read_selector(r, f);
   f.displacement = r.vec3("displacement", f.displacement);
   f.ramp = r.number("ramp", 0.0, non_negative, "must be >= 0 (s)");
   return f;
 }
+
+RegionSpec read_region(TableReader& r) {
+  RegionSpec g;
+  g.line = r.line();
+  read_selector(r, g);
+  if (r.find("model")) g.model = r.enumeration("model", MaterialModel::SVK);
+  if (r.find("young")) g.young = read_young(r, 0);
+  if (r.find("poisson")) g.poisson = read_poisson(r, 0);
+  if (r.find("density")) g.density = read_density(r, 0);
+  return g;
+}
+
 
 LoadSpec read_load(TableReader& r) {
   LoadSpec l;
@@ -471,6 +521,7 @@ Scene parse_scene(std::string_view text, const std::string& name, const std::str
     throw Error(fmt::format("{}:{}: probe: a probe needs a dynamic solver (solver.kind = \"explicit\" or \"implicit\")",
                             name, scene.probe.line));
   read_array_of_tables(top, "fixed", [&](TableReader& r) { scene.fixed.push_back(read_fixed(r)); });
+  read_array_of_tables(top, "region", [&](TableReader& r) { scene.regions.push_back(read_region(r)); });
   read_array_of_tables(top, "load", [&](TableReader& r) { scene.loads.push_back(read_load(r)); });
   top.finish();
   if (scene.lod.present && !scene.probe.present && !scene.lod.contact.allFinite()) {

@@ -183,7 +183,10 @@ void build_model_of(const Model& full, ActiveCloud& c, index_t n_passive, Active
   c.cloud.support = c.support;
   KernelParams kernel = full.kernel;
   kernel.support = full.h;
-  a.model = build_model(c.cloud, full.material, kernel);
+  std::vector<std::uint8_t> material_of;  // the object's per-point materials, for the active points
+  if (!full.material_of.empty())
+    for (const index_t i : a.full_of) material_of.push_back(full.material_of[i]);
+  a.model = build_model(c.cloud, full.material, kernel, full.point_materials, std::move(material_of));
   a.model.mass = c.mass;  // kernel-volume mode included: the region's mass is what it was
   a.model.f_ext = c.f_ext;
   a.model.n_passive = n_passive;

@@ -37,7 +37,7 @@ EnergyTerms strain_energy(const Model& model, const Points& u, std::vector<Mat3>
             }
             if (i >= model.stencil_end()) continue;
             const double v = model.volume[i];
-            acc.elastic += v * energy.material.energy_density(G);
+            acc.elastic += v * energy.material_energy_density(i, G);
             acc.volume += v * energy.volume.energy_density(G);
           }
           return acc;

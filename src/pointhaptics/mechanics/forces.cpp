@@ -13,7 +13,7 @@ void internal_forces_of(const Energy energy, const Model& model, const Points& u
   const double* volume = model.volume.data();
   // the stress map captures by value: the material's constants stay in registers while the loop writes forces
   detail::stencil_sum(model, u, ws, ws.f_int, 1.0,
-                      [energy, volume](index_t i, const Mat3& G) PH_ALWAYS_INLINE -> Mat3 { return energy.scaled_stress(G, volume[i]); });
+                      [energy, volume](index_t i, const Mat3& G) PH_ALWAYS_INLINE -> Mat3 { return energy.scaled_stress(i, G, volume[i]); });
 }
 
 }  // namespace

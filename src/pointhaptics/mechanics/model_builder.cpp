@@ -43,10 +43,24 @@ double support_radius(const PointCloud& cloud, const KernelParams& kernel) {
 
 }  // namespace
 
-Model build_model(const PointCloud& cloud, const MaterialParams& material, const KernelParams& kernel) {
+Model build_model(const PointCloud& cloud, const MaterialParams& material, const KernelParams& kernel,
+                  std::vector<MaterialParams> point_materials, std::vector<std::uint8_t> material_of) {
   validate_material(material);
   const index_t n = cloud.size();
   if (n == 0) throw Error("model: the object has no points");
+  if (!material_of.empty()) {
+    if (static_cast<index_t>(material_of.size()) != n) throw Error("model: per-point materials must give one per point");
+    if (point_materials.empty() || point_materials.size() > max_point_materials)
+      throw Error(fmt::format("model: {} materials in one object; at most {} (the object's and its regions')",
+                              point_materials.size(), max_point_materials));
+    for (const MaterialParams& p : point_materials) {
+      validate_material(p);
+      if (p.volume_stiffness != material.volume_stiffness || p.hourglass != material.hourglass || p.volume != material.volume)
+        throw Error("model: regions may change young, poisson, density and model; volume_stiffness, hourglass and volume are the object's");
+    }
+    for (const std::uint8_t k : material_of)
+      if (k >= point_materials.size()) throw Error(fmt::format("model: per-point material {} does not exist", int{k}));
+  }
   if (!cloud.X.allFinite()) throw Error("model: the point positions contain NaN or infinity");
 
   Model model;
@@ -55,6 +69,8 @@ Model build_model(const PointCloud& cloud, const MaterialParams& material, const
   model.spacing = cloud.spacing;
   model.kernel = kernel;
   model.material = material;
+  model.point_materials = std::move(point_materials);
+  model.material_of = std::move(material_of);
   model.lambda = material.lambda();
   model.mu = material.mu();
   model.h = support_radius(cloud, kernel);
@@ -112,11 +128,13 @@ Model build_model(const PointCloud& cloud, const MaterialParams& material, const
     throw Error("model: every point needs a positive sampling volume");
   if (material.volume == VolumeMode::CELL) {
     model.volume = cloud.volume;
-    model.mass = material.density * model.volume;
+    model.mass.resize(n);
+    for (index_t i = 0; i < n; ++i) model.mass[i] = model.material_at(i).density * model.volume[i];
   } else {
     // seed Eq. 7-8: equal masses, kernel-summed density (self term included; the viscosity
     // kernel is infinite at r = 0, so it is left out there)
-    const double total_mass = material.density * cloud.volume.sum();
+    double total_mass = 0;
+    for (index_t i = 0; i < n; ++i) total_mass += model.material_at(i).density * cloud.volume[i];
     model.mass = Eigen::VectorXd::Constant(n, total_mass / n);
     model.volume.resize(n);
     for (index_t i = 0; i < n; ++i) {

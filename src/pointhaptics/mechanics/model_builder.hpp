@@ -3,6 +3,9 @@
 #include <pointhaptics/core/model.hpp>
 #include <pointhaptics/core/point_cloud.hpp>
 
+#include <cstdint>
+#include <vector>
+
 namespace pointhaptics {
 
 /// Condition number of M_i above which the neighbourhood is regularised (M + eps tr(M) I).
@@ -12,7 +15,13 @@ inline constexpr double max_moment_condition = 1e6;
 /// d_ij and d_ii (Eq. 10), and the hourglass coefficients. All points are free and unloaded; the
 /// scene builder adds boundary conditions and loads before the model is used.
 /// Throws Error on invalid parameters or coincident points.
-Model build_model(const PointCloud& cloud, const MaterialParams& material, const KernelParams& kernel);
+/// `point_materials` and `material_of` (optional, Model's): the points' own materials, which may change
+/// young, poisson, density and model; at most max_point_materials of them.
+Model build_model(const PointCloud& cloud, const MaterialParams& material, const KernelParams& kernel,
+                  std::vector<MaterialParams> point_materials = {}, std::vector<std::uint8_t> material_of = {});
+
+/// The most materials one object mixes (its own and its regions'), as energies/material.hpp's table holds.
+inline constexpr std::size_t max_point_materials = 32;
 
 /// Throws Error naming `name` if a free point has no neighbour within its support: nothing holds it, it
 /// has no strain and the run would report success on nonsense (issue 21). Call once the held points are set.

@@ -20,7 +20,7 @@ PointFields point_fields(const Model& model, const Points& u) {
       for (index_t i = range.begin(); i != range.end(); ++i) {
         const Mat3 G = displacement_gradient(model, u, i);  // seed Eq. 10
         const Mat3 F = Mat3::Identity() + G;
-        const Mat3 P = energy.stress(G);
+        const Mat3 P = energy.stress(i, G);
         const double J = F.determinant();
         // sigma = P F^T / J; a point whose neighbourhood inverted has no meaningful Cauchy stress: report the
         // first Piola-Kirchhoff one rather than divide by J <= 0
@@ -28,7 +28,7 @@ PointFields point_fields(const Model& model, const Points& u) {
         Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(f.cauchy_stress.col(i).data()) = sigma;
         const Mat3 dev = sigma - sigma.trace() / 3.0 * Mat3::Identity();
         f.von_mises[i] = std::sqrt(1.5 * (dev.array() * dev.array()).sum());
-        f.energy_density[i] = energy.energy_density(G);
+        f.energy_density[i] = energy.energy_density(i, G);
       }
     });
   });

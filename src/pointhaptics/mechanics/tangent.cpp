@@ -52,7 +52,7 @@ void Tangent::linearise(const Model& model, const Points& u, TangentMode mode, W
     linearisation_.resize(doubles_of<L> * static_cast<std::size_t>(model.n_points));
     double* base = linearisation_.data();
     for_each_point(model.n_points, ws, [&](index_t i) {
-      const L at = energy.linearise(displacement_gradient(model, u, i), mode == TangentMode::PROJECTED);  // seed Eq. 10
+      const L at = energy.linearise(i, displacement_gradient(model, u, i), mode == TangentMode::PROJECTED);  // seed Eq. 10
       std::memcpy(static_cast<void*>(base + doubles_of<L> * static_cast<std::size_t>(i)), &at, sizeof(L));
     });
   });
@@ -66,7 +66,7 @@ void Tangent::apply(const Model& model, const Points& du, Workspace& ws, Points&
     using L = typename std::decay_t<decltype(energy)>::Linearisation;
     // the force loop with the stress map linearised gives -K du; the hourglass part is linear already
     detail::stencil_sum(model, du, ws, out, -1.0, [energy, volume, base, projected](index_t i, const Mat3& dG) PH_ALWAYS_INLINE -> Mat3 {
-      return volume[i] * energy.stress_derivative(load_linearisation<L>(base, i), dG, projected);
+      return volume[i] * energy.stress_derivative(i, load_linearisation<L>(base, i), dG, projected);
     });
   });
 }
@@ -85,14 +85,14 @@ void Tangent::diagonal_blocks(const Model& model, Eigen::Matrix<double, 9, Eigen
     for_each_point(n, ws, [&](index_t j) {
       Mat3 K = Mat3::Zero();
       if (j < stencil_end) {
-        K = model.volume[j] * energy.stiffness_block(load_linearisation<L>(base, j), model.d_self.col(j));
+        K = model.volume[j] * energy.stiffness_block(j, load_linearisation<L>(base, j), model.d_self.col(j));
         if (model.hg_diagonal.size()) K.diagonal().array() += model.hg_diagonal[j];
       }
       for (index_t e = nbr.begin(j); e < nbr.end(j); ++e) {
         const index_t i = nbr.index[e];
         if (i >= stencil_end) continue;
         // d_ij of the pair (i, j) in i's row
-        K += model.volume[i] * energy.stiffness_block(load_linearisation<L>(base, i), model.d.col(model.reverse_pair[e]));
+        K += model.volume[i] * energy.stiffness_block(i, load_linearisation<L>(base, i), model.d.col(model.reverse_pair[e]));
       }
       blocks.col(j) = K.reshaped();
     });

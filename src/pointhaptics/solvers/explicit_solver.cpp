@@ -27,7 +27,9 @@ double estimated_stable_time_step(const Model& model, double safety) {
   double rho = std::numeric_limits<double>::infinity();
   for (index_t i = 0; i < model.n_points; ++i) rho = std::min(rho, model.mass[i] / model.volume[i]);
   const MaterialParams& m = model.material;
-  const double modulus = model.lambda + 2 * model.mu + m.volume_stiffness + m.hourglass * m.young;
+  double young = m.young;
+  for (const MaterialParams& p : model.point_materials) young = std::max(young, p.young);
+  const double modulus = model.max_p_wave_modulus() + m.volume_stiffness + m.hourglass * young;
   return safety * a / std::sqrt(modulus / rho);
 }
 
@@ -104,7 +106,7 @@ double strain_stiffening(const Model& model, Workspace& ws) {
       for (index_t i = ws.chunk_begin(chunk); i < end; ++i) {
         Mat3 G;
         for (int c = 0; c < 3; ++c) G.col(c) = ws.gradients.block<3, 1>(4 * c, i);
-        m = std::max(m, energy.material.stiffening(G));
+        m = std::max(m, energy.stiffening(i, G));
       }
       chunk_max[chunk] = m;
     });

@@ -13,8 +13,9 @@ namespace pointhaptics {
 void build_hourglass(Model& model, const Eigen::VectorXd& w, const std::vector<double>& weight_sum) {
   const Csr& nbr = model.neighbours;
   const index_t n = model.n_points;
-  const double scale = 0.5 * model.material.hourglass * model.material.young;
-  auto share = [&](index_t i) { return weight_sum[i] > 0 ? model.volume[i] / weight_sum[i] : 0.0; };
+  // each end's share carries its own Young's modulus (per-point materials): a stiff inclusion's pairs are stiff
+  const double scale = 0.5 * model.material.hourglass;
+  auto share = [&](index_t i) { return weight_sum[i] > 0 ? model.material_at(i).young * model.volume[i] / weight_sum[i] : 0.0; };
   const bool per_point = model.support.size() == n;
   for (index_t i = 0; i < n; ++i)
     for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {

@@ -4,7 +4,8 @@
 /// side (tests/mechanics/energies/hourglass_test.cpp).
 ///
 /// W = sum_i sum_{j in N(i)} (k_ij / 2) |r_ij|^2,  r_ij = u_j - u_i - (G_i + G_j) X_ij / 2,
-/// k_ij = (alpha E / 2) (v_i w^_ij + v_j w^_ji) / |X_ij|^2,  w^_ij = w_ij / sum_k w_ik  (symmetric).
+/// k_ij = (alpha / 2) (E_i v_i w^_ij + E_j v_j w^_ji) / |X_ij|^2,  w^_ij = w_ij / sum_k w_ik  (symmetric; E_i the
+/// point's Young's modulus).
 /// r vanishes for any field whose gradient the stencils reproduce at both ends, so quadratic (bending) fields
 /// cost nothing inside the body, while checkerboard modes, whose interior gradients vanish, are fully
 /// penalised. Its exact gradient, per pair: y_j -= k r, y_i += k r, and the stress of stencil i gains

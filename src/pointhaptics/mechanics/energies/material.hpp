@@ -1,53 +1,161 @@
 #pragma once
 /// @file The registry of materials, and a point's elastic energy: its material plus the volume term.
-/// Adding a material is one file beside svk.hpp (energy_density, scaled_stress and stress, Linearisation
-/// with F, linearise, stress_derivative, stiffness_block, stiffening), a value of MaterialModel with its name
-/// (core/parameters.hpp), and a case in with_material() below; the force loop, the energy, the tangent, the
-/// stable step and the point fields then use it, each compiled for it.
+/// Adding a material is one file beside svk.hpp (energy_density, scaled_stress and stress, a Linearisation
+/// with F, linearise, stress_derivative, stiffness_block, stiffening; or stress_differential and the shared
+/// HessianLinearisation of hessian.hpp), a value of MaterialModel with its name (core/parameters.hpp), an
+/// alternative of AnyMaterial and a case in material_constants() below; the force loop, the energy, the
+/// tangent, the stable step and the point fields then use it, each compiled for it.
+#include <pointhaptics/core/model.hpp>
+#include <pointhaptics/mechanics/energies/corotated.hpp>
+#include <pointhaptics/mechanics/energies/mooney_rivlin.hpp>
+#include <pointhaptics/mechanics/energies/neo_hookean.hpp>
 #include <pointhaptics/mechanics/energies/svk.hpp>
 #include <pointhaptics/mechanics/energies/volume_penalty.hpp>
 
+#include <array>
+#include <type_traits>
+#include <variant>
+
 namespace pointhaptics {
 
-/// A stencil's energy per unit volume: the material's, plus the volume penalty's.
+/// One material's constants, of any model.
+using AnyMaterial = std::variant<StVenantKirchhoff, NeoHookean, MooneyRivlin, Corotated>;
+
+/// The constants of `params`' model. young and poisson are the small-strain moduli of every model:
+/// lambda = E nu / ((1 + nu)(1 - 2 nu)), mu = E / (2 (1 + nu)), K = E / (3 (1 - 2 nu)); Mooney-Rivlin
+/// splits mu = 2 (C10 + C01) as params.c10 : params.c01 when they are given, else equally.
+inline AnyMaterial material_constants(const MaterialParams& params) {
+  const double lambda = params.lambda(), mu = params.mu(), bulk = params.bulk_modulus();
+  switch (params.model) {
+    case MaterialModel::NEO_HOOKEAN: return NeoHookean{mu, bulk};
+    case MaterialModel::MOONEY_RIVLIN: {
+      const double sum = params.c10 + params.c01;
+      const double share = sum > 0 ? params.c10 / sum : 0.5;
+      return MooneyRivlin{0.5 * mu * share, 0.5 * mu * (1 - share), bulk};
+    }
+    case MaterialModel::COROTATED: return Corotated{lambda, mu};
+    case MaterialModel::SVK: break;
+  }
+  return StVenantKirchhoff{lambda, mu};
+}
+
+/// The linearisation of any material as its 9 x 9 dP/dF (for objects that mix models).
+template <class Material>
+HessianLinearisation as_hessian(const Material& material, const Mat3& G, bool projected) {
+  if constexpr (std::is_same_v<typename Material::Linearisation, HessianLinearisation>) {
+    return material.linearise(G, projected);
+  } else {
+    const auto own = material.linearise(G, projected);  // St. Venant-Kirchhoff's projection is its own
+    HessianLinearisation at;
+    at.F = Mat3::Identity() + G;
+    for (int k = 0; k < 9; ++k) {
+      Mat3 dG = Mat3::Zero();
+      dG(k % 3, k / 3) = 1;
+      const Mat3 dP = material.stress_derivative(own, dG);
+      at.H.col(k) = Eigen::Map<const Vec9>(dP.data());
+    }
+    return at;
+  }
+}
+
+/// A stencil's energy per unit volume when every point has the same material: the material's, plus the
+/// volume penalty's. Every function takes the point i (ignored here; see MixedEnergy).
 template <class Material>
 struct PointEnergy {
   Material material;
   VolumePenalty volume;
 
-  double energy_density(const Mat3& G) const {
-    return material.energy_density(G) + (volume.active() ? volume.energy_density(G) : 0.0);
+  /// The material's energy per unit volume, without the volume term, J/m^3.
+  double material_energy_density(index_t, const Mat3& G) const { return material.energy_density(G); }
+  double energy_density(index_t i, const Mat3& G) const {
+    return material_energy_density(i, G) + (volume.active() ? volume.energy_density(G) : 0.0);
   }
   /// First Piola-Kirchhoff stress P = dW/dF, Pa, times `scale` (the force loop's v_i).
-  PH_ALWAYS_INLINE Mat3 scaled_stress(const Mat3& G, double scale) const {
+  PH_ALWAYS_INLINE Mat3 scaled_stress(index_t, const Mat3& G, double scale) const {
     Mat3 P = material.scaled_stress(G, scale);
     if (volume.active()) P += scale * volume.stress(G);
     return P;
   }
-  PH_ALWAYS_INLINE Mat3 stress(const Mat3& G) const { return scaled_stress(G, 1.0); }
+  PH_ALWAYS_INLINE Mat3 stress(index_t i, const Mat3& G) const { return scaled_stress(i, G, 1.0); }
   using Linearisation = typename Material::Linearisation;
   /// `projected`: the positive semi-definite part (the material's projection, the volume's Gauss-Newton part).
-  Linearisation linearise(const Mat3& G, bool projected) const { return material.linearise(G, projected); }
-  PH_ALWAYS_INLINE Mat3 stress_derivative(const Linearisation& at, const Mat3& dG, bool projected) const {
+  Linearisation linearise(index_t, const Mat3& G, bool projected) const { return material.linearise(G, projected); }
+  PH_ALWAYS_INLINE Mat3 stress_derivative(index_t, const Linearisation& at, const Mat3& dG, bool projected) const {
     Mat3 dP = material.stress_derivative(at, dG);
     if (volume.active()) dP += volume.stress_derivative(at.F, dG, !projected);
     return dP;
   }
-  Mat3 stiffness_block(const Linearisation& at, const Vec3& d) const {
+  Mat3 stiffness_block(index_t, const Linearisation& at, const Vec3& d) const {
     Mat3 K = material.stiffness_block(at, d);
     if (volume.active()) K += volume.stiffness_block(at.F, d);
     return K;
   }
+  /// How much stiffer than at rest the material is at G (the explicit stable step).
+  double stiffening(index_t, const Mat3& G) const { return material.stiffening(G); }
 };
 
-/// fn(PointEnergy<M>) with the model's material M: the one switch over materials.
+/// The most materials one object can mix (the object's own and its regions'; model_builder.hpp's limit).
+inline constexpr std::size_t max_materials = 32;
+
+/// A stencil's energy when points have their own materials (Model::material_of): each call dispatches on
+/// the point's material, whose constants sit in a small table. Regions are contiguous in space, so the
+/// branch is predicted; the linearisation is the 9 x 9 dP/dF of any model.
+struct MixedEnergy {
+  std::array<AnyMaterial, max_materials> materials;
+  const std::uint8_t* material_of = nullptr;
+  VolumePenalty volume;
+
+  template <class Fn>
+  PH_ALWAYS_INLINE decltype(auto) visit(index_t i, Fn&& fn) const {
+    return std::visit(std::forward<Fn>(fn), materials[material_of[i]]);
+  }
+  double material_energy_density(index_t i, const Mat3& G) const {
+    return visit(i, [&](const auto& m) { return m.energy_density(G); });
+  }
+  double energy_density(index_t i, const Mat3& G) const {
+    return material_energy_density(i, G) + (volume.active() ? volume.energy_density(G) : 0.0);
+  }
+  PH_ALWAYS_INLINE Mat3 scaled_stress(index_t i, const Mat3& G, double scale) const {
+    Mat3 P = visit(i, [&](const auto& m) -> Mat3 { return m.scaled_stress(G, scale); });
+    if (volume.active()) P += scale * volume.stress(G);
+    return P;
+  }
+  PH_ALWAYS_INLINE Mat3 stress(index_t i, const Mat3& G) const { return scaled_stress(i, G, 1.0); }
+  using Linearisation = HessianLinearisation;
+  Linearisation linearise(index_t i, const Mat3& G, bool projected) const {
+    return visit(i, [&](const auto& m) { return as_hessian(m, G, projected); });
+  }
+  PH_ALWAYS_INLINE Mat3 stress_derivative(index_t, const Linearisation& at, const Mat3& dG, bool projected) const {
+    Mat3 dP = at.apply(dG);
+    if (volume.active()) dP += volume.stress_derivative(at.F, dG, !projected);
+    return dP;
+  }
+  Mat3 stiffness_block(index_t, const Linearisation& at, const Vec3& d) const {
+    Mat3 K = at.block(d);
+    if (volume.active()) K += volume.stiffness_block(at.F, d);
+    return K;
+  }
+  double stiffening(index_t i, const Mat3& G) const {
+    return visit(i, [&](const auto& m) { return m.stiffening(G); });
+  }
+};
+
+/// fn(energy) with the model's energy: PointEnergy<M> of its one material's model M, or MixedEnergy when its
+/// points have their own materials. The one switch over materials.
 template <class Fn>
 decltype(auto) with_material(const Model& model, Fn&& fn) {
   const VolumePenalty volume{model.material.volume_stiffness};
-  switch (model.material.model) {
-    case MaterialModel::SVK: break;
+  if (!model.material_of.empty()) {
+    MixedEnergy mixed;
+    for (std::size_t k = 0; k < model.point_materials.size() && k < max_materials; ++k)
+      mixed.materials[k] = material_constants(model.point_materials[k]);
+    mixed.material_of = model.material_of.data();
+    mixed.volume = volume;
+    return fn(static_cast<const MixedEnergy&>(mixed));
   }
-  return fn(PointEnergy<StVenantKirchhoff>{{model.lambda, model.mu}, volume});
+  return std::visit([&](const auto& material) -> decltype(auto) {
+    return fn(PointEnergy<std::decay_t<decltype(material)>>{material, volume});
+  }, material_constants(model.material));
 }
 
 }  // namespace pointhaptics

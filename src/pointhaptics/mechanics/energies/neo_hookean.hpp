@@ -1,0 +1,80 @@
+#pragma once
+/// @file Compressible neo-Hookean elasticity, CalculiX's NEO HOOKE: its energy density, first Piola-Kirchhoff
+/// stress and stress derivative side by side (tests/mechanics/energies/materials_test.cpp checks each against
+/// finite differences of the one before).
+#include <pointhaptics/mechanics/energies/hessian.hpp>
+
+namespace pointhaptics {
+
+/// W(F) = C10 (I1bar - 3) + (J - 1)^2 / D1, I1bar = J^-2/3 tr(F^T F), with C10 = mu / 2 and D1 = 2 / K:
+/// exactly CalculiX's *HYPERELASTIC, NEO HOOKE for J >= PowerOfJ::j_floor, and finite and restoring below
+/// (J^-2/3 continued by its Taylor expansion; hessian.hpp). mu and K are the small-strain shear and bulk
+/// moduli: mu = E / (2 (1 + nu)), K = E / (3 (1 - 2 nu)), so young and poisson keep their meaning. Unlike
+/// St. Venant-Kirchhoff it stiffens under compression: the volume term's (J - 1)^2 and I1bar's J^-2/3 grow
+/// without bound as a neighbourhood flattens.
+struct NeoHookean {
+  double mu = 0, bulk = 0;  ///< small-strain shear and bulk moduli, Pa (C10 = mu / 2, D1 = 2 / bulk)
+
+  double c10() const { return 0.5 * mu; }
+
+  /// Energy per unit reference volume, J/m^3. I1bar - 3 = g (I1 - 3) + 3 (g - 1) with g = J^-2/3, both terms
+  /// formed from the strain (no cancellation at small strain).
+  double energy_density(const Mat3& G) const {
+    const double jm1 = volume_change(G);
+    const PowerOfJ g(1 + jm1, 2.0 / 3.0);
+    const double gm1 = 1 + jm1 >= PowerOfJ::j_floor ? std::expm1(-2.0 / 3.0 * std::log1p(jm1)) : g.value - 1;
+    const double i1m3 = 2 * green_strain(G).trace();
+    return c10() * (g.value * i1m3 + 3 * gm1) + 0.5 * bulk * jm1 * jm1;
+  }
+
+  /// P = C10 (g' I1 cof F + 2 g F) + K (J - 1) cof F, Pa, times `scale`. For J >= j_floor, where g' = -2/3 g / J,
+  /// the deviatoric part is 4 C10 (g / J) cof F dev(E) (no cancellation at small strain).
+  PH_ALWAYS_INLINE Mat3 scaled_stress(const Mat3& G, double scale) const {
+    const Mat3 F = Mat3::Identity() + G;
+    const Mat3 cof = cofactor(F);
+    const double jm1 = volume_change(G), J = 1 + jm1;
+    const PowerOfJ g(J, 2.0 / 3.0);
+    if (J >= PowerOfJ::j_floor) {
+      const Mat3 E = green_strain(G);
+      return (scale * 4 * c10() * g.value / J) * (cof * deviator(E)) + (scale * bulk * jm1) * cof;
+    }
+    const double i1 = (F.array() * F.array()).sum();
+    return scale * (c10() * (g.first * i1 * cof + 2 * g.value * F) + bulk * jm1 * cof);
+  }
+  PH_ALWAYS_INLINE Mat3 stress(const Mat3& G) const { return scaled_stress(G, 1.0); }
+
+  /// dP along dF at F: with dJ = cof F : dF, dI1 = 2 F : dF and d(cof F),
+  ///   dP = C10 [(g'' dJ I1 + g' dI1) cof + g' I1 dcof + 2 g' dJ F + 2 g dF] + K [dJ cof + (J - 1) dcof].
+  Mat3 stress_differential(const Mat3& F, const Mat3& dF) const {
+    const Mat3 cof = cofactor(F), dcof = cofactor_differential(F, dF);
+    const double jm1 = volume_change(F - Mat3::Identity()), J = 1 + jm1;
+    const PowerOfJ g(J, 2.0 / 3.0);
+    const double i1 = (F.array() * F.array()).sum();
+    const double dJ = (cof.array() * dF.array()).sum(), di1 = 2 * (F.array() * dF.array()).sum();
+    return c10() * ((g.second * dJ * i1 + g.first * di1) * cof + g.first * i1 * dcof + 2 * g.first * dJ * F + 2 * g.value * dF) +
+           bulk * (dJ * cof + jm1 * dcof);
+  }
+
+  using Linearisation = HessianLinearisation;
+  Linearisation linearise(const Mat3& G, bool projected) const { return hessian_linearisation(*this, G, projected); }
+  PH_ALWAYS_INLINE Mat3 stress_derivative(const Linearisation& at, const Mat3& dG) const { return at.apply(dG); }
+  Mat3 stiffness_block(const Linearisation& at, const Vec3& d) const { return at.block(d); }
+
+  /// How much stiffer than at rest (for the explicit stable step): each term of dP bounded in Frobenius
+  /// norms (|F|^2 = I1, |cof F|, |d cof| <= 2 |F| |dF|); the bound's growth over its rest value, over the
+  /// tangent's rest norm 3 K (the volumetric mode; 2 mu for negative Poisson's ratios).
+  double stiffening(const Mat3& G) const {
+    const Mat3 F = Mat3::Identity() + G;
+    const double jm1 = volume_change(G);
+    const PowerOfJ g(1 + jm1, 2.0 / 3.0);
+    return hyperelastic_stiffening(F, jm1, c10() * (shear_bound(F, g) - shear_bound(Mat3::Identity(), PowerOfJ(1, 2.0 / 3.0))),
+                                   bulk, mu);
+  }
+  /// The C10 (I1bar - 3) terms of |dP| / |dF|, over C10.
+  static double shear_bound(const Mat3& F, const PowerOfJ& g) {
+    const double i1 = F.squaredNorm(), f = std::sqrt(i1), c = cofactor(F).norm();
+    return 2 * g.value + std::abs(g.second) * i1 * c * c + std::abs(g.first) * (2 * f * c + 2 * i1 * f + 2 * c * f);
+  }
+};
+
+}  // namespace pointhaptics
