@@ -16,7 +16,9 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <cmath>
+#include <string_view>
 #include <fstream>
 #include <map>
 #include <memory>
@@ -35,6 +37,38 @@ const Model& bench_model(int n) {
     const double spacing = 0.005;
     const PointCloud cloud = sample_box(Vec3::Zero(), Vec3::Constant(spacing * (side - 1)), spacing);
     slot = std::make_unique<Model>(build_model(cloud, MaterialParams{}, KernelParams{}));
+  }
+  return *slot;
+}
+
+// the force loop's cost per material (issue 17): the bench box with each model, and with per-point materials
+// (a neo-Hookean inclusion, ten times stiffer, in the svk box: a stiff nodule in soft tissue)
+const std::array<std::string_view, 5> material_variants = {"svk", "neo_hookean", "mooney_rivlin", "corotated", "regions"};
+
+const Model& material_model(int n, int variant) {
+  static std::map<std::pair<int, int>, std::unique_ptr<Model>> cache;
+  auto& slot = cache[{n, variant}];
+  if (!slot) {
+    const Model& base = bench_model(n);
+    PointCloud cloud;
+    cloud.X = base.X;
+    cloud.volume = base.volume;
+    cloud.spacing = base.spacing;
+    MaterialParams m;
+    std::vector<MaterialParams> materials;
+    std::vector<std::uint8_t> material_of;
+    if (const std::string_view name = material_variants[variant]; name == "regions") {
+      MaterialParams inclusion = m;
+      inclusion.model = MaterialModel::NEO_HOOKEAN;
+      inclusion.young *= 10;
+      materials = {m, inclusion};
+      const Vec3 centre = 0.5 * (base.X.rowwise().minCoeff() + base.X.rowwise().maxCoeff());
+      const double radius = 0.3 * (base.X.rowwise().maxCoeff() - base.X.rowwise().minCoeff()).maxCoeff();
+      for (index_t i = 0; i < base.n_points; ++i) material_of.push_back((base.X.col(i) - centre).norm() < radius ? 1 : 0);
+    } else {
+      m.model = *parse_enum<MaterialModel>(name);
+    }
+    slot = std::make_unique<Model>(build_model(cloud, m, KernelParams{}, materials, material_of));
   }
   return *slot;
 }
@@ -59,6 +93,19 @@ void set_counters(benchmark::State& state, const Model& model, int threads) {
 
 void force_benchmark(benchmark::State& state) {
   const Model& model = bench_model(static_cast<int>(state.range(0)));
+  const int threads = static_cast<int>(state.range(1));
+  Workspace ws(model, threads);
+  const Points u = random_displacement(model);
+  for (auto _ : state) {
+    compute_internal_forces(model, u, ws);
+    benchmark::DoNotOptimize(ws.f_int.data());
+    benchmark::ClobberMemory();
+  }
+  set_counters(state, model, threads);
+}
+
+void material_benchmark(benchmark::State& state) {
+  const Model& model = material_model(static_cast<int>(state.range(0)), static_cast<int>(state.range(2)));
   const int threads = static_cast<int>(state.range(1));
   Workspace ws(model, threads);
   const Points u = random_displacement(model);
@@ -174,7 +221,7 @@ void haptic_benchmark(benchmark::State& state) {
 class CollectingReporter : public benchmark::ConsoleReporter {
  public:
   nlohmann::json force = nlohmann::json::array(), step = nlohmann::json::array(), beam = nlohmann::json::array(),
-                 haptic = nlohmann::json::array();
+                 haptic = nlohmann::json::array(), materials = nlohmann::json::array();
   void ReportRuns(const std::vector<Run>& runs) override {
     ConsoleReporter::ReportRuns(runs);
     for (const Run& run : runs) {
@@ -185,6 +232,15 @@ class CollectingReporter : public benchmark::ConsoleReporter {
                                 "sim_steps_per_s"})
           row[key] = static_cast<double>(run.counters.at(key).value);
         haptic.push_back(row);
+        continue;
+      }
+      if (run.benchmark_name().rfind("materials/", 0) == 0) {
+        const std::string name = run.benchmark_name();
+        const size_t slash = name.find('/', 10);
+        materials.push_back({{"model", name.substr(10, slash - 10)},
+                             {"points", static_cast<long long>(run.counters.at("points").value)},
+                             {"threads", static_cast<int>(run.counters.at("threads").value)},
+                             {"point_steps_per_s", static_cast<double>(run.counters.at("point_steps_per_s").value)}});
         continue;
       }
       if (run.benchmark_name().rfind("beam4x1x1", 0) == 0) {
@@ -215,6 +271,10 @@ int run_bench_suite(const BenchOptions& options) {
           ->Args({n, t})->Unit(benchmark::kMicrosecond)->MinTime(options.min_time)->UseRealTime();
       benchmark::RegisterBenchmark(fmt::format("step/points:{}/threads:{}", n, t).c_str(), step_benchmark)
           ->Args({n, t})->Unit(benchmark::kMicrosecond)->MinTime(options.min_time)->UseRealTime();
+      for (int v = 0; v < static_cast<int>(material_variants.size()); ++v)
+        benchmark::RegisterBenchmark(fmt::format("materials/{}/points:{}/threads:{}", material_variants[v], n, t).c_str(),
+                                     material_benchmark)
+            ->Args({n, t, v})->Unit(benchmark::kMicrosecond)->MinTime(options.min_time)->UseRealTime();
     }
   for (int t : options.threads)
     for (int solver : {0, 1})
@@ -252,7 +312,8 @@ int run_bench_suite(const BenchOptions& options) {
   }
   if (!options.json_path.empty()) {
     const std::string text =
-        nlohmann::json{{"force", reporter.force}, {"step", reporter.step}, {"beam_4x1x1", reporter.beam}, {"haptic", reporter.haptic}}.dump(1);
+        nlohmann::json{{"force", reporter.force}, {"step", reporter.step}, {"beam_4x1x1", reporter.beam}, {"haptic", reporter.haptic},
+                       {"materials", reporter.materials}}.dump(1);
     try {
       write_text_file(options.json_path, "--json", [&](TextOutput& out) { out.print("{}\n", text); });
     } catch (const Error& e) {

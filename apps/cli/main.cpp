@@ -3,6 +3,7 @@
 #include "experiment_cantilever.hpp"
 #include "experiment_force_profile.hpp"
 #include "experiment_lod.hpp"
+#include "experiment_materials.hpp"
 #include "progress_bar.hpp"
 
 #include <pointhaptics/pointhaptics.hpp>
@@ -315,6 +316,15 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   cantilever_cmd->add_option("--plot-script", cantilever.plot_script, "plot_cantilever.py to use");
 
+  ph::experiments::MaterialsOptions materials;
+  CLI::App* materials_cmd = experiment_cmd->add_subcommand(
+      "materials", "Each material model against CalculiX's own: the cantilever and a flat punch's force against depth");
+  materials_cmd->add_option("--out", materials.out, "Output folder")->required();
+  materials_cmd->add_flag("--quick", materials.quick, "Coarse CalculiX meshes only");
+  materials_cmd->add_option("--threads", materials.threads, "Threads for the point model and ccx (0: all)")
+      ->check(CLI::NonNegativeNumber);
+  materials_cmd->add_option("--plot-script", materials.plot_script, "plot_materials.py to use");
+
   ph::experiments::BeamOptions beam;
   CLI::App* beam_cmd = experiment_cmd->add_subcommand(
       "beam-4x1x1", "The 4 x 1 x 1 m benchmark beam: settled sag vs CalculiX, compute s per simulated s");
@@ -364,6 +374,7 @@ int main(int argc, char** argv) {
 #endif
     if (*bench_cmd) return ph::bench::run_bench_suite(bench);
     if (*cantilever_cmd) return ph::experiments::run_cantilever_experiment(cantilever);
+    if (*materials_cmd) return ph::experiments::run_materials_experiment(materials);
     if (*beam_cmd) return ph::experiments::run_beam_experiment(beam);
     if (*profile_cmd) return ph::experiments::run_force_profile_experiment(profile);
     if (*lod_table_cmd) return ph::experiments::run_lod_table_experiment(lod_table);

@@ -54,6 +54,28 @@ def test_a_model_from_arrays_matches_forces_and_energy():
     np.testing.assert_allclose(f[~fixed] + forces[~fixed], 0, atol=1e-8 * np.abs(forces).max())
 
 
+def test_the_material_models_and_regions_are_the_scene_files_keys():
+    # the punch scene (neo-Hookean) solves; the same points with each model from arrays differ as the models do
+    sim = ph.Simulation.from_scene(scene("punch.toml"), threads=1)
+    sim.step()
+    summary = sim.summary()
+    assert summary["solver"]["converged"] and summary["solver"]["inverted"] == 0
+    assert -summary["constraints"][1]["reaction"][1] > 0.5  # the punch pushes down
+    g = np.stack(np.meshgrid(np.arange(6), np.arange(3), np.arange(3), indexing="ij"), axis=-1).reshape(-1, 3) * 0.01
+    forces = np.zeros_like(g)
+    forces[g[:, 0] == 0.05, 0] = 0.05
+    stretch = {}
+    for model in ("svk", "neo_hookean", "mooney_rivlin", "corotated"):
+        s = ph.Simulation.from_points(g, spacing=0.01, fixed=g[:, 0] == 0, forces=forces, young=1e4, solver="static",
+                                      threads=1, model=model)
+        s.step()
+        stretch[model] = s.displacement[g[:, 0] == 0.05, 0].mean()
+    assert all(v > 0 for v in stretch.values())
+    assert stretch["svk"] != stretch["neo_hookean"]
+    with pytest.raises(ph.Error, match="model"):
+        ph.Simulation.from_points(g, spacing=0.01, model="jelly")
+
+
 def test_long_runs_release_the_gil():
     sim = ph.Simulation.from_scene(scene("beam_fixed_both_ends.toml"), threads=1)
     ticks = []

@@ -1,11 +1,13 @@
 #include <pointhaptics/fem/calculix.hpp>
 
 #include <pointhaptics/core/error.hpp>
+#include <pointhaptics/mechanics/energies/material.hpp>
 
 #include <fmt/format.h>
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -159,13 +161,44 @@ std::string write_inp(const BoxProblem& p) {
   if (held.empty()) throw Error("CalculiX mesh: the clamps hold no node of the mesh");
   out += "*NSET, NSET=NFIX\n";
   write_id_list(out, held);
-  out += fmt::format("*MATERIAL, NAME=MAT\n*ELASTIC\n{:.13g}, {:.13g}\n*DENSITY\n{:.13g}\n", p.young, p.poisson, p.density);
+  // the prescribed sets: a node already held stays held
+  std::vector<std::vector<int>> moved(p.prescribed.size());
+  for (Eigen::Index k = 0; k < nodes.cols(); ++k) {
+    if (std::binary_search(held.begin(), held.end(), static_cast<int>(k + 1))) continue;
+    for (size_t s = 0; s < p.prescribed.size(); ++s)
+      if (p.prescribed[s].holds(nodes.col(k), tol)) {
+        moved[s].push_back(static_cast<int>(k + 1));
+        break;
+      }
+  }
+  for (size_t s = 0; s < moved.size(); ++s) {
+    if (moved[s].empty()) throw Error(fmt::format("CalculiX mesh: prescribed set {} holds no free node of the mesh", s + 1));
+    out += fmt::format("*NSET, NSET=NMOVE{}\n", s + 1);
+    write_id_list(out, moved[s]);
+  }
+  out += "*MATERIAL, NAME=MAT\n";
+  switch (p.material) {
+    case FemMaterial::ELASTIC: out += fmt::format("*ELASTIC\n{:.13g}, {:.13g}\n", p.young, p.poisson); break;
+    case FemMaterial::NEO_HOOKE: out += fmt::format("*HYPERELASTIC, NEO HOOKE\n{:.13g}, {:.13g}\n", p.c10, p.d1); break;
+    case FemMaterial::MOONEY_RIVLIN:
+      out += fmt::format("*HYPERELASTIC, MOONEY-RIVLIN\n{:.13g}, {:.13g}, {:.13g}\n", p.c10, p.c01, p.d1);
+      break;
+  }
+  out += fmt::format("*DENSITY\n{:.13g}\n", p.density);
   out += "*SOLID SECTION, ELSET=EALL, MATERIAL=MAT\n*BOUNDARY\nNFIX, 1, 3\n";
-  if (p.nlgeom) {
+  if (p.nlgeom && p.fixed_increments > 0) {
+    const double dt = 1.0 / p.fixed_increments;
+    out += fmt::format("*STEP, NLGEOM, INC=1000\n*STATIC, DIRECT\n{:.13g}, 1.0\n*CONTROLS, PARAMETERS=FIELD\n1e-5, 1e-4\n", dt);
+  } else if (p.nlgeom) {
     // small first increment, tightened equilibrium tolerances (ccx's defaults leave ~1e-3 error)
     out += "*STEP, NLGEOM, INC=1000\n*STATIC\n0.05, 1.0, 1e-6, 0.25\n*CONTROLS, PARAMETERS=FIELD\n1e-5, 1e-4\n";
   } else {
     out += "*STEP\n*STATIC\n";
+  }
+  if (!moved.empty()) {
+    out += "*BOUNDARY\n";
+    for (size_t s = 0; s < moved.size(); ++s)
+      for (int a = 0; a < 3; ++a) out += fmt::format("NMOVE{}, {}, {}, {:.13g}\n", s + 1, a + 1, a + 1, p.prescribed[s].displacement[a]);
   }
   const std::map<int, Vec3> forces = traction_forces(p, g);
   if (!forces.empty()) {
@@ -178,7 +211,9 @@ std::string write_inp(const BoxProblem& p) {
     const Vec3 dir = p.gravity.normalized();
     out += fmt::format("*DLOAD\nEALL, GRAV, {:.13g}, {:.13g}, {:.13g}, {:.13g}\n", p.gravity.norm(), dir.x(), dir.y(), dir.z());
   }
-  out += "*NODE PRINT, NSET=NALL\nU\n*END STEP\n";
+  out += "*NODE PRINT, NSET=NALL\nU\n";
+  for (size_t s = 0; s < moved.size(); ++s) out += fmt::format("*NODE PRINT, NSET=NMOVE{}, TOTALS=ONLY\nRF\n", s + 1);
+  out += "*END STEP\n";
   return out;
 }
 
@@ -233,6 +268,62 @@ Points read_dat_displacements(std::istream& dat, index_t n_nodes, const std::str
   return u;
 }
 
+std::vector<Reaction> read_dat_totals(std::istream& dat, const std::string& set, const std::string& source) {
+  std::vector<Reaction> out;
+  std::string line;
+  long long line_no = 0;
+  const std::string key = "total force (fx,fy,fz) for set " + set + " and time";
+  while (std::getline(dat, line)) {
+    ++line_no;
+    const size_t at = line.find(key);
+    if (at == std::string::npos) continue;
+    Reaction r;
+    char* end = nullptr;
+    const std::string time = line.substr(at + key.size());
+    r.time = std::strtod(time.c_str(), &end);
+    if (end == time.c_str()) throw Error(fmt::format("{}:{}: no time in \"{}\"", source, line_no, line));
+    while (std::getline(dat, line)) {  // the totals follow after a blank line
+      ++line_no;
+      if (line.find_first_not_of(" \t\r") != std::string::npos) break;
+    }
+    std::istringstream in(line);
+    std::string tokens[3];
+    for (int a = 0; a < 3; ++a) {
+      if (!(in >> tokens[a])) throw Error(fmt::format("{}:{}: malformed total force line \"{}\"", source, line_no, line));
+      r.force[a] = std::strtod(tokens[a].c_str(), &end);
+      if (end == tokens[a].c_str() || !std::isfinite(r.force[a]))
+        throw Error(fmt::format("{}:{}: malformed total force line \"{}\"", source, line_no, line));
+    }
+    out.push_back(r);
+  }
+  return out;
+}
+
+void set_material(BoxProblem& problem, const MaterialParams& material) {
+  problem.young = material.young;
+  problem.poisson = material.poisson;
+  problem.density = material.density;
+  std::visit(
+      [&](const auto& m) {
+        using M = std::decay_t<decltype(m)>;
+        if constexpr (std::is_same_v<M, StVenantKirchhoff>) {
+          problem.material = FemMaterial::ELASTIC;
+        } else if constexpr (std::is_same_v<M, NeoHookean>) {
+          problem.material = FemMaterial::NEO_HOOKE;
+          problem.c10 = m.c10();
+          problem.d1 = 2 / m.bulk;
+        } else if constexpr (std::is_same_v<M, MooneyRivlin>) {
+          problem.material = FemMaterial::MOONEY_RIVLIN;
+          problem.c10 = m.c10;
+          problem.c01 = m.c01;
+          problem.d1 = 2 / m.bulk;
+        } else {
+          throw Error(fmt::format("CalculiX has no {} material", to_string(material.model)));
+        }
+      },
+      material_constants(material));
+}
+
 std::string find_ccx() {
   auto executable = [](const std::string& path) { return !path.empty() && ::access(path.c_str(), X_OK) == 0; };
   if (const char* env = std::getenv("PH_CCX")) {
@@ -278,6 +369,10 @@ Solution solve(const BoxProblem& problem, int threads) {
   solution.nodes = mesh_nodes(problem);
   try {
     solution.displacement = read_dat_displacements(dat, solution.nodes.cols(), (dir / "job.dat").string());
+    for (size_t s = 0; s < problem.prescribed.size(); ++s) {
+      std::ifstream again(dir / "job.dat");
+      solution.reactions.push_back(read_dat_totals(again, fmt::format("NMOVE{}", s + 1), (dir / "job.dat").string()));
+    }
   } catch (const Error& e) {
     throw failure(e.what());
   }

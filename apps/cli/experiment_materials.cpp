@@ -1,0 +1,267 @@
+#include "experiment_materials.hpp"
+
+#include "plots.hpp"
+
+#include <pointhaptics/core/error.hpp>
+#include <pointhaptics/fem/calculix.hpp>
+#include <pointhaptics/pointhaptics.hpp>
+
+#include <fmt/format.h>
+#include <fmt/os.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <thread>
+
+namespace pointhaptics::experiments {
+namespace {
+
+// The models CalculiX has, with the same small-strain moduli; Mooney-Rivlin splits the shear modulus 70 : 30
+MaterialParams material_of(MaterialModel model, double young, double poisson) {
+  MaterialParams m;
+  m.model = model;
+  m.young = young;
+  m.poisson = poisson;
+  if (model == MaterialModel::MOONEY_RIVLIN) m.c10 = 0.7, m.c01 = 0.3;
+  return m;
+}
+
+struct Outcome {
+  double value = NAN;  // deflection (m) or force (N)
+  bool ok = false;
+  std::string note;
+  double seconds = 0;
+};
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// ---- the seed's cantilever: [0, 0.15] x [0, 0.03] x [0, 0.03] m, E = 1e5 Pa, nu = 0.4, face x = 0 clamped ----
+constexpr double L = 0.15, H = 0.03, W = 0.03;
+
+struct BeamCase {
+  std::string name;
+  double force = 0;  // N down on the tip face; 0: gravity
+};
+
+Scene beam_scene(const MaterialParams& m, const BeamCase& c, double spacing) {
+  Scene s;
+  s.path = "materials-cantilever";
+  s.object.size = Vec3(L, H, W);
+  s.object.spacing = spacing;
+  s.material = m;
+  FixedSpec clamp;
+  clamp.box = {Vec3(-1, -1, -1), Vec3(0, 1, 1)};
+  s.fixed.push_back(clamp);
+  LoadSpec load;
+  if (c.force > 0) {
+    load.kind = LoadKind::TRACTION;
+    load.box = {Vec3(L, -1, -1), Vec3(1, 1, 1)};
+    load.total = Vec3(0, -c.force, 0);
+  } else {
+    load.kind = LoadKind::GRAVITY;
+  }
+  s.loads.push_back(load);
+  s.solver.kind = SolverKind::STATIC;
+  return s;
+}
+
+// -u_y at the tip-face centre
+double tip_deflection(const Points& X, const Points& u) {
+  for (Eigen::Index k = 0; k < X.cols(); ++k)
+    if ((X.col(k) - Vec3(L, H / 2, W / 2)).norm() < 1e-9) return -u(1, k);
+  return NAN;
+}
+
+Outcome point_beam(const MaterialParams& m, const BeamCase& c, double spacing, int threads) {
+  const auto start = std::chrono::steady_clock::now();
+  Simulation sim(build_scene_model(beam_scene(m, c, spacing)), SolverSpec{SolverKind::STATIC}, threads);
+  sim.run(0.0);
+  const RunSummary s = sim.summary();
+  Outcome o;
+  o.seconds = seconds_since(start);
+  o.ok = s.converged;
+  o.note = s.failure;
+  o.value = tip_deflection(sim.model().X, sim.state().u);
+  return o;
+}
+
+Outcome fem_beam(const MaterialParams& m, const BeamCase& c, int nx, int threads) {
+  fem::BoxProblem p;
+  p.size = Vec3(L, H, W);
+  p.nx = nx, p.ny = nx / 5, p.nz = nx / 5;
+  fem::set_material(p, m);
+  p.nlgeom = true;
+  p.clamps.push_back({Vec3(-1, -1, -1), Vec3(0, 1, 1)});
+  if (c.force > 0) p.tractions.push_back({{Vec3(L, -1, -1), Vec3(1, 1, 1)}, Vec3(0, -c.force, 0)});
+  else p.gravity = Vec3(0, -9.81, 0);
+  Outcome o;
+  try {
+    const fem::Solution sol = fem::solve(p, threads);
+    o.value = tip_deflection(sol.nodes, sol.displacement);
+    o.seconds = sol.wall_s;
+    o.ok = std::isfinite(o.value);
+  } catch (const Error& e) {
+    o.note = e.what();
+  }
+  return o;
+}
+
+// ---- the flat punch: a 0.1 x 0.05 x 0.1 m block, E = 1e4 Pa, nu = 0.45, bottom held, the top face's points
+// within 10 mm of its centre pushed down (scenes/punch.toml) ----
+constexpr double punch_radius = 0.01, block_height = 0.05;
+
+Scene punch_scene(const MaterialParams& m, double depth, double spacing) {
+  Scene s;
+  s.path = "materials-punch";
+  s.object.size = Vec3(0.1, block_height, 0.1);
+  s.object.origin = Vec3(-0.05, 0, -0.05);
+  s.object.spacing = spacing;
+  s.material = m;
+  FixedSpec bottom;
+  bottom.box = {Vec3(-1, -1, -1), Vec3(1, 0, 1)};
+  s.fixed.push_back(bottom);
+  FixedSpec punch;
+  punch.cylinder = CylinderRegion{Vec3(0, block_height, 0), Vec3::UnitY(), punch_radius, 1e-4};
+  punch.displacement = Vec3(0, -depth, 0);
+  s.fixed.push_back(punch);
+  s.solver.kind = SolverKind::STATIC;
+  return s;
+}
+
+Outcome point_punch(const MaterialParams& m, double depth, double spacing, int threads) {
+  const auto start = std::chrono::steady_clock::now();
+  Simulation sim(build_scene_model(punch_scene(m, depth, spacing)), SolverSpec{SolverKind::STATIC}, threads);
+  sim.run(0.0);
+  const RunSummary s = sim.summary();
+  Outcome o;
+  o.seconds = seconds_since(start);
+  o.ok = s.converged;
+  o.note = s.failure;
+  o.value = -s.reactions[1].y();  // the punch pushes down
+  return o;
+}
+
+// CalculiX: the whole depth in `increments` equal increments, the punch force printed at each
+std::vector<Outcome> fem_punch(const MaterialParams& m, double depth, int increments, int nx, int threads) {
+  fem::BoxProblem p;
+  p.origin = Vec3(-0.05, 0, -0.05);
+  p.size = Vec3(0.1, block_height, 0.1);
+  p.nx = nx, p.ny = nx / 2, p.nz = nx;
+  fem::set_material(p, m);
+  p.nlgeom = true;
+  p.fixed_increments = increments;
+  p.clamps.push_back({Vec3(-1, -1, -1), Vec3(1, 0, 1)});
+  fem::Prescribed punch;
+  punch.region = {Vec3(-1, block_height, -1), Vec3(1, 1, 1)};
+  punch.centre = Vec3(0, block_height, 0);
+  punch.radius = punch_radius;
+  punch.displacement = Vec3(0, -depth, 0);
+  p.prescribed.push_back(punch);
+  std::vector<Outcome> out(increments);
+  try {
+    const fem::Solution sol = fem::solve(p, threads);
+    for (const fem::Reaction& r : sol.reactions[0]) {
+      const int k = static_cast<int>(std::lround(r.time * increments)) - 1;
+      if (k < 0 || k >= increments || std::abs(r.time * increments - (k + 1)) > 1e-6) continue;
+      out[k].value = -r.force.y();
+      out[k].ok = true;
+      out[k].seconds = sol.wall_s;
+    }
+  } catch (const Error& e) {
+    // ccx stopped (SVK's collapse): the increments it printed are still in no file we kept; report the failure
+    for (Outcome& o : out) o.note = e.what();
+  }
+  return out;
+}
+
+std::string first_line(const std::string& text) { return text.substr(0, text.find('\n')); }
+
+}  // namespace
+
+int run_materials_experiment(const MaterialsOptions& options) {
+  namespace fs = std::filesystem;
+  fs::create_directories(options.out);
+  const fs::path out = options.out;
+  const int threads = options.threads > 0 ? options.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  fem::find_ccx();
+  const std::vector<MaterialModel> models = {MaterialModel::SVK, MaterialModel::NEO_HOOKEAN, MaterialModel::MOONEY_RIVLIN};
+  auto md = fmt::output_file((out / "summary.md").string());
+  md.print("# Materials: the point model against CalculiX's own models\n\n"
+           "Each model with the same small-strain moduli: svk as CalculiX's *ELASTIC with NLGEOM, neo_hookean as "
+           "*HYPERELASTIC, NEO HOOKE (C10 = mu / 2, D1 = 2 / K), mooney_rivlin as MOONEY-RIVLIN (C10 : C01 = 70 : 30, "
+           "D1 = 2 / K). CalculiX: C3D20R, NLGEOM; the reference is its finest mesh.\n\n");
+
+  // the cantilever
+  const std::vector<BeamCase> beam_cases = {{"F = 0.3 N", 0.3}, {"gravity", 0.0}};
+  const std::vector<int> beam_meshes = options.quick ? std::vector<int>{20} : std::vector<int>{20, 40};
+  const std::vector<double> spacings = {0.0075, 0.005};
+  auto csv = fmt::output_file((out / "materials.csv").string());
+  csv.print("model,case,method,spacing_or_elements,deflection_m,error_pct,seconds,converged\n");
+  md.print("## The seed's cantilever (E = 1e5 Pa, nu = 0.4): tip-face centre deflection\n\n"
+           "| model | case | CalculiX (m) | point 7.5 mm | point 5 mm |\n|---|---|---|---|---|\n");
+  for (const MaterialModel model : models) {
+    const MaterialParams m = material_of(model, 1e5, 0.4);
+    for (const BeamCase& c : beam_cases) {
+      Outcome reference;
+      for (const int nx : beam_meshes) {
+        reference = fem_beam(m, c, nx, threads);
+        csv.print("{},{},calculix,{}x{}x{},{:.6e},,{:.2f},{}\n", to_string(model), c.name, nx, nx / 5, nx / 5, reference.value,
+                  reference.seconds, reference.ok);
+        fmt::print("{} {}: CalculiX {}x{}x{}: {:.5e} m ({:.1f} s){}\n", to_string(model), c.name, nx, nx / 5, nx / 5,
+                   reference.value, reference.seconds, reference.ok ? "" : " FAILED: " + first_line(reference.note));
+      }
+      std::string cells;
+      for (const double s : spacings) {
+        const Outcome o = point_beam(m, c, s, threads);
+        const double error = 100 * (o.value / reference.value - 1);
+        csv.print("{},{},point,{},{:.6e},{:.3f},{:.3f},{}\n", to_string(model), c.name, s, o.value, error, o.seconds, o.ok);
+        fmt::print("{} {}: point model s = {} m: {:.5e} m ({:+.2f}%), {:.2f} s\n", to_string(model), c.name, s, o.value, error,
+                   o.seconds);
+        cells += o.ok ? fmt::format(" {:+.2f}% |", error) : fmt::format(" not converged ({}) |", first_line(o.note));
+      }
+      md.print("| {} | {} | {:.5e} |{}\n", to_string(model), c.name, reference.value, cells);
+    }
+  }
+  csv.close();
+
+  // the punch
+  const std::vector<double> depths = {0.001, 0.002, 0.003, 0.004, 0.005};
+  // the punch's footprint is a staircase of the discretisation on both sides: finer spacings and meshes
+  // approach the 10 mm disc
+  const int punch_mesh = options.quick ? 10 : 20;
+  const std::vector<double> punch_spacings = options.quick ? std::vector<double>{0.005} : std::vector<double>{0.005, 0.0025};
+  auto punch_csv = fmt::output_file((out / "punch.csv").string());
+  punch_csv.print("model,spacing_m,depth_m,calculix_n,point_n,error_pct,point_converged,point_inverted\n");
+  md.print("\n## Flat punch (block 0.1 x 0.05 x 0.1 m, E = 1e4 Pa, nu = 0.45, 10 mm radius): force against depth\n\n"
+           "CalculiX {}x{}x{} elements (its punch: the nodes within 10 mm of the centre), the depth in 5 fixed increments; "
+           "the point model's punch: its points within 10 mm.\n\n| model | spacing (mm) | depth (mm) | CalculiX (N) | "
+           "point (N) | error |\n|---|---|---|---|---|---|\n", punch_mesh, punch_mesh / 2, punch_mesh);
+  for (const MaterialModel model : models) {
+    const MaterialParams m = material_of(model, 1e4, 0.45);
+    const std::vector<Outcome> fem = fem_punch(m, depths.back(), static_cast<int>(depths.size()), punch_mesh, threads);
+    for (const double spacing : punch_spacings)
+      for (size_t k = 0; k < depths.size(); ++k) {
+        const Outcome o = point_punch(m, depths[k], spacing, threads);
+        const double error = fem[k].ok ? 100 * (o.value / fem[k].value - 1) : NAN;
+        punch_csv.print("{},{},{},{:.6e},{:.6e},{:.3f},{},{}\n", to_string(model), spacing, depths[k], fem[k].value, o.value,
+                        error, o.ok, o.note.find("inverted") != std::string::npos);
+        fmt::print("{} punch s = {} m, {} mm: CalculiX {} N, point {:.4f} N{} ({:+.2f}%, {:.1f} s)\n", to_string(model), spacing,
+                   1e3 * depths[k], fem[k].ok ? fmt::format("{:.4f}", fem[k].value) : "no result", o.value,
+                   o.ok ? "" : " NOT converged", error, o.seconds);
+        md.print("| {} | {} | {} | {} | {} | {} |\n", to_string(model), 1e3 * spacing, 1e3 * depths[k],
+                 fem[k].ok ? fmt::format("{:.4f}", fem[k].value) : "did not converge",
+                 o.ok ? fmt::format("{:.4f}", o.value) : fmt::format("{:.4f} ({})", o.value, first_line(o.note)),
+                 fem[k].ok && o.ok ? fmt::format("{:+.2f}%", error) : "");
+      }
+  }
+  punch_csv.close();
+  md.close();
+  if (run_plot_script("plot_materials.py", out.string(), options.plot_script) != 0) return 1;
+  fmt::print("wrote {}\n", out.string());
+  return 0;
+}
+
+}  // namespace pointhaptics::experiments
