@@ -3,6 +3,7 @@
 #include <pointhaptics/core/error.hpp>
 #include <pointhaptics/fem/calculix.hpp>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -162,6 +163,65 @@ TEST(CalculixRun, MissingProgramIsAClearError) {
   EXPECT_THROW(find_ccx(), Error);
   ::setenv("PATH", saved_path.c_str(), 1);
   if (saved) ::setenv("PH_CCX", saved, 1);
+}
+
+TEST(CalculixDeck, HyperelasticCardsCarryOurModelsConstants) {
+  // neo-Hookean: C10 = mu / 2, D1 = 2 / K; Mooney-Rivlin: the split of mu and the same D1; corotated: none
+  MaterialParams m;
+  m.young = 1e4;
+  m.poisson = 0.45;
+  m.model = MaterialModel::NEO_HOOKEAN;
+  BoxProblem p = cantilever(0.1, 4, 1, 1);
+  set_material(p, m);
+  EXPECT_EQ(p.material, FemMaterial::NEO_HOOKE);
+  EXPECT_NEAR(p.c10, m.mu() / 2, 1e-9);
+  EXPECT_NEAR(p.d1, 2 / m.bulk_modulus(), 1e-18);
+  EXPECT_NE(write_inp(p).find(fmt::format("*HYPERELASTIC, NEO HOOKE\n{:.13g}, {:.13g}\n", p.c10, p.d1)), std::string::npos);
+  m.model = MaterialModel::MOONEY_RIVLIN;
+  m.c10 = 3, m.c01 = 1;
+  set_material(p, m);
+  EXPECT_NEAR(p.c10 + p.c01, m.mu() / 2, 1e-9);
+  EXPECT_NEAR(p.c10 / p.c01, 3.0, 1e-12);
+  EXPECT_NE(write_inp(p).find("*HYPERELASTIC, MOONEY-RIVLIN\n"), std::string::npos);
+  m.model = MaterialModel::SVK;
+  set_material(p, m);
+  EXPECT_NE(write_inp(p).find("*ELASTIC\n"), std::string::npos);
+  m.model = MaterialModel::COROTATED;
+  EXPECT_THROW(set_material(p, m), Error);
+}
+
+TEST(CalculixDeck, PrescribedSetsMoveTheirFreeNodesAndPrintTheirReactions) {
+  BoxProblem p = cantilever(0.0, 4, 2, 2);
+  p.tractions.clear();
+  Prescribed end;
+  end.region = {Vec3(0.15, -1, -1), Vec3(1, 1, 1)};
+  end.displacement = Vec3(0.01, 0, 0);
+  p.prescribed.push_back(end);
+  p.nlgeom = true;
+  p.fixed_increments = 4;
+  const std::string deck = write_inp(p);
+  EXPECT_NE(deck.find("*NSET, NSET=NMOVE1\n"), std::string::npos);
+  EXPECT_NE(deck.find("NMOVE1, 1, 1, 0.01\n"), std::string::npos);
+  EXPECT_NE(deck.find("*STATIC, DIRECT\n0.25, 1.0\n"), std::string::npos);
+  EXPECT_NE(deck.find("*NODE PRINT, NSET=NMOVE1, TOTALS=ONLY\nRF\n"), std::string::npos);
+  p.prescribed[0].radius = 1e-6;  // a footprint that takes no node
+  p.prescribed[0].centre = Vec3(0.15, 0.0151, 0.0151);
+  EXPECT_THROW(write_inp(p), Error);
+}
+
+TEST(CalculixDat, ReadsTheReactionTotalsOfEachIncrement) {
+  std::istringstream dat(
+      " total force (fx,fy,fz) for set NMOVE1 and time  0.5000000E+00\n\n"
+      "        1.000000E-01 -2.000000E+00  3.000000E-03\n\n"
+      " total force (fx,fy,fz) for set NOTHIS and time  0.5000000E+00\n\n        9 9 9\n"
+      " total force (fx,fy,fz) for set NMOVE1 and time  0.1000000E+01\n\n"
+      "        2.000000E-01 -4.000000E+00  6.000000E-03\n");
+  const std::vector<Reaction> r = read_dat_totals(dat, "NMOVE1", "job.dat");
+  ASSERT_EQ(r.size(), 2u);
+  EXPECT_DOUBLE_EQ(r[0].time, 0.5);
+  EXPECT_DOUBLE_EQ(r[1].force.y(), -4.0);
+  std::istringstream bad(" total force (fx,fy,fz) for set NMOVE1 and time  0.5\n\n   1.0 nan-ish\n");
+  EXPECT_THROW(read_dat_totals(bad, "NMOVE1", "job.dat"), Error);
 }
 
 // ccx is installed by scripts/setup (Debian calculix-ccx); its absence is a failure here, not a skip

@@ -127,6 +127,19 @@ Points mesh_nodes(const BoxProblem& problem) {
   return nodes;
 }
 
+// *MATERIAL with its constitutive card and density (13 significant digits fit ccx's 20-character fields)
+static std::string material_card(const std::string& name, const BoxProblem& p) {
+  std::string out = fmt::format("*MATERIAL, NAME={}\n", name);
+  switch (p.material) {
+    case FemMaterial::ELASTIC: out += fmt::format("*ELASTIC\n{:.13g}, {:.13g}\n", p.young, p.poisson); break;
+    case FemMaterial::NEO_HOOKE: out += fmt::format("*HYPERELASTIC, NEO HOOKE\n{:.13g}, {:.13g}\n", p.c10, p.d1); break;
+    case FemMaterial::MOONEY_RIVLIN:
+      out += fmt::format("*HYPERELASTIC, MOONEY-RIVLIN\n{:.13g}, {:.13g}, {:.13g}\n", p.c10, p.c01, p.d1);
+      break;
+  }
+  return out + fmt::format("*DENSITY\n{:.13g}\n", p.density);
+}
+
 // ccx reads real numbers in fields of 20 characters: 13 significant digits always fit
 std::string write_inp(const BoxProblem& p) {
   const Grid g = make_grid(p);
@@ -176,16 +189,34 @@ std::string write_inp(const BoxProblem& p) {
     out += fmt::format("*NSET, NSET=NMOVE{}\n", s + 1);
     write_id_list(out, moved[s]);
   }
-  out += "*MATERIAL, NAME=MAT\n";
-  switch (p.material) {
-    case FemMaterial::ELASTIC: out += fmt::format("*ELASTIC\n{:.13g}, {:.13g}\n", p.young, p.poisson); break;
-    case FemMaterial::NEO_HOOKE: out += fmt::format("*HYPERELASTIC, NEO HOOKE\n{:.13g}, {:.13g}\n", p.c10, p.d1); break;
-    case FemMaterial::MOONEY_RIVLIN:
-      out += fmt::format("*HYPERELASTIC, MOONEY-RIVLIN\n{:.13g}, {:.13g}, {:.13g}\n", p.c10, p.c01, p.d1);
-      break;
+  // the elements of each inclusion (by their centres), the rest the body's
+  std::vector<int> material_of(static_cast<size_t>(p.nx) * p.ny * p.nz, 0);
+  for (size_t s = 0; s < p.inclusions.size(); ++s)
+    for (int k = 0, e = 0; k < p.nz; ++k)
+      for (int j = 0; j < p.ny; ++j)
+        for (int i = 0; i < p.nx; ++i, ++e)
+          if ((grid_position(p, 2 * i + 1, 2 * j + 1, 2 * k + 1) - p.inclusions[s].centre).norm() <= p.inclusions[s].radius)
+            material_of[e] = static_cast<int>(s + 1);
+  out += material_card("MAT", p);
+  for (size_t s = 0; s < p.inclusions.size(); ++s) {
+    BoxProblem inclusion;
+    set_material(inclusion, p.inclusions[s].material);
+    std::vector<int> elements;
+    for (size_t e = 0; e < material_of.size(); ++e)
+      if (material_of[e] == static_cast<int>(s + 1)) elements.push_back(static_cast<int>(e + 1));
+    if (elements.empty()) throw Error(fmt::format("CalculiX mesh: inclusion {} holds no element centre", s + 1));
+    out += fmt::format("*ELSET, ELSET=EINC{}\n", s + 1);
+    write_id_list(out, elements);
+    out += material_card(fmt::format("MAT{}", s + 1), inclusion);
   }
-  out += fmt::format("*DENSITY\n{:.13g}\n", p.density);
-  out += "*SOLID SECTION, ELSET=EALL, MATERIAL=MAT\n*BOUNDARY\nNFIX, 1, 3\n";
+  std::vector<int> body;
+  for (size_t e = 0; e < material_of.size(); ++e)
+    if (material_of[e] == 0) body.push_back(static_cast<int>(e + 1));
+  out += "*ELSET, ELSET=EBODY\n";
+  write_id_list(out, body);
+  out += "*SOLID SECTION, ELSET=EBODY, MATERIAL=MAT\n";
+  for (size_t s = 0; s < p.inclusions.size(); ++s) out += fmt::format("*SOLID SECTION, ELSET=EINC{0}, MATERIAL=MAT{0}\n", s + 1);
+  out += "*BOUNDARY\nNFIX, 1, 3\n";
   if (p.nlgeom && p.fixed_increments > 0) {
     const double dt = 1.0 / p.fixed_increments;
     out += fmt::format("*STEP, NLGEOM, INC=1000\n*STATIC, DIRECT\n{:.13g}, 1.0\n*CONTROLS, PARAMETERS=FIELD\n1e-5, 1e-4\n", dt);

@@ -46,6 +46,13 @@ struct Prescribed {
 /// (W = C10 (I1bar - 3) + (J - 1)^2 / D1) or MOONEY-RIVLIN (+ C01 (I2bar - 3)).
 enum class FemMaterial { ELASTIC, NEO_HOOKE, MOONEY_RIVLIN };
 
+/// A ball of another material (a stiff nodule): the elements whose centre lies inside take it.
+struct Inclusion {
+  Vec3 centre = Vec3::Zero();
+  double radius = 0;  ///< m
+  MaterialParams material;  ///< its model and moduli (set_material's mapping)
+};
+
 /// A box body [origin, origin + size] meshed with nx x ny x nz quadratic hexahedra.
 struct BoxProblem {
   Vec3 origin = Vec3::Zero();
@@ -61,6 +68,7 @@ struct BoxProblem {
   /// NLGEOM increments: 0 lets ccx choose them (from 5% of the step); n > 0: n fixed increments of 1/n (the
   /// reactions are then printed at each 1/n of the step)
   int fixed_increments = 0;
+  std::vector<Inclusion> inclusions;    ///< later ones win where they overlap
   bool nlgeom = false;                  ///< geometrically nonlinear (*ELASTIC is then St. Venant-Kirchhoff)
   bool reduced_integration = true;      ///< C3D20R, else C3D20
 };
