@@ -133,10 +133,33 @@ void assign_region_materials(const Scene& scene, const Points& X, std::vector<Ma
 
 }  // namespace
 
+// [object] stiffness_map: each point's E_i / E from its voxel's intensity (linear between the rows, the end
+// values beyond them)
+static void apply_stiffness_map(const Scene& scene, PointCloud& cloud) {
+  const auto& map = scene.object.stiffness_map;
+  if (map.empty()) return;
+  if (cloud.intensity.size() != cloud.size())
+    throw Error(fmt::format("{}:{}: object.stiffness_map: needs a volume image (.nii, .nii.gz, .nrrd, .nhdr) for its intensities",
+                            scene.path, scene.object.line));
+  cloud.stiffness_scale.resize(cloud.size());
+  for (index_t i = 0; i < cloud.size(); ++i) {
+    const double v = cloud.intensity[i];
+    double young = v <= map.front()[0] ? map.front()[1] : map.back()[1];
+    for (std::size_t r = 1; r < map.size(); ++r)
+      if (v >= map[r - 1][0] && v <= map[r][0]) {
+        const double t = (v - map[r - 1][0]) / (map[r][0] - map[r - 1][0]);
+        young = map[r - 1][1] + t * (map[r][1] - map[r - 1][1]);
+        break;
+      }
+    cloud.stiffness_scale[i] = young / scene.material.young;
+  }
+}
+
 Model build_scene_model(const Scene& scene, double max_memory) {
   // too big for the machine: refused before anything is allocated (files once they are read)
   check_model_fits(estimated_points(scene), scene, max_memory);
-  const PointCloud cloud = sample_object(scene);
+  PointCloud cloud = sample_object(scene);
+  apply_stiffness_map(scene, cloud);
   check_model_fits(static_cast<double>(cloud.X.cols()), scene, max_memory);
   std::vector<MaterialParams> materials;
   std::vector<std::uint8_t> material_of;

@@ -131,6 +131,46 @@ TEST_F(VolumeFile, AnEllipsoidWithAHoleKeepsItsHoleInAScene) {
   }
 }
 
+// a sphere of soft tissue (intensity 100) with a stiffer core (intensity 300 within 5 mm of the centre)
+float sphere_with_core(const Vec3& x) {
+  const double r = (x - centre_mm).norm();
+  return r <= 5.0 ? 300.0f : r <= 10.0 ? 100.0f : 0.0f;
+}
+
+TEST_F(VolumeFile, AStiffnessMapGivesEachPointTheYoungsModulusOfItsIntensity) {
+  const Grid g;
+  const std::string nii = write_nifti("core.nii", g, voxels(g, sphere_with_core));
+  const std::string text = "[object]\nshape = \"file\"\nfile = \"" + nii +
+                           "\"\nspacing = 0.001\nthreshold = [50, 350]\nstiffness_map = [[100, 1e4], [200, 5e4], [300, 9e4]]\n"
+                           "[material]\nyoung = 2e4\n";
+  const Model m = build_scene_model(parse_scene(text, "core.toml"));
+  ASSERT_EQ(m.stiffness_scale.size(), m.n_points);
+  int core = 0, soft = 0;
+  for (index_t i = 0; i < m.n_points; ++i) {
+    const double r = (m.X.col(i) - 1e-3 * centre_mm).norm();
+    if (r < 4e-3) {  // well inside the core: 9e4 Pa
+      EXPECT_NEAR(m.young_at(i), 9e4, 1e-6);
+      ++core;
+    } else if (r > 6e-3) {  // the soft shell: 1e4 Pa
+      EXPECT_NEAR(m.young_at(i), 1e4, 1e-6);
+      ++soft;
+    }
+    // the stress weight carries it: a stencil's stress is its material's times E_i / E
+    EXPECT_NEAR(m.stiffness_volume[i], m.volume[i] * m.young_at(i) / 2e4, 1e-18);
+  }
+  EXPECT_GT(core, 100);
+  EXPECT_GT(soft, 1000);
+  // interpolation between the rows, and the named errors
+  EXPECT_THROW(parse_scene(std::string(text).replace(text.find("[[100, 1e4]"), 11, "[[200, 1e4]"), "bad.toml"), Error);
+  try {
+    build_scene_model(parse_scene("[object]\nshape = \"box\"\nsize = [0.01, 0.01, 0.01]\nspacing = 0.005\n"
+                                  "stiffness_map = [[0, 1e4], [1, 2e4]]\n", "box.toml"));
+    ADD_FAILURE() << "a stiffness map without a volume image was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("object.stiffness_map: needs a volume image"), std::string::npos) << e.what();
+  }
+}
+
 TEST_F(VolumeFile, BadVolumesAreNamedErrors) {
   const Grid g;
   const std::vector<float> v = voxels(g, sphere);

@@ -38,6 +38,11 @@ struct Model {
   /// (point_materials[0] is `material`); both empty when every point has `material`
   std::vector<MaterialParams> point_materials;
   std::vector<std::uint8_t> material_of;
+  /// E_i / E per point from a stiffness map (empty: 1): at a fixed Poisson's ratio every model's stress is
+  /// proportional to E, so the point's stress is its material's times this
+  Eigen::VectorXd stiffness_scale;
+  /// v_i times stiffness_scale_i, the weight of stencil i's stress (its energy, forces and tangent), m^3  (n)
+  Eigen::VectorXd stiffness_volume;
 
   /// stencils: the neighbours j != i with |X_j - X_i| < h of each point i, as CSR (pairs e = (i, j)),
   /// each row sorted; symmetric (j is in i's row when i is in j's)
@@ -64,11 +69,20 @@ struct Model {
 
   /// The material of point i.
   const MaterialParams& material_at(index_t i) const { return material_of.empty() ? material : point_materials[material_of[i]]; }
-  /// The largest P-wave modulus lambda + 2 mu over the object's materials, Pa (the explicit stable step).
+  /// Young's modulus of point i, Pa (its material's, times its stiffness scale).
+  double young_at(index_t i) const { return material_at(i).young * (stiffness_scale.size() ? stiffness_scale[i] : 1.0); }
+  /// The largest P-wave modulus lambda + 2 mu over the object's materials and stiffness scales, Pa (the explicit
+  /// stable step).
   double max_p_wave_modulus() const {
     double m = material.lambda() + 2 * material.mu();
     for (const MaterialParams& p : point_materials) m = std::max(m, p.lambda() + 2 * p.mu());
-    return m;
+    return m * (stiffness_scale.size() ? std::max(1.0, stiffness_scale.maxCoeff()) : 1.0);
+  }
+  /// The largest Young's modulus of any point, Pa.
+  double max_young() const {
+    double e = material.young;
+    for (const MaterialParams& p : point_materials) e = std::max(e, p.young);
+    return e * (stiffness_scale.size() ? std::max(1.0, stiffness_scale.maxCoeff()) : 1.0);
   }
 
   index_t n_pairs() const { return neighbours.n_entries(); }

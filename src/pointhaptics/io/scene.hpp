@@ -31,6 +31,9 @@ struct ObjectSpec {
   double spacing = 0.0075;             ///< sample spacing, m
   std::string file;                    ///< shape = file: path, resolved against the scene file's folder
   double threshold_low = NAN, threshold_high = NAN;  ///< volume images: the intensity window sampled
+  /// volume images: [intensity, young (Pa)] rows, intensities increasing; each point's Young's modulus is
+  /// interpolated linearly at its voxel's intensity (held at the end values beyond them); empty: none
+  std::vector<std::array<double, 2>> stiffness_map;
   int line = 0;                        ///< of the [object] table, for messages
 };
 

@@ -228,6 +228,20 @@ void read_object(TableReader& r, ObjectSpec& o, const Context& ctx) {
       if (!(o.threshold_low <= o.threshold_high)) r.fail_at(*node, "threshold", "low must not exceed high");
     }
   }
+  // any shape: the scene builder says when there is no volume image to map
+  if (const toml::node* node = r.find("stiffness_map")) {
+    const toml::array* rows = node->as_array();
+    const char* form = "expected [[intensity, young], ...] with at least two rows, intensities increasing, young in (0, 1e13] Pa";
+    if (!rows || rows->size() < 2) r.fail_at(*node, "stiffness_map", form);
+    for (const toml::node& row : *rows) {
+      const toml::array* pair = row.as_array();
+      if (!pair || pair->size() != 2) r.fail_at(row, "stiffness_map", form);
+      const double intensity = r.as_number(*pair->get(0), "stiffness_map"), young = r.as_number(*pair->get(1), "stiffness_map");
+      if (!(young > 0 && young <= 1e13) || (!o.stiffness_map.empty() && !(intensity > o.stiffness_map.back()[0])))
+        r.fail_at(row, "stiffness_map", form);
+      o.stiffness_map.push_back({intensity, young});
+    }
+  }
   o.line = r.line();
 }
 

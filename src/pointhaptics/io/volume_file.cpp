@@ -191,6 +191,7 @@ PointCloud sample_volume(const VolumeImage& image, double low, double high, doub
   const Vec3 origin = 0.5 * (lo + hi) - 0.5 * (cells.matrix() - Vec3::Ones()) * spacing;
   const Eigen::Matrix3d to_voxel = A.inverse();
   std::vector<Vec3> points;
+  std::vector<double> intensities;
   for (index_t c = 0; c < static_cast<index_t>(cells.prod()); ++c) {
     const index_t ci = c % static_cast<index_t>(cells.x()), cj = (c / static_cast<index_t>(cells.x())) % static_cast<index_t>(cells.y()),
                   ck = c / static_cast<index_t>(cells.x() * cells.y());
@@ -199,7 +200,10 @@ PointCloud sample_volume(const VolumeImage& image, double low, double high, doub
     const index_t i = static_cast<index_t>(std::lround(v.x())), j = static_cast<index_t>(std::lround(v.y())),
                   k = static_cast<index_t>(std::lround(v.z()));
     if (i < 0 || j < 0 || k < 0 || i >= image.nx || j >= image.ny || k >= image.nz) continue;
-    if (in_window(image.at(i, j, k))) points.push_back(x);
+    if (in_window(image.at(i, j, k))) {
+      points.push_back(x);
+      intensities.push_back(image.at(i, j, k));
+    }
   }
   if (points.empty()) throw Error(fmt::format("{}: no lattice point of spacing {:.3g} m falls in the window (finer spacing?)", name, spacing));
   if (static_cast<index_t>(points.size()) > max_points) throw Error(fmt::format("{}: {} points: too many (coarser spacing?)", name, points.size()));
@@ -209,6 +213,7 @@ PointCloud sample_volume(const VolumeImage& image, double low, double high, doub
   for (std::size_t p = 0; p < points.size(); ++p) cloud.X.col(static_cast<Eigen::Index>(p)) = points[p];
   cloud.volume = Eigen::VectorXd::Constant(cloud.X.cols(), spacing * spacing * spacing);
   cloud.surface.assign(points.size(), 0);
+  cloud.intensity = Eigen::Map<const Eigen::VectorXd>(intensities.data(), static_cast<Eigen::Index>(intensities.size()));
   return cloud;
 }
 

@@ -181,6 +181,10 @@ index_t keep_needed_ring(const std::vector<char>& ring_needed, ActiveSet& a, Act
 // ring held where it is, and the object's held groups restricted to the active points.
 void build_model_of(const Model& full, ActiveCloud& c, index_t n_passive, ActiveSet& a) {
   c.cloud.support = c.support;
+  if (full.stiffness_scale.size()) {  // the object's stiffness map, for the active points
+    c.cloud.stiffness_scale.resize(static_cast<Eigen::Index>(a.full_of.size()));
+    for (std::size_t k = 0; k < a.full_of.size(); ++k) c.cloud.stiffness_scale[static_cast<Eigen::Index>(k)] = full.stiffness_scale[a.full_of[k]];
+  }
   KernelParams kernel = full.kernel;
   kernel.support = full.h;
   std::vector<std::uint8_t> material_of;  // the object's per-point materials, for the active points

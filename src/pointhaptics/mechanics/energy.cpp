@@ -36,7 +36,7 @@ EnergyTerms strain_energy(const Model& model, const Points& u, std::vector<Mat3>
                                                      model.X.col(j) - model.X.col(i));
             }
             if (i >= model.stencil_end()) continue;
-            const double v = model.volume[i];
+            const double v = model.stiffness_volume[i];  // v_i, times E_i / E with a stiffness map
             acc.elastic += v * energy.material_energy_density(i, G);
             acc.volume += v * energy.volume.energy_density(G);
           }

@@ -146,6 +146,16 @@ Model build_model(const PointCloud& cloud, const MaterialParams& material, const
     }
   }
 
+  // the weight of each stencil's stress: its volume, times its stiffness scale
+  if (cloud.stiffness_scale.size()) {
+    if (cloud.stiffness_scale.size() != n || !(cloud.stiffness_scale.array() > 0).all() || !cloud.stiffness_scale.allFinite())
+      throw Error("model: per-point stiffness scales must be positive and finite, one per point");
+    model.stiffness_scale = cloud.stiffness_scale;
+    model.stiffness_volume = model.volume.cwiseProduct(model.stiffness_scale);
+  } else {
+    model.stiffness_volume = model.volume;
+  }
+
   // moment matrices (seed Eq. 11), their conditioning, d_ij and d_ii (seed Eq. 10)
   model.d.resize(3, n_pairs);
   model.d_self.resize(3, n);

@@ -60,7 +60,7 @@ void Tangent::linearise(const Model& model, const Points& u, TangentMode mode, W
 
 void Tangent::apply(const Model& model, const Points& du, Workspace& ws, Points& out) const {
   const bool projected = mode_ == TangentMode::PROJECTED;
-  const double* volume = model.volume.data();
+  const double* volume = model.stiffness_volume.data();  // v_i, times E_i / E with a stiffness map
   const double* base = linearisation_.data();
   with_material(model, [&](const auto& energy) {
     using L = typename std::decay_t<decltype(energy)>::Linearisation;
@@ -85,14 +85,14 @@ void Tangent::diagonal_blocks(const Model& model, Eigen::Matrix<double, 9, Eigen
     for_each_point(n, ws, [&](index_t j) {
       Mat3 K = Mat3::Zero();
       if (j < stencil_end) {
-        K = model.volume[j] * energy.stiffness_block(j, load_linearisation<L>(base, j), model.d_self.col(j));
+        K = model.stiffness_volume[j] * energy.stiffness_block(j, load_linearisation<L>(base, j), model.d_self.col(j));
         if (model.hg_diagonal.size()) K.diagonal().array() += model.hg_diagonal[j];
       }
       for (index_t e = nbr.begin(j); e < nbr.end(j); ++e) {
         const index_t i = nbr.index[e];
         if (i >= stencil_end) continue;
         // d_ij of the pair (i, j) in i's row
-        K += model.volume[i] * energy.stiffness_block(i, load_linearisation<L>(base, i), model.d.col(model.reverse_pair[e]));
+        K += model.stiffness_volume[i] * energy.stiffness_block(i, load_linearisation<L>(base, i), model.d.col(model.reverse_pair[e]));
       }
       blocks.col(j) = K.reshaped();
     });

@@ -27,9 +27,7 @@ double estimated_stable_time_step(const Model& model, double safety) {
   double rho = std::numeric_limits<double>::infinity();
   for (index_t i = 0; i < model.n_points; ++i) rho = std::min(rho, model.mass[i] / model.volume[i]);
   const MaterialParams& m = model.material;
-  double young = m.young;
-  for (const MaterialParams& p : model.point_materials) young = std::max(young, p.young);
-  const double modulus = model.max_p_wave_modulus() + m.volume_stiffness + m.hourglass * young;
+  const double modulus = model.max_p_wave_modulus() + m.volume_stiffness + m.hourglass * model.max_young();
   return safety * a / std::sqrt(modulus / rho);
 }
 

@@ -15,7 +15,7 @@ void build_hourglass(Model& model, const Eigen::VectorXd& w, const std::vector<d
   const index_t n = model.n_points;
   // each end's share carries its own Young's modulus (per-point materials): a stiff inclusion's pairs are stiff
   const double scale = 0.5 * model.material.hourglass;
-  auto share = [&](index_t i) { return weight_sum[i] > 0 ? model.material_at(i).young * model.volume[i] / weight_sum[i] : 0.0; };
+  auto share = [&](index_t i) { return weight_sum[i] > 0 ? model.young_at(i) * model.volume[i] / weight_sum[i] : 0.0; };
   const bool per_point = model.support.size() == n;
   for (index_t i = 0; i < n; ++i)
     for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
