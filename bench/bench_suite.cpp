@@ -91,9 +91,8 @@ void set_counters(benchmark::State& state, const Model& model, int threads) {
                                                      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
-void force_benchmark(benchmark::State& state) {
-  const Model& model = bench_model(static_cast<int>(state.range(0)));
-  const int threads = static_cast<int>(state.range(1));
+// the force loop on `model`, timed
+void time_forces(benchmark::State& state, const Model& model, int threads) {
   Workspace ws(model, threads);
   const Points u = random_displacement(model);
   for (auto _ : state) {
@@ -104,17 +103,12 @@ void force_benchmark(benchmark::State& state) {
   set_counters(state, model, threads);
 }
 
+void force_benchmark(benchmark::State& state) {
+  time_forces(state, bench_model(static_cast<int>(state.range(0))), static_cast<int>(state.range(1)));
+}
+
 void material_benchmark(benchmark::State& state) {
-  const Model& model = material_model(static_cast<int>(state.range(0)), static_cast<int>(state.range(2)));
-  const int threads = static_cast<int>(state.range(1));
-  Workspace ws(model, threads);
-  const Points u = random_displacement(model);
-  for (auto _ : state) {
-    compute_internal_forces(model, u, ws);
-    benchmark::DoNotOptimize(ws.f_int.data());
-    benchmark::ClobberMemory();
-  }
-  set_counters(state, model, threads);
+  time_forces(state, material_model(static_cast<int>(state.range(0)), static_cast<int>(state.range(2))), static_cast<int>(state.range(1)));
 }
 
 void step_benchmark(benchmark::State& state) {

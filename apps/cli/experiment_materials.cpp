@@ -75,17 +75,24 @@ double tip_deflection(const Points& X, const Points& u) {
   return NAN;
 }
 
-Outcome point_beam(const MaterialParams& m, const BeamCase& c, double spacing, int threads) {
+// a static scene solved by the point model: the outcome (converged, why not, time) and `value` of the solution
+template <class Value>
+Outcome solve_point_model(const Scene& scene, int threads, Value&& value) {
   const auto start = std::chrono::steady_clock::now();
-  Simulation sim(build_scene_model(beam_scene(m, c, spacing)), SolverSpec{SolverKind::STATIC}, threads);
+  Simulation sim(build_scene_model(scene), SolverSpec{SolverKind::STATIC}, threads);
   sim.run(0.0);
   const RunSummary s = sim.summary();
   Outcome o;
   o.seconds = seconds_since(start);
   o.ok = s.converged;
   o.note = s.failure;
-  o.value = tip_deflection(sim.model().X, sim.state().u);
+  o.value = value(sim, s);
   return o;
+}
+
+Outcome point_beam(const MaterialParams& m, const BeamCase& c, double spacing, int threads) {
+  return solve_point_model(beam_scene(m, c, spacing), threads,
+                           [](const Simulation& sim, const RunSummary&) { return tip_deflection(sim.model().X, sim.state().u); });
 }
 
 Outcome fem_beam(const MaterialParams& m, const BeamCase& c, int nx, int threads) {
@@ -132,16 +139,8 @@ Scene punch_scene(const MaterialParams& m, double depth, double spacing) {
 }
 
 Outcome point_punch(const MaterialParams& m, double depth, double spacing, int threads) {
-  const auto start = std::chrono::steady_clock::now();
-  Simulation sim(build_scene_model(punch_scene(m, depth, spacing)), SolverSpec{SolverKind::STATIC}, threads);
-  sim.run(0.0);
-  const RunSummary s = sim.summary();
-  Outcome o;
-  o.seconds = seconds_since(start);
-  o.ok = s.converged;
-  o.note = s.failure;
-  o.value = -s.reactions[1].y();  // the punch pushes down
-  return o;
+  // the punch pushes down
+  return solve_point_model(punch_scene(m, depth, spacing), threads, [](const Simulation&, const RunSummary& s) { return -s.reactions[1].y(); });
 }
 
 // CalculiX: the whole depth in `increments` equal increments, the punch force printed at each

@@ -38,8 +38,10 @@ inline Mat3 rotation_of(const Mat3& F) {
 /// elasticity in the rotated frame, so rotations cost nothing and small strains match St. Venant-Kirchhoff's
 /// and neo-Hookean's moduli (lambda, mu from young and poisson), without their softening or stiffening at
 /// large strain. The fast option (PhysX, Drake, iMSTK offer it): no invariant powers, no volume barrier.
-struct Corotated {
+struct Corotated : HessianTangent<Corotated> {
   double lambda = 0, mu = 0;  ///< Lame's parameters, Pa
+  Corotated() = default;
+  Corotated(double lambda_, double mu_) : lambda(lambda_), mu(mu_) {}
 
   double energy_density(const Mat3& G) const {
     const Mat3 F = Mat3::Identity() + G;
@@ -76,11 +78,6 @@ struct Corotated {
     const double t = S.trace() - 3;
     return 2 * mu * (dF - dR) + lambda * (R.transpose() * dF).trace() * R + lambda * t * dR;
   }
-
-  using Linearisation = HessianLinearisation;
-  Linearisation linearise(const Mat3& G, bool projected) const { return hessian_linearisation(*this, G, projected); }
-  PH_ALWAYS_INLINE Mat3 stress_derivative(const Linearisation& at, const Mat3& dG) const { return at.apply(dG); }
-  Mat3 stiffness_block(const Linearisation& at, const Vec3& d) const { return at.block(d); }
 
   /// How much stiffer than at rest (explicit stable step): dP = 2 mu dF + lambda tr(R^T dF) R + (lambda tr(S - I)
   /// - 2 mu) dR with |dR| <= 2 |dF| / (the smallest sum of two singular values), bounded from the stretches

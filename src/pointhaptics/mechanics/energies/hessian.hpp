@@ -54,6 +54,18 @@ HessianLinearisation hessian_linearisation(const Material& material, const Mat3&
   return at;
 }
 
+/// The tangent of a model that gives its exact directional derivative stress_differential(F, dF): the 9 x 9
+/// linearisation above (derive from HessianTangent<Model>; the model keeps its constants as members).
+template <class Material>
+struct HessianTangent {
+  using Linearisation = HessianLinearisation;
+  Linearisation linearise(const Mat3& G, bool projected) const {
+    return hessian_linearisation(static_cast<const Material&>(*this), G, projected);
+  }
+  PH_ALWAYS_INLINE Mat3 stress_derivative(const Linearisation& at, const Mat3& dG) const { return at.apply(dG); }
+  Mat3 stiffness_block(const Linearisation& at, const Vec3& d) const { return at.block(d); }
+};
+
 /// J^-p, extended below j_floor by its second-order Taylor expansion there: the deviatoric invariants
 /// I1bar = J^-2/3 I1 and I2bar = J^-4/3 I2 stay finite at J <= 0 and keep pushing J up (the value grows,
 /// the slope stays negative, as J falls), so an inverted or flattened neighbourhood is restored instead of

@@ -9,8 +9,10 @@ namespace pointhaptics {
 /// I2 = (I1^2 - tr(C^2)) / 2, D1 = 2 / K: CalculiX's *HYPERELASTIC, MOONEY-RIVLIN for J >= PowerOfJ::j_floor,
 /// finite and restoring below (hessian.hpp). Small-strain shear modulus mu = 2 (C10 + C01); C01 = 0 is
 /// neo-Hookean. C01 stiffens shear at large stretch, as measured for many soft tissues.
-struct MooneyRivlin {
+struct MooneyRivlin : HessianTangent<MooneyRivlin> {
   double c10 = 0, c01 = 0, bulk = 0;  ///< Pa
+  MooneyRivlin() = default;
+  MooneyRivlin(double c10_, double c01_, double bulk_) : c10(c10_), c01(c01_), bulk(bulk_) {}
 
   double mu() const { return 2 * (c10 + c01); }
 
@@ -65,11 +67,6 @@ struct MooneyRivlin {
            c01 * ((g2.second * dJ * i2 + g2.first * di2) * cof + g2.first * i2 * dcof + 2 * g2.first * dJ * B + 2 * g2.value * dB) +
            bulk * (dJ * cof + jm1 * dcof);
   }
-
-  using Linearisation = HessianLinearisation;
-  Linearisation linearise(const Mat3& G, bool projected) const { return hessian_linearisation(*this, G, projected); }
-  PH_ALWAYS_INLINE Mat3 stress_derivative(const Linearisation& at, const Mat3& dG) const { return at.apply(dG); }
-  Mat3 stiffness_block(const Linearisation& at, const Vec3& d) const { return at.block(d); }
 
   /// How much stiffer than at rest (explicit stable step): as NeoHookean::stiffening, with the C01 terms'
   /// bounds (|B| <= 2 I1 |F|, |dB| <= 6 I1 |dF|, I2 <= I1^2 / 3).

@@ -12,8 +12,10 @@ namespace pointhaptics {
 /// moduli: mu = E / (2 (1 + nu)), K = E / (3 (1 - 2 nu)), so young and poisson keep their meaning. Unlike
 /// St. Venant-Kirchhoff it stiffens under compression: the volume term's (J - 1)^2 and I1bar's J^-2/3 grow
 /// without bound as a neighbourhood flattens.
-struct NeoHookean {
+struct NeoHookean : HessianTangent<NeoHookean> {
   double mu = 0, bulk = 0;  ///< small-strain shear and bulk moduli, Pa (C10 = mu / 2, D1 = 2 / bulk)
+  NeoHookean() = default;
+  NeoHookean(double mu_, double bulk_) : mu(mu_), bulk(bulk_) {}
 
   double c10() const { return 0.5 * mu; }
 
@@ -54,11 +56,6 @@ struct NeoHookean {
     return c10() * ((g.second * dJ * i1 + g.first * di1) * cof + g.first * i1 * dcof + 2 * g.first * dJ * F + 2 * g.value * dF) +
            bulk * (dJ * cof + jm1 * dcof);
   }
-
-  using Linearisation = HessianLinearisation;
-  Linearisation linearise(const Mat3& G, bool projected) const { return hessian_linearisation(*this, G, projected); }
-  PH_ALWAYS_INLINE Mat3 stress_derivative(const Linearisation& at, const Mat3& dG) const { return at.apply(dG); }
-  Mat3 stiffness_block(const Linearisation& at, const Vec3& d) const { return at.block(d); }
 
   /// How much stiffer than at rest (for the explicit stable step): each term of dP bounded in Frobenius
   /// norms (|F|^2 = I1, |cof F|, |d cof| <= 2 |F| |dF|); the bound's growth over its rest value, over the
