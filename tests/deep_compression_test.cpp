@@ -11,13 +11,14 @@
 namespace pointhaptics {
 namespace {
 
-// a 5 cm cube (E = 2e4 Pa, nu = 0.4) between a held bottom plate and a top plate moved down by `strain`
-RunSummary compress(const std::string& model, double strain) {
+// a 5 cm cube (E = 2e4 Pa, nu = 0.4) between a held bottom plate and a top plate moved down by `strain`,
+// sampled at `spacing`
+RunSummary compress(const std::string& model, double strain, double spacing = 0.005) {
   const std::string text = fmt::format(R"(
 [object]
 shape = "box"
 size = [0.05, 0.05, 0.05]
-spacing = 0.005
+spacing = {}
 [material]
 model = "{}"
 young = 2e4
@@ -29,7 +30,7 @@ box = {{ min = [-1.0, 0.05, -1.0], max = [1.0, 1.0, 1.0] }}
 displacement = [0.0, {}, 0.0]
 [solver]
 kind = "static"
-)", model, -0.05 * strain);
+)", spacing, model, -0.05 * strain);
   SceneSession session = open_scene(parse_scene(text, "compression.toml"));
   session.simulation->step();
   return session.simulation->summary();
@@ -51,8 +52,8 @@ TEST(DeepCompression, StVenantKirchhoffCollapseIsReportedNotConverged) {
 
 TEST(DeepCompression, NeoHookeanHoldsAndStiffensToHalfTheHeight) {
   double previous = 0;
-  for (const double strain : {0.1, 0.2, 0.3, 0.5}) {
-    const RunSummary s = compress("neo_hookean", strain);
+  for (const double strain : {0.1, 0.3, 0.5}) {
+    const RunSummary s = compress("neo_hookean", strain, 0.00625);  // 9 points an edge: the sanitizer builds run it too
     ASSERT_TRUE(s.converged) << strain << ": " << s.failure;
     EXPECT_EQ(s.inverted, 0);
     EXPECT_TRUE(s.collapsed.empty());
@@ -81,8 +82,8 @@ TEST(DeepCompression, AProbePushedToHalfASoftBlocksThicknessNeitherInvertsNorMak
     const std::string text = fmt::format(R"(
 [object]
 shape = "box"
-size = [0.06, 0.04, 0.06]
-origin = [-0.03, 0.0, -0.03]
+size = [0.05, 0.04, 0.05]
+origin = [-0.025, 0.0, -0.025]
 spacing = 0.005
 [material]
 model = "{}"
@@ -94,13 +95,13 @@ box = {{ min = [-1.0, -1.0, -1.0], max = [1.0, 0.0, 1.0] }}
 [solver]
 kind = "explicit"
 dt = 1e-3
-duration = 1.2
+duration = 0.8
 [probe]
 radius = 0.01
 mode = "push"
 stiffness = 500.0
 # the probe starts 10 mm above the top (two radii above it, centre): its lowest point reaches half the thickness
-keyframes = [[0.0, 0.0, 0.0, 0.0], [1.0, 0.0, -0.03, 0.0], [1.2, 0.0, -0.03, 0.0]]
+keyframes = [[0.0, 0.0, 0.0, 0.0], [0.6, 0.0, -0.03, 0.0], [0.8, 0.0, -0.03, 0.0]]
 [device]
 kind = "virtual"
 specs = "custom"
