@@ -95,13 +95,13 @@ box = {{ min = [-1.0, -1.0, -1.0], max = [1.0, 0.0, 1.0] }}
 [solver]
 kind = "explicit"
 dt = 1e-3
-duration = 0.8
+duration = 0.6
 [probe]
 radius = 0.01
 mode = "push"
 stiffness = 500.0
 # the probe starts 10 mm above the top (two radii above it, centre): its lowest point reaches half the thickness
-keyframes = [[0.0, 0.0, 0.0, 0.0], [0.6, 0.0, -0.03, 0.0], [0.8, 0.0, -0.03, 0.0]]
+keyframes = [[0.0, 0.0, 0.0, 0.0], [0.45, 0.0, -0.03, 0.0], [0.6, 0.0, -0.03, 0.0]]
 [device]
 kind = "virtual"
 specs = "custom"
