@@ -89,7 +89,8 @@ struct PowerOfJ {
 /// J - 1 = det(I + G) - 1 = tr G + I2(G) + det G, written in G (no cancellation at small strain).
 PH_ALWAYS_INLINE inline double volume_change(const Mat3& G) {
   const double t = G.trace();
-  return t + 0.5 * (t * t - (G * G).trace()) + G.determinant();
+  const double trace_of_square = (G.array() * G.transpose().array()).sum();  // tr(G G) without the product
+  return t + 0.5 * (t * t - trace_of_square) + G.determinant();
 }
 
 /// The derivative of cof F along dF: rows of cof F are cross products of rows of F (product rule).

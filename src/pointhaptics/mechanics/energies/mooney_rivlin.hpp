@@ -37,13 +37,15 @@ struct MooneyRivlin : HessianTangent<MooneyRivlin> {
     const Mat3 F = Mat3::Identity() + G;
     const Mat3 cof = cofactor(F);
     const double jm1 = volume_change(G), J = 1 + jm1;
-    const PowerOfJ g1(J, 2.0 / 3.0), g2(J, 4.0 / 3.0);
     if (J >= PowerOfJ::j_floor) {
+      // J^-2/3 and J^-4/3 by one cube root (std::pow cost a third of the force loop)
+      const double c = std::cbrt(J), g1 = 1 / (c * c), g2 = g1 * g1;
       const Mat3 E = green_strain(G);
       const Mat3 devE = deviator(E);
-      const Mat3 inner = (c10 * g1.value + c01 * g2.value * (1 + 2 * E.trace())) * devE - (2 * c01 * g2.value) * deviator(E * E);
+      const Mat3 inner = (c10 * g1 + c01 * g2 * (1 + 2 * E.trace())) * devE - (2 * c01 * g2) * deviator(E * E);
       return (scale * 4 / J) * (cof * inner) + (scale * bulk * jm1) * cof;
     }
+    const PowerOfJ g1(J, 2.0 / 3.0), g2(J, 4.0 / 3.0);
     const Mat3 C = F.transpose() * F;
     const double i1 = C.trace(), i2 = 0.5 * (i1 * i1 - (C * C).trace());
     return scale * (c10 * (g1.first * i1 * cof + 2 * g1.value * F) + c01 * (g2.first * i2 * cof + 2 * g2.value * (i1 * F - F * C)) +

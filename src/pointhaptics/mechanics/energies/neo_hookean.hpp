@@ -35,11 +35,13 @@ struct NeoHookean : HessianTangent<NeoHookean> {
     const Mat3 F = Mat3::Identity() + G;
     const Mat3 cof = cofactor(F);
     const double jm1 = volume_change(G), J = 1 + jm1;
-    const PowerOfJ g(J, 2.0 / 3.0);
     if (J >= PowerOfJ::j_floor) {
+      // J^-2/3 / J by one cube root (std::pow cost a third of the force loop)
+      const double c = std::cbrt(J);
       const Mat3 E = green_strain(G);
-      return (scale * 4 * c10() * g.value / J) * (cof * deviator(E)) + (scale * bulk * jm1) * cof;
+      return (scale * 4 * c10() / (c * c * J)) * (cof * deviator(E)) + (scale * bulk * jm1) * cof;
     }
+    const PowerOfJ g(J, 2.0 / 3.0);
     const double i1 = (F.array() * F.array()).sum();
     return scale * (c10() * (g.first * i1 * cof + 2 * g.value * F) + bulk * jm1 * cof);
   }
