@@ -56,8 +56,8 @@ void print_summary(ph::Simulation& sim, const ph::RunSummary& s, double setup_s)
              ph::to_string(m.material.model), m.material.young, m.material.poisson, m.material.density, m.mass.sum(),
              m.point_materials.size() > 1 ? fmt::format("; {} region materials", m.point_materials.size() - 1) : "");
   if (s.inverted_steps > 0 || s.inverted > 0)
-    fmt::print("warning         {} steps ended with inverted neighbourhoods (det F <= 0); {} inverted at the end\n",
-               s.inverted_steps, s.inverted);
+    fmt::print("warning         {} step{} ended with inverted neighbourhoods (det F <= 0); {} inverted at the end\n",
+               s.inverted_steps, s.inverted_steps == 1 ? "" : "s", s.inverted);
   if (s.solver_kind == "static")
     fmt::print("solver          static: {} in {} load increments, {} Newton and {} CG iterations, residual {:.3g}\n",
                s.converged ? "converged" : "NOT converged", s.substeps, s.iterations, s.cg_iterations, s.residual);
