@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <optional>
 #include <thread>
 
 namespace pointhaptics::experiments {
@@ -186,7 +187,18 @@ int run_materials_experiment(const MaterialsOptions& options) {
   const fs::path out = options.out;
   const int threads = options.threads > 0 ? options.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   fem::find_ccx();
-  const std::vector<MaterialModel> models = {MaterialModel::SVK, MaterialModel::NEO_HOOKEAN, MaterialModel::MOONEY_RIVLIN};
+  std::vector<MaterialModel> models = {MaterialModel::SVK, MaterialModel::NEO_HOOKEAN, MaterialModel::MOONEY_RIVLIN};
+  if (!options.models.empty()) {
+    models.clear();
+    for (const std::string& name : options.models) {
+      const std::optional<MaterialModel> model = parse_enum<MaterialModel>(name);
+      if (!model || *model == MaterialModel::COROTATED) {
+        fmt::print(stderr, "pointhaptics: experiment materials: --models: \"{}\" is not one CalculiX has (svk | neo_hookean | mooney_rivlin)\n", name);
+        return 1;
+      }
+      models.push_back(*model);
+    }
+  }
   auto md = fmt::output_file((out / "summary.md").string());
   md.print("# Materials: the point model against CalculiX's own models\n\n"
            "Each model with the same small-strain moduli: svk as CalculiX's *ELASTIC with NLGEOM, neo_hookean as "

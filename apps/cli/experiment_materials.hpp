@@ -1,6 +1,7 @@
 #pragma once
 /// @file `pointhaptics experiment materials`: each hyperelastic model against CalculiX's own (issue 17).
 #include <string>
+#include <vector>
 
 namespace pointhaptics::experiments {
 
@@ -9,6 +10,7 @@ struct MaterialsOptions {
   bool quick = false;                 ///< coarse CalculiX meshes only (a minute)
   int threads = 0;                    ///< point model and ccx threads (0: all)
   std::string plot_script;            ///< plot_materials.py; empty: the built-in search
+  std::vector<std::string> models;    ///< of svk, neo_hookean, mooney_rivlin; empty: all three
 };
 
 /// For svk (*ELASTIC with NLGEOM), neo_hookean (NEO HOOKE) and mooney_rivlin (MOONEY-RIVLIN): the seed's

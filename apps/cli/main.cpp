@@ -324,6 +324,7 @@ int main(int argc, char** argv) {
   materials_cmd->add_option("--threads", materials.threads, "Threads for the point model and ccx (0: all)")
       ->check(CLI::NonNegativeNumber);
   materials_cmd->add_option("--plot-script", materials.plot_script, "plot_materials.py to use");
+  materials_cmd->add_option("--models", materials.models, "Only these models (svk, neo_hookean, mooney_rivlin)")->delimiter(',');
 
   ph::experiments::BeamOptions beam;
   CLI::App* beam_cmd = experiment_cmd->add_subcommand(
