@@ -64,7 +64,6 @@ void ModelSimulation::count_inverted_neighbourhoods() {
   StepDiagnostics& d = diagnostics_;
   d.inverted = count_inverted(model_, ws_);
   d.inverted_steps += d.inverted > 0;
-  d.max_inverted = std::max(d.max_inverted, d.inverted);
 }
 
 void ModelSimulation::record(const StepReport& report, double seconds) {

@@ -32,7 +32,6 @@ struct StepDiagnostics {
   long long inverted_steps = 0; ///< steps that ended with inverted neighbourhoods (det F <= 0)
   index_t inverted = 0;         ///< inverted neighbourhoods at the end of the last step (of its last force
                                 ///< evaluation: explicit steps one sub-step before the end)
-  index_t max_inverted = 0;     ///< the most at the end of any step
   StepStatus status = StepStatus::CONVERGED;  ///< of the last step
   bool failed = false;          ///< a step failed: the state is not a result, and no step follows
   std::string failure;          ///< why

@@ -93,8 +93,10 @@ PointCloud sample_object(const Scene& scene) {
 
 namespace {
 
-// a relative tolerance so that a region drawn on a face catches the points on it
-double region_tolerance(const Model& model) { return 1e-9 * std::max(model.h, 1e-12); }
+// a relative tolerance (of a length of the model: its support, or before it is built its spacing) so that a
+// region drawn on a face catches the points on it
+double region_tolerance(double length) { return 1e-9 * std::max(length, 1e-12); }
+double region_tolerance(const Model& model) { return region_tolerance(model.h); }
 
 // the points of X a selector (a [[fixed]] or [[region]] table, a load's box) takes
 std::vector<index_t> points_in(const Points& X, const PointSelector& where, double tol) {
@@ -115,7 +117,7 @@ void assign_region_materials(const Scene& scene, const Points& X, std::vector<Ma
                             scene.regions.size(), max_point_materials - 1));
   materials = {scene.material};
   material_of.assign(static_cast<std::size_t>(X.cols()), 0);
-  const double tol = 1e-9 * std::max(scene.object.spacing, 1e-12);
+  const double tol = region_tolerance(scene.object.spacing);
   for (std::size_t k = 0; k < scene.regions.size(); ++k) {
     const RegionSpec& r = scene.regions[k];
     MaterialParams m = scene.material;
@@ -131,11 +133,9 @@ void assign_region_materials(const Scene& scene, const Points& X, std::vector<Ma
   }
 }
 
-}  // namespace
-
 // [object] stiffness_map: each point's E_i / E from its voxel's intensity (linear between the rows, the end
 // values beyond them)
-static void apply_stiffness_map(const Scene& scene, PointCloud& cloud) {
+void apply_stiffness_map(const Scene& scene, PointCloud& cloud) {
   const auto& map = scene.object.stiffness_map;
   if (map.empty()) return;
   if (cloud.intensity.size() != cloud.size())
@@ -154,6 +154,8 @@ static void apply_stiffness_map(const Scene& scene, PointCloud& cloud) {
     cloud.stiffness_scale[i] = young / scene.material.young;
   }
 }
+
+}  // namespace
 
 Model build_scene_model(const Scene& scene, double max_memory) {
   // too big for the machine: refused before anything is allocated (files once they are read)

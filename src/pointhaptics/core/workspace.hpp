@@ -50,6 +50,12 @@ class Workspace {
   // scratch of the stencil loop (mechanics/detail/stencil_loop.hpp)
   PaddedPoints padded_u;                  ///< the displacement (or increment) the loop reads
   PaddedGradients gradients;              ///< G_i of the last stencil pass, by columns
+  /// G_i of the last stencil pass, unpadded.
+  Mat3 gradient(index_t i) const {
+    Mat3 G;
+    for (int c = 0; c < 3; ++c) G.col(c) = gradients.block<3, 1>(4 * c, i);
+    return G;
+  }
   std::vector<PaddedPoints> chunk_forces; ///< per-chunk scatter targets, summed into the result  (n_threads)
   std::vector<double> chunk_scalars;      ///< one value per chunk for reductions without atomics  (n_threads)
   /// The solvers' scratch, sized for the model on the first call (explicit dynamics never pays for it);

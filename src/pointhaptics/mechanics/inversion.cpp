@@ -10,10 +10,7 @@ index_t count_inverted(const Model& model, Workspace& ws) {
     index_t inverted = 0;
     const index_t end = std::min(ws.chunk_end(chunk), model.stencil_end());
     for (index_t i = ws.chunk_begin(chunk); i < end; ++i) {
-      Mat3 F;
-      for (int c = 0; c < 3; ++c) F.col(c) = ws.gradients.block<3, 1>(4 * c, i);
-      F += Mat3::Identity();
-      inverted += !(F.determinant() > 0);  // NaN counts
+      inverted += !((Mat3::Identity() + ws.gradient(i)).determinant() > 0);  // NaN counts
     }
     per_chunk[chunk] = static_cast<double>(inverted);
   });

@@ -102,9 +102,7 @@ double strain_stiffening(const Model& model, Workspace& ws) {
       double m = 1;
       const index_t end = std::min(ws.chunk_end(chunk), model.stencil_end());
       for (index_t i = ws.chunk_begin(chunk); i < end; ++i) {
-        Mat3 G;
-        for (int c = 0; c < 3; ++c) G.col(c) = ws.gradients.block<3, 1>(4 * c, i);
-        m = std::max(m, energy.stiffening(i, G));
+        m = std::max(m, energy.stiffening(i, ws.gradient(i)));
       }
       chunk_max[chunk] = m;
     });

@@ -76,10 +76,10 @@ struct MooneyRivlin : HessianTangent<MooneyRivlin> {
     const Mat3 F = Mat3::Identity() + G;
     const double jm1 = volume_change(G);
     const PowerOfJ g1(1 + jm1, 2.0 / 3.0), g2(1 + jm1, 4.0 / 3.0);
-    const PowerOfJ g1_rest(1, 2.0 / 3.0), g2_rest(1, 4.0 / 3.0);
-    const Mat3 I = Mat3::Identity();
-    const double growth = c10 * (NeoHookean::shear_bound(F, g1) - NeoHookean::shear_bound(I, g1_rest)) +
-                          c01 * (second_bound(F, g2) - second_bound(I, g2_rest));
+    // the rest values are constants: computed once
+    static const double first_rest = NeoHookean::shear_bound(Mat3::Identity(), PowerOfJ(1, 2.0 / 3.0));
+    static const double second_rest = second_bound(Mat3::Identity(), PowerOfJ(1, 4.0 / 3.0));
+    const double growth = c10 * (NeoHookean::shear_bound(F, g1) - first_rest) + c01 * (second_bound(F, g2) - second_rest);
     return hyperelastic_stiffening(F, jm1, growth, bulk, mu());
   }
   /// The C01 (I2bar - 3) terms of |dP| / |dF|, over C01.

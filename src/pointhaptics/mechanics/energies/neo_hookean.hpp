@@ -66,8 +66,8 @@ struct NeoHookean : HessianTangent<NeoHookean> {
     const Mat3 F = Mat3::Identity() + G;
     const double jm1 = volume_change(G);
     const PowerOfJ g(1 + jm1, 2.0 / 3.0);
-    return hyperelastic_stiffening(F, jm1, c10() * (shear_bound(F, g) - shear_bound(Mat3::Identity(), PowerOfJ(1, 2.0 / 3.0))),
-                                   bulk, mu);
+    static const double rest = shear_bound(Mat3::Identity(), PowerOfJ(1, 2.0 / 3.0));  // a constant: once
+    return hyperelastic_stiffening(F, jm1, c10() * (shear_bound(F, g) - rest), bulk, mu);
   }
   /// The C10 (I1bar - 3) terms of |dP| / |dF|, over C10.
   static double shear_bound(const Mat3& F, const PowerOfJ& g) {
