@@ -76,6 +76,8 @@ void LevelsOfDetail::set_object_state(const State& state) {
   full_state_.u = state.u;
   full_state_.velocity = state.velocity;
   full_state_.time = state.time;
+  if (state.viscous.rows() == full_state_.viscous.rows() && state.viscous.cols() == full_state_.viscous.cols())
+    full_state_.viscous = state.viscous;
   State active = active_set_.restrict_state(full_state_);
   active.time = state.time;
   active_->set_state(active);

@@ -25,6 +25,9 @@ void ModelSimulation::set_state(const State& state) {
   state_.u = state.u;  // copied into the state's buffers: views of them stay valid
   state_.velocity = state.velocity;
   state_.time = state.time;
+  // a viscoelastic history: the state's when it has one for this model, else at rest
+  if (state.viscous.rows() == state_.viscous.rows() && state.viscous.cols() == state_.viscous.cols()) state_.viscous = state.viscous;
+  else state_.viscous.setZero();
 }
 
 // ---- the step pipeline below the active set: each stage is one function, in the order step() calls them ----

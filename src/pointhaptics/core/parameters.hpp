@@ -32,6 +32,13 @@ enum class MaterialModel {
   COROTATED,      ///< linear corotated (energies/corotated.hpp)
 };
 
+/// One term of a Prony series: the share g of the instantaneous shear stiffness that relaxes with time
+/// constant tau (mechanics/viscoelasticity.hpp).
+struct PronyTerm {
+  double g = 0;    ///< relaxing share of the shear modulus, in (0, 1); the terms' sum stays below 1
+  double tau = 1;  ///< relaxation time, s
+};
+
 struct MaterialParams {
   MaterialModel model = MaterialModel::SVK;
   double young = 1e5;              ///< Young's modulus E, Pa
@@ -44,7 +51,16 @@ struct MaterialParams {
   /// Mooney-Rivlin's split of the shear modulus mu = 2 (c10 + c01), Pa: when given (the scene's c10, c01 and
   /// bulk), young and poisson are set from them; otherwise both are mu / 4
   double c10 = 0, c01 = 0;
+  /// Viscoelasticity: the Prony series of the deviatoric (shear) part, the object's for all its points.
+  /// young and poisson are then the instantaneous moduli; the long-term shear modulus is mu (1 - sum g).
+  std::vector<PronyTerm> prony;
 
+  /// sum_k g_k of the Prony series (0: elastic).
+  double prony_total() const {
+    double g = 0;
+    for (const PronyTerm& t : prony) g += t.g;
+    return g;
+  }
   /// Lame's first parameter lambda = E nu / ((1 + nu)(1 - 2 nu)), Pa.
   double lambda() const { return young * poisson / ((1.0 + poisson) * (1.0 - 2.0 * poisson)); }
   /// Shear modulus mu = E / (2 (1 + nu)), Pa.

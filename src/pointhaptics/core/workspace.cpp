@@ -39,6 +39,7 @@ Workspace::Workspace(const Model& model, int n_threads) : n_points_(model.n_poin
   f_int = Points::Zero(3, model.n_points);
   acceleration = Points::Zero(3, model.n_points);
   padded_u = PaddedPoints::Zero(4, model.n_points);
+  if (!model.material.prony.empty()) overstress = Eigen::Matrix<double, 6, Eigen::Dynamic>::Zero(6, model.n_points);
   gradients = PaddedGradients::Zero(12, model.n_points);
   chunk_scalars.assign(static_cast<std::size_t>(n_threads_), 0.0);
   chunk_forces.assign(n_threads_, PaddedPoints::Zero(4, model.n_points));

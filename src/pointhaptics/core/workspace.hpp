@@ -56,6 +56,12 @@ class Workspace {
     for (int c = 0; c < 3; ++c) G.col(c) = gradients.block<3, 1>(4 * c, i);
     return G;
   }
+  /// Within a step of a viscoelastic model (mechanics/viscoelasticity.hpp): the share of the shear modulus
+  /// left to the material (1: elastic), and the overstress H_i of the history (6 x n, Voigt; sized for a
+  /// viscoelastic model only) when `overstress_active`.
+  double viscous_shear_factor = 1;
+  bool overstress_active = false;
+  Eigen::Matrix<double, 6, Eigen::Dynamic> overstress;
   std::vector<PaddedPoints> chunk_forces; ///< per-chunk scatter targets, summed into the result  (n_threads)
   std::vector<double> chunk_scalars;      ///< one value per chunk for reductions without atomics  (n_threads)
   /// The solvers' scratch, sized for the model on the first call (explicit dynamics never pays for it);

@@ -278,6 +278,25 @@ void read_mooney_rivlin(TableReader& r, MaterialParams& m) {
   m.poisson = (3 * bulk - 2 * mu) / (2 * (3 * bulk + mu));
 }
 
+// prony = [[g, tau], ...]: the relaxing shares of the shear modulus and their times (viscoelasticity.hpp)
+void read_prony(TableReader& r, MaterialParams& m) {
+  const toml::node* node = r.find("prony");
+  if (!node) return;
+  const char* form = "expected [[g, tau], ...] with 1 to 8 terms, each g in (0, 1) and tau in [1e-6, 1e6] s, the g summing below 1";
+  const toml::array* rows = node->as_array();
+  if (!rows || rows->empty() || rows->size() > 8) r.fail_at(*node, "prony", form);
+  m.prony.clear();
+  double sum = 0;
+  for (const toml::node& row : *rows) {
+    const toml::array* pair = row.as_array();
+    if (!pair || pair->size() != 2) r.fail_at(row, "prony", form);
+    const PronyTerm term{r.as_number(*pair->get(0), "prony"), r.as_number(*pair->get(1), "prony")};
+    sum += term.g;
+    if (!(term.g > 0 && term.g < 1) || !(term.tau >= 1e-6 && term.tau <= 1e6) || !(sum < 1)) r.fail_at(row, "prony", form);
+    m.prony.push_back(term);
+  }
+}
+
 void read_material(TableReader& r, MaterialParams& m) {
   m.model = r.enumeration("model", m.model);  // the registry: mechanics/energies/material.hpp
   m.young = read_young(r, m.young);
@@ -289,6 +308,7 @@ void read_material(TableReader& r, MaterialParams& m) {
   m.damping = r.number("damping", m.damping, non_negative, "must be >= 0 (1/s)");
   m.hourglass = r.number("hourglass", m.hourglass, [](double x) { return x >= 0 && x <= 10; }, "must lie in [0, 10]");
   m.volume = r.enumeration("volume", m.volume);
+  read_prony(r, m);
 }
 
 void read_kernel(TableReader& r, KernelParams& k) {

@@ -231,8 +231,10 @@ State ActiveSet::restrict_state(const State& full) const {
   const index_t n = static_cast<index_t>(full_of.size());
   s.u.resize(3, n);
   s.velocity.resize(3, n);
+  s.viscous.resize(full.viscous.rows(), full.viscous.rows() ? n : 0);
   for (index_t k = 0; k < n; ++k) {
     s.u.col(k) = full.u.col(full_of[k]);
+    if (s.viscous.rows()) s.viscous.col(k) = full.viscous.col(full_of[k]);  // the history of a point goes with it
     s.velocity.col(k) = k < n_selected ? Vec3(full.velocity.col(full_of[k])) : Vec3::Zero();  // the ring is held
   }
   s.time = full.time;
@@ -244,6 +246,7 @@ void ActiveSet::prolong_state(const State& active, State& full) const {
   for (index_t k = 0; k < static_cast<index_t>(full_of.size()); ++k) {
     full.u.col(full_of[k]) = active.u.col(k);
     full.velocity.col(full_of[k]) = active.velocity.col(k);
+    if (full.viscous.rows() && full.viscous.rows() == active.viscous.rows()) full.viscous.col(full_of[k]) = active.viscous.col(k);
   }
   // first-order MLS from the followed point: exact for any affine field. Each selected point's gradients
   // once (a point has several followers), into buffers kept for the next call

@@ -12,8 +12,8 @@
 
 namespace pointhaptics {
 
-EnergyTerms strain_energy(const Model& model, const Points& u, std::vector<Mat3>* scratch) {
-  return with_material(model, [&](const auto& energy) {
+EnergyTerms strain_energy(const Model& model, const Points& u, std::vector<Mat3>* scratch, const ViscousStep& step) {
+  return with_material(model, step, [&](const auto& energy) {
     const Csr& nbr = model.neighbours;
     const bool hourglass = model.material.hourglass > 0;
     // every gradient first: the hourglass term of a pair reads both ends' gradients
@@ -39,6 +39,7 @@ EnergyTerms strain_energy(const Model& model, const Points& u, std::vector<Mat3>
             const double v = model.stiffness_volume[i];  // v_i, times E_i / E with a stiffness map
             acc.elastic += v * energy.material_energy_density(i, G);
             acc.volume += v * energy.volume.energy_density(G);
+            acc.viscous += v * energy.viscous_energy_density(i, G);
           }
           return acc;
         },
@@ -46,6 +47,7 @@ EnergyTerms strain_energy(const Model& model, const Points& u, std::vector<Mat3>
           a.elastic += b.elastic;
           a.volume += b.volume;
           a.hourglass += b.hourglass;
+          a.viscous += b.viscous;
           return a;
         });
   });

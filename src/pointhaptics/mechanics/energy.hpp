@@ -1,6 +1,7 @@
 #pragma once
 /// @file The total elastic energy of a displacement field, term by term (independent of the force code).
 #include <pointhaptics/core/model.hpp>
+#include <pointhaptics/mechanics/energies/viscous_overstress.hpp>
 
 #include <vector>
 
@@ -10,13 +11,16 @@ struct EnergyTerms {
   double elastic = 0;    ///< sum_i v_i 0.5 S_i : E_i (St. Venant-Kirchhoff), J
   double volume = 0;     ///< sum_i 0.5 k_v v_i (det F_i - 1)^2, J
   double hourglass = 0;  ///< zero-energy-mode penalty (physics.md), J
-  double total() const { return elastic + volume + hourglass; }
+  double viscous = 0;    ///< within a viscoelastic step: the overstress's term -sum_i v_i H_i : E_i, J (not stored energy)
+  double total() const { return elastic + volume + hourglass + viscous; }
 };
 
 /// The strain energy W(u) whose exact negative gradient compute_internal_forces() returns. `gradients`:
 /// scratch for every point's G_i (resized to n, so a caller that keeps it allocates once); without it the
-/// call allocates its own.
-EnergyTerms strain_energy(const Model& model, const Points& u, std::vector<Mat3>* gradients = nullptr);
+/// call allocates its own. `step`: within a viscoelastic step, the energy that step minimises (relaxed shear
+/// modulus and overstress; viscoelasticity.hpp); by default the elastic one.
+EnergyTerms strain_energy(const Model& model, const Points& u, std::vector<Mat3>* gradients = nullptr,
+                          const ViscousStep& step = {});
 
 /// Kinetic energy 0.5 sum_i m_i |v_i|^2, J.
 double kinetic_energy(const Model& model, const Points& velocity);

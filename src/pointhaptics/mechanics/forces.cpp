@@ -2,6 +2,7 @@
 
 #include <pointhaptics/mechanics/detail/stencil_loop.hpp>
 #include <pointhaptics/mechanics/energies/material.hpp>
+#include <pointhaptics/mechanics/viscoelasticity.hpp>
 
 namespace pointhaptics {
 namespace {
@@ -19,7 +20,7 @@ void internal_forces_of(const Energy energy, const Model& model, const Points& u
 }  // namespace
 
 void compute_internal_forces(const Model& model, const Points& u, Workspace& ws) {
-  with_material(model, [&](const auto& energy) { internal_forces_of(energy, model, u, ws); });
+  with_material(model, viscous_step(ws), [&](const auto& energy) { internal_forces_of(energy, model, u, ws); });
 }
 
 }  // namespace pointhaptics

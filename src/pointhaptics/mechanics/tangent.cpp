@@ -3,6 +3,7 @@
 #include <pointhaptics/mechanics/deformation.hpp>
 #include <pointhaptics/mechanics/detail/stencil_loop.hpp>
 #include <pointhaptics/mechanics/energies/material.hpp>
+#include <pointhaptics/mechanics/viscoelasticity.hpp>
 
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/parallel_for.h>
@@ -47,7 +48,7 @@ PH_ALWAYS_INLINE inline L load_linearisation(const double* base, index_t i) {
 
 void Tangent::linearise(const Model& model, const Points& u, TangentMode mode, Workspace* ws) {
   mode_ = mode;
-  with_material(model, [&](const auto& energy) {
+  with_material(model, ws ? viscous_step(*ws) : ViscousStep{}, [&](const auto& energy) {
     using L = typename std::decay_t<decltype(energy)>::Linearisation;
     linearisation_.resize(doubles_of<L> * static_cast<std::size_t>(model.n_points));
     double* base = linearisation_.data();
@@ -62,7 +63,7 @@ void Tangent::apply(const Model& model, const Points& du, Workspace& ws, Points&
   const bool projected = mode_ == TangentMode::PROJECTED;
   const double* volume = model.stiffness_volume.data();  // v_i, times E_i / E with a stiffness map
   const double* base = linearisation_.data();
-  with_material(model, [&](const auto& energy) {
+  with_material(model, viscous_step(ws), [&](const auto& energy) {
     using L = typename std::decay_t<decltype(energy)>::Linearisation;
     // the force loop with the stress map linearised gives -K du; the hourglass part is linear already
     detail::stencil_sum(model, du, ws, out, -1.0, [energy, volume, base, projected](index_t i, const Mat3& dG) PH_ALWAYS_INLINE -> Mat3 {
@@ -80,7 +81,7 @@ void Tangent::diagonal_blocks(const Model& model, Eigen::Matrix<double, 9, Eigen
   // for j = i), and j's force by -v_i dP(dG) d: the energy's stiffness_block. Gathered per j over the
   // stencils that reach it (neighbourhoods are symmetric), so no two threads write one block. The hourglass
   // part is constant and precomputed in the model (energies/hourglass.cpp).
-  with_material(model, [&](const auto& energy) {
+  with_material(model, ws ? viscous_step(*ws) : ViscousStep{}, [&](const auto& energy) {
     using L = typename std::decay_t<decltype(energy)>::Linearisation;
     for_each_point(n, ws, [&](index_t j) {
       Mat3 K = Mat3::Zero();

@@ -5,6 +5,7 @@
 #include <pointhaptics/mechanics/energies/material.hpp>
 #include <pointhaptics/mechanics/forces.hpp>
 #include <pointhaptics/mechanics/tangent.hpp>
+#include <pointhaptics/mechanics/viscoelasticity.hpp>
 
 #include <Eigen/Eigenvalues>
 
@@ -125,8 +126,12 @@ StepReport explicit_step(const Model& model, State& state, Workspace& ws, double
   const double limit2 = (100 * model.extent) * (100 * model.extent);
   StepReport report;
   double* first_bad = ws.chunk_scalars.data();  // per chunk: the first diverged point, or -1 (no atomics)
+  const bool viscous = !model.material.prony.empty();
   for (int sub = 0; sub < n_sub; ++sub) {
+    // a viscoelastic material: the stress at u uses the history up to the sub-step before, then joins it
+    if (viscous) begin_viscous_step(model, state, h, ws);
     compute_internal_forces(model, state.u, ws);
+    if (viscous) end_viscous_step(model, h, state, ws, /*gradients_current=*/true);
     if (forces) {
       ws.acceleration.setZero();  // scratch for the dynamic forces
       forces->add(model, state, ws.acceleration);

@@ -1,5 +1,7 @@
 #include <pointhaptics/solvers/implicit_solver.hpp>
 
+#include <pointhaptics/mechanics/viscoelasticity.hpp>
+
 #include <fmt/format.h>
 
 namespace pointhaptics {
@@ -36,6 +38,8 @@ StepReport ImplicitSolver::step(const Model& model, State& state, Workspace& ws,
       problem.spring_anchor = &start;
     }
   }
+  // a viscoelastic material over this step: relaxed shear modulus and the history's overstress
+  begin_viscous_step(model, state, dt, ws);
   const NewtonStats stats = newton_.solve(model, problem, next, ws, settings_);
   StepReport report;
   report.iterations = stats.iterations;
@@ -53,6 +57,7 @@ StepReport ImplicitSolver::step(const Model& model, State& state, Workspace& ws,
   state.velocity = (next - state.u) / dt;
   state.u = next;  // copied, not swapped: NumPy views point into the state's buffer
   state.time = t_next;
+  end_viscous_step(model, dt, state, ws, /*gradients_current=*/false);
   return report;
 }
 

@@ -28,8 +28,8 @@ void NewtonSolver::mask_held(const Model& model, Points& x) const {
 }
 
 double NewtonSolver::energy(const Model& model, const NewtonProblem& problem, const Points& u,
-                            std::vector<Mat3>& gradients) const {
-  double pi = strain_energy(model, u, &gradients).total();
+                            std::vector<Mat3>& gradients, const ViscousStep& step) const {
+  double pi = strain_energy(model, u, &gradients, step).total();
   for (index_t i = 0; i < model.n_points; ++i) {
     if (model.fixed[i]) continue;
     pi -= problem.load->col(i).dot(u.col(i));
@@ -128,7 +128,7 @@ NewtonStats NewtonSolver::solve(const Model& model, const NewtonProblem& problem
   // Pi at the current iterate, evaluated only when a line search needs it (NaN: not yet)
   double pi = NAN;
   auto current_pi = [&] {
-    if (std::isnan(pi)) pi = energy(model, problem, u, s.gradients);
+    if (std::isnan(pi)) pi = energy(model, problem, u, s.gradients, viscous_step(ws));
     return pi;
   };
   for (;;) {
@@ -182,7 +182,7 @@ NewtonStats NewtonSolver::solve(const Model& model, const NewtonProblem& problem
       if (!std::isfinite(rel_trial)) continue;
       // the residual test first: it costs nothing more, and Pi is only needed when it fails
       const bool lowers_residual = rel_trial <= (1.0 - 1e-4 * alpha) * rel;
-      const double pi_trial = lowers_residual ? NAN : energy(model, problem, trial, s.gradients);
+      const double pi_trial = lowers_residual ? NAN : energy(model, problem, trial, s.gradients, viscous_step(ws));
       const double pi_now = lowers_residual ? NAN : current_pi();
       const bool armijo = !lowers_residual && std::isfinite(pi_trial) && pi_trial <= pi_now - 1e-4 * alpha * slope &&
                           std::abs(pi_trial - pi_now) > 1e-9 * std::max(std::abs(pi_now), 1e-300);

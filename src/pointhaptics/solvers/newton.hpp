@@ -5,6 +5,7 @@
 
 #include <vector>
 #include <pointhaptics/mechanics/tangent.hpp>
+#include <pointhaptics/mechanics/viscoelasticity.hpp>
 
 namespace pointhaptics {
 
@@ -50,7 +51,9 @@ class NewtonSolver {
                     const NewtonSettings& settings);
 
  private:
-  double energy(const Model& model, const NewtonProblem& problem, const Points& u, std::vector<Mat3>& gradients) const;
+  /// Pi(u); `step`: the material within a viscoelastic step (viscoelasticity.hpp)
+  double energy(const Model& model, const NewtonProblem& problem, const Points& u, std::vector<Mat3>& gradients,
+                const ViscousStep& step) const;
   /// r = -grad Pi at u, zero at held points; returns the relative residual
   double residual(const Model& model, const NewtonProblem& problem, const Points& u, Workspace& ws, Points& r) const;
   void build_preconditioner(const Model& model, const NewtonProblem& problem, Workspace& ws);

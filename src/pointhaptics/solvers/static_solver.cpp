@@ -1,5 +1,7 @@
 #include <pointhaptics/solvers/static_solver.hpp>
 
+#include <pointhaptics/mechanics/viscoelasticity.hpp>
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -53,6 +55,8 @@ StaticStats load_stepping(const Model& model, State& state, Workspace& ws, Newto
 StaticStats solve_static(const Model& model, State& state, Workspace& ws, NewtonSolver& newton,
                          const NewtonSettings& settings) {
   SolverScratch& scratch = ws.solver_scratch();
+  // a viscoelastic material at equilibrium has relaxed fully: its long-term shear modulus
+  if (!model.material.prony.empty()) relaxed_material(model, ws);
   return load_stepping(model, state, ws, newton, settings, scratch.load, scratch.next);
 }
 

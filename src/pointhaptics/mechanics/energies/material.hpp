@@ -10,6 +10,7 @@
 #include <pointhaptics/mechanics/energies/mooney_rivlin.hpp>
 #include <pointhaptics/mechanics/energies/neo_hookean.hpp>
 #include <pointhaptics/mechanics/energies/svk.hpp>
+#include <pointhaptics/mechanics/energies/viscous_overstress.hpp>
 #include <pointhaptics/mechanics/energies/volume_penalty.hpp>
 
 #include <array>
@@ -24,8 +25,15 @@ using AnyMaterial = std::variant<StVenantKirchhoff, NeoHookean, MooneyRivlin, Co
 /// The constants of `params`' model. young and poisson are the small-strain moduli of every model:
 /// lambda = E nu / ((1 + nu)(1 - 2 nu)), mu = E / (2 (1 + nu)), K = E / (3 (1 - 2 nu)); Mooney-Rivlin
 /// splits mu = 2 (C10 + C01) as params.c10 : params.c01 when they are given, else equally.
-inline AnyMaterial material_constants(const MaterialParams& params) {
-  const double lambda = params.lambda(), mu = params.mu(), bulk = params.bulk_modulus();
+/// `shear_factor` and `bulk_factor` scale mu and K apart (lambda = K - 2 mu / 3 follows): every model's
+/// stress is linear in (mu, K), so bulk_factor = 0 leaves its shear part, which a Prony series relaxes,
+/// and shear_factor = 1 - c the material within a viscoelastic step (viscoelasticity.hpp). For St.
+/// Venant-Kirchhoff the split is exact (W = K tr(E)^2 / 2 + mu |dev E|^2); for neo-Hookean and
+/// Mooney-Rivlin it is the isochoric/volumetric one; for corotated the shear part mu |F - R|^2 - (2 mu / 3)
+/// (J - 1)^2 / 2 is deviatoric at small strain.
+inline AnyMaterial material_constants(const MaterialParams& params, double shear_factor = 1, double bulk_factor = 1) {
+  const double mu = shear_factor * params.mu(), bulk = bulk_factor * params.bulk_modulus();
+  const double lambda = shear_factor == 1 && bulk_factor == 1 ? params.lambda() : bulk - 2.0 / 3.0 * mu;
   switch (params.model) {
     case MaterialModel::NEO_HOOKEAN: return NeoHookean{mu, bulk};
     case MaterialModel::MOONEY_RIVLIN: {
@@ -64,25 +72,33 @@ template <class Material>
 struct PointEnergy {
   Material material;
   VolumePenalty volume;
+  ViscousOverstress viscous;  ///< within a viscoelastic step (viscous_overstress.hpp); else none
 
   /// The material's energy per unit volume, without the volume term, J/m^3.
   double material_energy_density(index_t, const Mat3& G) const { return material.energy_density(G); }
+  /// The viscous overstress's term of a step's energy, J/m^3 (0 outside a viscoelastic step).
+  double viscous_energy_density(index_t i, const Mat3& G) const { return viscous.active() ? viscous.energy_density(i, G) : 0.0; }
   double energy_density(index_t i, const Mat3& G) const {
-    return material_energy_density(i, G) + (volume.active() ? volume.energy_density(G) : 0.0);
+    return material_energy_density(i, G) + (volume.active() ? volume.energy_density(G) : 0.0) + viscous_energy_density(i, G);
   }
+  /// The material's own first Piola-Kirchhoff stress, without the volume and viscous terms, Pa.
+  Mat3 material_stress(index_t, const Mat3& G) const { return material.scaled_stress(G, 1.0); }
   /// First Piola-Kirchhoff stress P = dW/dF, Pa, times `scale` (the force loop's v_i).
-  PH_ALWAYS_INLINE Mat3 scaled_stress(index_t, const Mat3& G, double scale) const {
+  PH_ALWAYS_INLINE Mat3 scaled_stress(index_t i, const Mat3& G, double scale) const {
     Mat3 P = material.scaled_stress(G, scale);
     if (volume.active()) P += scale * volume.stress(G);
+    if (viscous.active()) P += scale * viscous.stress(i, G);
     return P;
   }
   PH_ALWAYS_INLINE Mat3 stress(index_t i, const Mat3& G) const { return scaled_stress(i, G, 1.0); }
   using Linearisation = typename Material::Linearisation;
   /// `projected`: the positive semi-definite part (the material's projection, the volume's Gauss-Newton part).
   Linearisation linearise(index_t, const Mat3& G, bool projected) const { return material.linearise(G, projected); }
-  PH_ALWAYS_INLINE Mat3 stress_derivative(index_t, const Linearisation& at, const Mat3& dG, bool projected) const {
+  /// `projected` drops the viscous overstress's term (its sign follows the history's).
+  PH_ALWAYS_INLINE Mat3 stress_derivative(index_t i, const Linearisation& at, const Mat3& dG, bool projected) const {
     Mat3 dP = material.stress_derivative(at, dG);
     if (volume.active()) dP += volume.stress_derivative(at.F, dG, !projected);
+    if (viscous.active() && !projected) dP += viscous.stress_derivative(i, dG);
     return dP;
   }
   Mat3 stiffness_block(index_t, const Linearisation& at, const Vec3& d) const {
@@ -104,6 +120,7 @@ struct MixedEnergy {
   std::array<AnyMaterial, max_materials> materials;
   const std::uint8_t* material_of = nullptr;
   VolumePenalty volume;
+  ViscousOverstress viscous;
 
   template <class Fn>
   PH_ALWAYS_INLINE decltype(auto) visit(index_t i, Fn&& fn) const {
@@ -112,12 +129,17 @@ struct MixedEnergy {
   double material_energy_density(index_t i, const Mat3& G) const {
     return visit(i, [&](const auto& m) { return m.energy_density(G); });
   }
+  double viscous_energy_density(index_t i, const Mat3& G) const { return viscous.active() ? viscous.energy_density(i, G) : 0.0; }
   double energy_density(index_t i, const Mat3& G) const {
-    return material_energy_density(i, G) + (volume.active() ? volume.energy_density(G) : 0.0);
+    return material_energy_density(i, G) + (volume.active() ? volume.energy_density(G) : 0.0) + viscous_energy_density(i, G);
+  }
+  Mat3 material_stress(index_t i, const Mat3& G) const {
+    return visit(i, [&](const auto& m) -> Mat3 { return m.scaled_stress(G, 1.0); });
   }
   PH_ALWAYS_INLINE Mat3 scaled_stress(index_t i, const Mat3& G, double scale) const {
     Mat3 P = visit(i, [&](const auto& m) -> Mat3 { return m.scaled_stress(G, scale); });
     if (volume.active()) P += scale * volume.stress(G);
+    if (viscous.active()) P += scale * viscous.stress(i, G);
     return P;
   }
   PH_ALWAYS_INLINE Mat3 stress(index_t i, const Mat3& G) const { return scaled_stress(i, G, 1.0); }
@@ -125,9 +147,10 @@ struct MixedEnergy {
   Linearisation linearise(index_t i, const Mat3& G, bool projected) const {
     return visit(i, [&](const auto& m) { return as_hessian(m, G, projected); });
   }
-  PH_ALWAYS_INLINE Mat3 stress_derivative(index_t, const Linearisation& at, const Mat3& dG, bool projected) const {
+  PH_ALWAYS_INLINE Mat3 stress_derivative(index_t i, const Linearisation& at, const Mat3& dG, bool projected) const {
     Mat3 dP = at.apply(dG);
     if (volume.active()) dP += volume.stress_derivative(at.F, dG, !projected);
+    if (viscous.active() && !projected) dP += viscous.stress_derivative(i, dG);
     return dP;
   }
   Mat3 stiffness_block(index_t, const Linearisation& at, const Vec3& d) const {
@@ -141,21 +164,30 @@ struct MixedEnergy {
 };
 
 /// fn(energy) with the model's energy: PointEnergy<M> of its one material's model M, or MixedEnergy when its
-/// points have their own materials. The one switch over materials.
+/// points have their own materials; within a viscoelastic step (`step`), with the step's relaxed shear
+/// moduli and overstress. The one switch over materials. The preconditioner's stiffness_block() leaves the
+/// overstress out (it only needs to be close).
 template <class Fn>
-decltype(auto) with_material(const Model& model, Fn&& fn) {
-  const VolumePenalty volume{model.material.volume_stiffness};
+decltype(auto) with_material(const Model& model, const ViscousStep& step, Fn&& fn, double bulk_factor = 1) {
+  const VolumePenalty volume{bulk_factor == 1 ? model.material.volume_stiffness : 0.0};
   if (!model.material_of.empty()) {
     MixedEnergy mixed;
     for (std::size_t k = 0; k < model.point_materials.size() && k < max_materials; ++k)
-      mixed.materials[k] = material_constants(model.point_materials[k]);
+      mixed.materials[k] = material_constants(model.point_materials[k], step.shear_factor, bulk_factor);
     mixed.material_of = model.material_of.data();
     mixed.volume = volume;
+    mixed.viscous = step.overstress;
     return fn(static_cast<const MixedEnergy&>(mixed));
   }
   return std::visit([&](const auto& material) -> decltype(auto) {
-    return fn(PointEnergy<std::decay_t<decltype(material)>>{material, volume});
-  }, material_constants(model.material));
+    return fn(PointEnergy<std::decay_t<decltype(material)>>{material, volume, step.overstress});
+  }, material_constants(model.material, step.shear_factor, bulk_factor));
+}
+
+/// fn(energy) with the model's elastic energy (no viscous step).
+template <class Fn>
+decltype(auto) with_material(const Model& model, Fn&& fn) {
+  return with_material(model, ViscousStep{}, std::forward<Fn>(fn));
 }
 
 }  // namespace pointhaptics
