@@ -5,6 +5,7 @@
 #include <pointhaptics/geometry/sampling.hpp>
 #include <pointhaptics/mechanics/forces.hpp>
 #include <pointhaptics/mechanics/model_builder.hpp>
+#include <pointhaptics/mechanics/viscoelasticity.hpp>
 #include <pointhaptics/haptics/devices/virtual_device.hpp>
 #include <pointhaptics/interactive.hpp>
 #include <pointhaptics/io/output_file.hpp>
@@ -42,8 +43,10 @@ const Model& bench_model(int n) {
 }
 
 // the force loop's cost per material (issue 17): the bench box with each model, and with per-point materials
-// (a neo-Hookean inclusion, ten times stiffer, in the svk box: a stiff nodule in soft tissue)
-const std::array<std::string_view, 5> material_variants = {"svk", "neo_hookean", "mooney_rivlin", "corotated", "regions"};
+// (a neo-Hookean inclusion, ten times stiffer, in the svk box: a stiff nodule in soft tissue), and a
+// viscoelastic neo-Hookean (two Prony terms: the force loop with its history's update, as an explicit sub-step)
+const std::array<std::string_view, 6> material_variants = {"svk", "neo_hookean", "mooney_rivlin", "corotated", "regions",
+                                                           "viscoelastic"};
 
 const Model& material_model(int n, int variant) {
   static std::map<std::pair<int, int>, std::unique_ptr<Model>> cache;
@@ -65,6 +68,9 @@ const Model& material_model(int n, int variant) {
       const Vec3 centre = 0.5 * (base.X.rowwise().minCoeff() + base.X.rowwise().maxCoeff());
       const double radius = 0.3 * (base.X.rowwise().maxCoeff() - base.X.rowwise().minCoeff()).maxCoeff();
       for (index_t i = 0; i < base.n_points; ++i) material_of.push_back((base.X.col(i) - centre).norm() < radius ? 1 : 0);
+    } else if (name == "viscoelastic") {
+      m.model = MaterialModel::NEO_HOOKEAN;
+      m.prony = {{0.3, 0.1}, {0.2, 1.0}};
     } else {
       m.model = *parse_enum<MaterialModel>(name);
     }
@@ -94,9 +100,13 @@ void set_counters(benchmark::State& state, const Model& model, int threads) {
 // the force loop on `model`, timed
 void time_forces(benchmark::State& state, const Model& model, int threads) {
   Workspace ws(model, threads);
-  const Points u = random_displacement(model);
+  State s = State::at_rest(model);
+  s.u = random_displacement(model);
+  const bool viscous = !model.material.prony.empty();
   for (auto _ : state) {
-    compute_internal_forces(model, u, ws);
+    if (viscous) begin_viscous_step(model, s, 1e-4, ws);
+    compute_internal_forces(model, s.u, ws);
+    if (viscous) end_viscous_step(model, 1e-4, s, ws, true);
     benchmark::DoNotOptimize(ws.f_int.data());
     benchmark::ClobberMemory();
   }

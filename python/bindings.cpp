@@ -98,7 +98,7 @@ std::unique_ptr<PySimulation> from_scene(const std::string& path, int threads) {
 std::unique_ptr<PySimulation> from_points(const RowPoints& X, double spacing, py::object fixed, py::object forces,
                                           double young, double poisson, double density, double damping, const std::string& kernel,
                                           double support_factor, const std::string& solver, double dt, int threads,
-                                          const std::string& model_name) {
+                                          const std::string& model_name, const std::vector<std::pair<double, double>>& prony) {
   // the same rules as scene files and the point-cloud readers (issue 21: these were accepted here)
   if (!(spacing > 0) || !std::isfinite(spacing)) throw ph::Error("spacing: must be > 0 (m)");
   if (!(dt >= 1e-9 && dt <= 1)) throw ph::Error("dt: must lie in [1e-9, 1] (s)");
@@ -111,6 +111,8 @@ std::unique_ptr<PySimulation> from_points(const RowPoints& X, double spacing, py
   material.density = density;
   material.damping = damping;
   material.model = enum_value<ph::MaterialModel>("material", "model", model_name);
+  for (const auto& [g, tau] : prony) material.prony.push_back({g, tau});
+  if (!prony.empty() && !ph::valid_prony(material.prony)) throw ph::Error(std::string("prony: ") + ph::prony_rule);
   if (!(young > 0 && young <= 1e13) || !(poisson > -1 && poisson < 0.5) || !(density >= 1e-3 && density <= 1e5) ||
       !(damping >= 0 && std::isfinite(damping)))
     throw ph::Error("material: 0 < young <= 1e13 Pa, -1 < poisson < 0.5, 1e-3 <= density <= 1e5 kg/m^3 and damping >= 0 are "
@@ -167,9 +169,11 @@ names the problem.)doc")
                   py::arg("forces") = py::none(), py::arg("young") = 1e5, py::arg("poisson") = 0.4, py::arg("density") = 1000.0,
                   py::arg("damping") = 0.0, py::arg("kernel") = "poly6", py::arg("support_factor") = 2.0,
                   py::arg("solver") = "explicit", py::arg("dt") = 1e-3, py::arg("threads") = 0, py::arg("model") = "svk",
+                  py::arg("prony") = std::vector<std::pair<double, double>>{},
                   "Build a model from an (n, 3) array of points (m) sampled at `spacing`, with an optional boolean "
                   "`fixed` mask and (n, 3) constant `forces` (N); `model`: svk | neo_hookean | mooney_rivlin | corotated "
-                  "(young and poisson are its small-strain moduli). Scene files take every material key, [[region]] too.")
+                  "(young and poisson are its small-strain moduli); `prony`: [(g, tau), ...], a viscoelastic shear part "
+                  "(young and poisson then the instantaneous moduli). Scene files take every material key, [[region]] too.")
       .def(
           "step", [](PySimulation& p) {
             py::gil_scoped_release release;

@@ -76,6 +76,23 @@ def test_the_material_models_and_regions_are_the_scene_files_keys():
         ph.Simulation.from_points(g, spacing=0.01, model="jelly")
 
 
+def test_from_points_takes_a_prony_series():
+    # a viscoelastic block under a constant pull creeps: its stretch grows toward the long-term one
+    g = np.stack(np.meshgrid(*[np.arange(0, 0.051, 0.01)] * 3, indexing="ij"), -1).reshape(-1, 3)
+    forces = np.zeros_like(g)
+    forces[g[:, 0] == 0.05, 0] = 0.05
+    sim = ph.Simulation.from_points(g, spacing=0.01, fixed=g[:, 0] == 0, forces=forces, young=1e4, solver="implicit",
+                                    dt=0.01, threads=1, model="neo_hookean", damping=20.0, prony=[(0.5, 0.2)])
+    tip = g[:, 0] == 0.05
+    sim.run(0.3)
+    early = sim.displacement[tip, 0].mean()
+    sim.run(1.7)
+    late = sim.displacement[tip, 0].mean()
+    assert late > 1.3 * early > 0
+    with pytest.raises(ph.Error, match="prony"):
+        ph.Simulation.from_points(g, spacing=0.01, prony=[(0.7, 1.0), (0.4, 1.0)])  # the shares sum above 1
+
+
 def test_long_runs_release_the_gil():
     sim = ph.Simulation.from_scene(scene("beam_fixed_both_ends.toml"), threads=1)
     ticks = []

@@ -159,6 +159,25 @@ TEST(SceneToml, MooneyRivlinTakesC10C01AndBulkInsteadOfYoungAndPoisson) {
             std::string::npos);
 }
 
+TEST(SceneToml, PronySeriesIsReadAndChecked) {
+  const std::string material = "young = 1e5";
+  std::string text = full_scene;
+  text.replace(text.find(material), material.size(), "young = 1e5\nprony = [[0.3, 0.1], [0.2, 2]]");
+  const MaterialParams m = parse_scene(text).material;
+  ASSERT_EQ(m.prony.size(), 2u);
+  EXPECT_DOUBLE_EQ(m.prony[1].g, 0.2);
+  EXPECT_DOUBLE_EQ(m.prony[1].tau, 2.0);
+  EXPECT_DOUBLE_EQ(m.prony_total(), 0.5);
+  EXPECT_TRUE(parse_scene(full_scene).material.prony.empty());
+  // the row that breaks the rule is named, with the rule
+  const std::string sum = error_of(material, "young = 1e5\nprony = [[0.6, 0.1],\n [0.5, 2]]");
+  EXPECT_NE(sum.find("material.prony: expected [[g, tau], ...]"), std::string::npos) << sum;
+  EXPECT_NE(sum.find(":" + std::to_string(line_of(material) + 2) + ":"), std::string::npos) << sum;
+  for (const char* bad : {"prony = [[0, 1]]", "prony = [[0.5, 0]]", "prony = [[0.5]]", "prony = []", "prony = 0.5",
+                          "prony = [[0.5, nan]]", "prony = [[0.1, 1], [0.1, 1], [0.1, 1], [0.1, 1], [0.1, 1], [0.1, 1], [0.1, 1], [0.1, 1], [0.1, 1]]"})
+    EXPECT_NE(error_of(material, std::string("young = 1e5\n") + bad).find("material.prony"), std::string::npos) << bad;
+}
+
 TEST(SceneToml, RegionsTakeASelectorAndAnyOfTheMaterialKeys) {
   std::string text = std::string(full_scene) + "\n[[region]]\nsphere = { centre = [0.05, 0.015, 0.015], radius = 0.01 }\nyoung = 1e6\n"
                                   "model = \"neo_hookean\"\n\n[[region]]\nbox = { min = [0, 0, 0], max = [0.01, 0.03, 0.03] }\ndensity = 2000\n";

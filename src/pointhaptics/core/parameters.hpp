@@ -71,6 +71,12 @@ struct MaterialParams {
   double p_wave_speed() const;
 };
 
+/// What a Prony series must be (scene files and Python say it the same way).
+inline constexpr const char* prony_rule =
+    "expected [[g, tau], ...] with 1 to 8 terms, each g in (0, 1) and tau in [1e-6, 1e6] s, the g summing below 1";
+/// Whether `series` follows prony_rule.
+bool valid_prony(const std::vector<PronyTerm>& series);
+
 struct KernelParams {
   KernelType type = KernelType::POLY6;
   double support_factor = 2.0;  ///< h = support_factor * spacing, unless `support` is set

@@ -282,18 +282,14 @@ void read_mooney_rivlin(TableReader& r, MaterialParams& m) {
 void read_prony(TableReader& r, MaterialParams& m) {
   const toml::node* node = r.find("prony");
   if (!node) return;
-  const char* form = "expected [[g, tau], ...] with 1 to 8 terms, each g in (0, 1) and tau in [1e-6, 1e6] s, the g summing below 1";
   const toml::array* rows = node->as_array();
-  if (!rows || rows->empty() || rows->size() > 8) r.fail_at(*node, "prony", form);
+  if (!rows || rows->empty() || rows->size() > 8) r.fail_at(*node, "prony", prony_rule);
   m.prony.clear();
-  double sum = 0;
   for (const toml::node& row : *rows) {
     const toml::array* pair = row.as_array();
-    if (!pair || pair->size() != 2) r.fail_at(row, "prony", form);
-    const PronyTerm term{r.as_number(*pair->get(0), "prony"), r.as_number(*pair->get(1), "prony")};
-    sum += term.g;
-    if (!(term.g > 0 && term.g < 1) || !(term.tau >= 1e-6 && term.tau <= 1e6) || !(sum < 1)) r.fail_at(row, "prony", form);
-    m.prony.push_back(term);
+    if (!pair || pair->size() != 2) r.fail_at(row, "prony", prony_rule);
+    m.prony.push_back({r.as_number(*pair->get(0), "prony"), r.as_number(*pair->get(1), "prony")});
+    if (!valid_prony(m.prony)) r.fail_at(row, "prony", prony_rule);  // the row that breaks it
   }
 }
 
