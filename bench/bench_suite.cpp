@@ -106,7 +106,7 @@ void time_forces(benchmark::State& state, const Model& model, int threads) {
   for (auto _ : state) {
     if (viscous) begin_viscous_step(model, s, 1e-4, ws);
     compute_internal_forces(model, s.u, ws);
-    if (viscous) end_viscous_step(model, 1e-4, s, ws, true);
+    if (viscous) end_viscous_step(model, 1e-4, s, ws);
     benchmark::DoNotOptimize(ws.f_int.data());
     benchmark::ClobberMemory();
   }

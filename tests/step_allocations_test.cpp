@@ -60,8 +60,12 @@ int posix_memalign(void** out, std::size_t alignment, std::size_t size) {
 namespace pointhaptics {
 namespace {
 
-Simulation beam(const std::string& solver) {
-  const Scene scene = parse_scene(test::cantilever_scene(solver, "2e-3"));
+// "implicit" or "implicit_viscoelastic" (the same beam with a Prony series: its history is updated each step)
+Simulation beam(const std::string& kind) {
+  const bool viscous = kind.ends_with("_viscoelastic");
+  std::string text = test::cantilever_scene(viscous ? kind.substr(0, kind.find('_')) : kind, "2e-3");
+  if (viscous) text.replace(text.find("damping"), 0, "prony = [[0.3, 0.05], [0.2, 1.0]]\n");
+  const Scene scene = parse_scene(text);
   return Simulation(build_scene_model(scene), scene.solver, 1);
 }
 
@@ -88,7 +92,8 @@ TEST_P(StepTest, KeepsTheStateBuffersAndAllocatesNothing) {
   EXPECT_LT(sim.state().u.minCoeff(), -1e-6);  // the beam did move
 }
 
-INSTANTIATE_TEST_SUITE_P(Solvers, StepTest, ::testing::Values("explicit", "implicit", "static"),
+INSTANTIATE_TEST_SUITE_P(Solvers, StepTest, ::testing::Values("explicit", "implicit", "static", "explicit_viscoelastic",
+                                                               "implicit_viscoelastic", "static_viscoelastic"),
                          [](const auto& info) { return info.param; });
 
 }  // namespace

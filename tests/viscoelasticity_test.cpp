@@ -82,7 +82,7 @@ TEST_P(HeldStretch, RelaxesAsTheClosedFormAtFiniteStrain) {
     begin_viscous_step(model, state, dt, ws);
     t += dt;
     const Mat3 S = step_stress(model, ws, G, centre);
-    end_viscous_step(model, dt, state, ws, false);
+    end_viscous_step(model, dt, state, ws);
     Mat3 expected = S_el;
     for (const PronyTerm& k : series) {
       const double ramp = 0.01;
@@ -131,7 +131,7 @@ TEST(ViscousStep, ForcesAreTheEnergysGradient) {
   F << 1.1, 0.05, 0.0, 0.0, 0.95, 0.02, 0.03, 0.0, 1.05;
   state.u = affine(model, F);
   begin_viscous_step(model, state, 0.02, ws);
-  end_viscous_step(model, 0.02, state, ws, false);  // some history
+  end_viscous_step(model, 0.02, state, ws);  // some history
   begin_viscous_step(model, state, 0.03, ws);
   std::mt19937 rng(3);
   std::normal_distribution<double> noise;

@@ -78,7 +78,7 @@ void begin_viscous_step(const Model& model, const State& state, double dt, Works
   });
 }
 
-void end_viscous_step(const Model& model, double dt, State& state, Workspace& ws, bool gradients_current) {
+void end_viscous_step(const Model& model, double dt, State& state, Workspace& ws) {
   if (model.material.prony.empty()) return;
   const PronyStep step = prony_step(model.material.prony, dt);
   const auto terms = static_cast<Eigen::Index>(step.terms);
@@ -89,7 +89,7 @@ void end_viscous_step(const Model& model, double dt, State& state, Workspace& ws
         auto history = state.viscous.col(i);
         const Voigt6 S_before = history.segment<6>(6 * terms);
         Mat3 S_now;
-        const Mat3 G = gradients_current ? ws.gradient(i) : displacement_gradient(model, state.u, i);
+        const Mat3 G = displacement_gradient(model, state.u, i);  // seed Eq. 10
         const Voigt6 S = shear_stress_of(shear, i, G, S_now) ? to_voigt(S_now) : S_before;
         for (Eigen::Index k = 0; k < terms; ++k)
           history.segment<6>(6 * k) = step.a[k] * history.segment<6>(6 * k) + step.b[k] * S_before + step.c[k] * S;

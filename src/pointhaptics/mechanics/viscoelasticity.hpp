@@ -14,8 +14,8 @@
 /// unconditionally stable (a_k < 1) for any dt. The stress at the step's end is then
 ///   S' = S_elastic(mu (1 - c)) - H,  c = sum_k c_k,  H = sum_k (a_k Q_k + b_k S_s):
 /// the material with a relaxed shear modulus plus a constant overstress H per point, whose term
-/// (energies/viscous_overstress.hpp) keeps the step an energy minimisation for Newton. Explicit steps take
-/// the same form per sub-step, with the history from the sub-step before.
+/// (energies/viscous_overstress.hpp) keeps the step an energy minimisation for Newton. An explicit step takes
+/// its whole dt as one viscous step: its sub-steps see the stress the step would end with at their u.
 #include <pointhaptics/core/state.hpp>
 #include <pointhaptics/core/workspace.hpp>
 #include <pointhaptics/mechanics/energies/viscous_overstress.hpp>
@@ -42,10 +42,9 @@ Mat3 shear_stress(const Model& model, index_t i, const Mat3& G);
 /// The step's material (relaxed shear modulus) and overstress H_i, from the state's history, into ws: what
 /// compute_internal_forces(), strain_energy() and the tangent then use. No-op for an elastic model.
 void begin_viscous_step(const Model& model, const State& state, double dt, Workspace& ws);
-/// The history at the end of the step: each point's shear stress at the state's displacement (from ws's
-/// gradients when `gradients_current`, the last force evaluation's, else from state.u), and the Q_k.
+/// The history at the end of the step: each point's shear stress at the state's displacement, and the Q_k.
 /// Where a neighbourhood is degenerate (det F < 0.05) the shear stress is kept from the step before.
-void end_viscous_step(const Model& model, double dt, State& state, Workspace& ws, bool gradients_current);
+void end_viscous_step(const Model& model, double dt, State& state, Workspace& ws);
 /// A static solve of a viscoelastic model: the equilibrium after all relaxation, with the long-term shear
 /// modulus mu (1 - sum_k g_k) and no history.
 void relaxed_material(const Model& model, Workspace& ws);

@@ -57,7 +57,7 @@ StepReport ImplicitSolver::step(const Model& model, State& state, Workspace& ws,
   state.velocity = (next - state.u) / dt;
   state.u = next;  // copied, not swapped: NumPy views point into the state's buffer
   state.time = t_next;
-  end_viscous_step(model, dt, state, ws, /*gradients_current=*/false);
+  end_viscous_step(model, dt, state, ws);
   return report;
 }
 
