@@ -165,6 +165,27 @@ TEST(ActiveSet, PointsNoLongerSimulatedStayWhereTheyWereAndAtRest) {
   EXPECT_GT(unsimulated, 0);
 }
 
+TEST(ActiveSet, AViscoelasticHistoryGoesWithItsPoints) {
+  // issue 17: a simulated point's Prony history comes back to it on the object, and goes to it in the next
+  // active set; the rest keep theirs
+  Model full = bar();
+  full.material.prony = {{0.3, 0.1}};
+  const ActiveSet a = build_active_set(full, select(full, Vec3(0.05, 0.03, 0.015), levels()));
+  ASSERT_EQ(a.model.material.prony.size(), 1u);
+  State f = State::at_rest(full);
+  ASSERT_EQ(f.viscous.rows(), 12);
+  for (index_t j = 0; j < full.n_points; ++j) f.viscous.col(j).setConstant(static_cast<double>(j));
+  State active = a.restrict_state(f);
+  ASSERT_EQ(active.viscous.cols(), a.model.n_points);
+  for (index_t k = 0; k < a.model.n_points; ++k) ASSERT_EQ(active.viscous(5, k), static_cast<double>(a.full_of[k]));
+  active.viscous *= 2;  // the active set's steps changed it
+  a.prolong_state(active, f);
+  for (index_t j = 0; j < full.n_points; ++j) {
+    const bool simulated = a.active_of[j] >= 0;
+    ASSERT_EQ(f.viscous(7, j), (simulated ? 2.0 : 1.0) * static_cast<double>(j)) << "point " << j;
+  }
+}
+
 TEST(ActiveSet, StaticSolveAgreesWithTheFullModelNearTheContact) {
   Model full = bar();
   // a point load at the free end's top edge, the contact
