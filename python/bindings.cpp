@@ -5,6 +5,7 @@
 #include <pointhaptics/mechanics/forces.hpp>
 #include <pointhaptics/io/point_cloud_file.hpp>
 #include <pointhaptics/mechanics/model_builder.hpp>
+#include <pointhaptics/mechanics/viscoelasticity.hpp>
 #include <pointhaptics/pointhaptics.hpp>
 
 #include <fmt/format.h>
@@ -248,6 +249,8 @@ names the problem.)doc")
             const auto lock = locked(p);
             const ph::Model& m = p.sim->simulated_model();
             ph::Workspace ws(m, 1);
+            if (p.sim->solver().kind != ph::SolverKind::STATIC) ph::viscous_stress_at_state(m, p.sim->simulated_state(), ws);
+            else ph::relaxed_material(m, ws);
             ph::compute_internal_forces(m, p.sim->simulated_state().u, ws);
             // one row per point of the object, as every other array (with levels of detail the simulated
             // points carry theirs, the others none)

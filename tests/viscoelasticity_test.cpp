@@ -150,6 +150,35 @@ TEST(ViscousStep, ForcesAreTheEnergysGradient) {
   EXPECT_NE(strain_energy(model, u, nullptr, viscous_step(ws)).viscous, 0.0);
 }
 
+TEST(ViscousStep, TheStepsEndStressIsTheStatesStress) {
+  // the stress a step ends with (relaxed modulus, overstress from the history before) is the stress of the
+  // state it leaves (elastic less the new history's sum of Q_k): reactions after a step need no step
+  const Model model = cube(MaterialModel::MOONEY_RIVLIN, {{0.3, 0.05}, {0.25, 0.4}});
+  Workspace ws(model, 2);
+  State state = State::at_rest(model);
+  std::mt19937 rng(5);
+  std::normal_distribution<double> noise;
+  for (const double dt : {0.01, 0.03, 0.2}) {
+    for (Eigen::Index k = 0; k < state.u.size(); ++k) state.u.data()[k] += 2e-4 * noise(rng);
+    begin_viscous_step(model, state, dt, ws);
+    compute_internal_forces(model, state.u, ws);
+    const Points step_end = ws.f_int;
+    end_viscous_step(model, dt, state, ws);
+    viscous_stress_at_state(model, state, ws);
+    compute_internal_forces(model, state.u, ws);
+    EXPECT_LT((ws.f_int - step_end).norm(), 1e-10 * step_end.norm()) << dt;
+  }
+  // and a state that carries no history (made by hand) is taken as at rest, not read out of bounds
+  State bare;
+  bare.u = state.u;
+  bare.velocity = state.velocity;
+  begin_viscous_step(model, bare, 0.01, ws);
+  EXPECT_EQ(ws.overstress.norm(), 0.0);
+  end_viscous_step(model, 0.01, bare, ws);
+  EXPECT_EQ(bare.viscous.rows(), 18);
+  EXPECT_GT(bare.viscous.norm(), 0.0);
+}
+
 // ---- a bar in dynamics against the standard linear solid (one Prony term, small strain) ----
 // G0 = mu, G_inf = (1 - g) mu, K fixed; uniaxial stress: E(t) = E_inf + (E0 - E_inf) e^(-t/tau_R),
 // tau_R = tau (3K + G0) / (3K + G_inf); creep D(t) = 1/E_inf - (1/E_inf - 1/E0) e^(-t/tau_C), tau_C = tau_R E0 / E_inf.

@@ -144,12 +144,24 @@ Outcome point_punch(const MaterialParams& m, double depth, double spacing, int t
   return solve_point_model(punch_scene(m, depth, spacing), threads, [](const Simulation&, const RunSummary& s) { return -s.reactions[1].y(); });
 }
 
-// CalculiX: the whole depth in `increments` equal increments, the punch force printed at each
+// Richardson's extrapolation of three solutions on meshes refined by `ratio` each time (coarse to fine), with
+// the order they show; NAN when they do not converge monotonically
+double richardson(double coarse, double middle, double fine, double ratio) {
+  const double d1 = middle - coarse, d2 = fine - middle;
+  if (!(d1 * d2 > 0) || !(std::abs(d2) < std::abs(d1))) return NAN;
+  const double order = std::log(d1 / d2) / std::log(ratio);
+  return fine + d2 / (std::pow(ratio, order) - 1);
+}
+
+// CalculiX: the whole depth in `increments` equal increments, the punch force printed at each. The block and
+// punch are symmetric about x = 0 and z = 0: CalculiX solves the quarter x, z >= 0 with mirror planes there
+// (nx / 2 elements a side, so nx is the whole block's count across), and the force is four times the quarter's
 std::vector<Outcome> fem_punch(const MaterialParams& m, double depth, int increments, int nx, int threads) {
   fem::BoxProblem p;
-  p.origin = Vec3(-0.05, 0, -0.05);
-  p.size = Vec3(0.1, block_height, 0.1);
-  p.nx = nx, p.ny = nx / 2, p.nz = nx;
+  p.origin = Vec3(0, 0, 0);
+  p.size = Vec3(0.05, block_height, 0.05);
+  p.nx = nx / 2, p.ny = nx / 2, p.nz = nx / 2;
+  p.symmetry = {{0, 0.0}, {2, 0.0}};
   fem::set_material(p, m);
   p.nlgeom = true;
   p.fixed_increments = increments;
@@ -166,7 +178,7 @@ std::vector<Outcome> fem_punch(const MaterialParams& m, double depth, int increm
     for (const fem::Reaction& r : sol.reactions[0]) {
       const int k = static_cast<int>(std::lround(r.time * increments)) - 1;
       if (k < 0 || k >= increments || std::abs(r.time * increments - (k + 1)) > 1e-6) continue;
-      out[k].value = -r.force.y();
+      out[k].value = -4 * r.force.y();
       out[k].ok = true;
       out[k].seconds = sol.wall_s;
     }
@@ -242,33 +254,75 @@ int run_materials_experiment(const MaterialsOptions& options) {
   const std::vector<double> depths = {0.001, 0.002, 0.003, 0.004, 0.005};
   // the punch's footprint is a staircase of the discretisation on both sides: finer spacings and meshes
   // approach the 10 mm disc
-  const int punch_mesh = options.quick ? 10 : 20;
+  std::vector<int> punch_meshes = options.punch_meshes;
+  if (punch_meshes.empty()) punch_meshes = options.quick ? std::vector<int>{10} : std::vector<int>{10, 20, 40};
+  for (int& n : punch_meshes) n += n % 2;  // the quarter has n / 2 a side
+  const int punch_mesh = punch_meshes.back();
+  // the last three meshes, each twice the one before: the edge of a flat punch is singular, so the force
+  // converges slowly with the mesh; Richardson's extrapolation estimates CalculiX's converged force
+  const size_t n_meshes = punch_meshes.size();
+  const bool extrapolate = n_meshes >= 3 && punch_meshes[n_meshes - 1] == 2 * punch_meshes[n_meshes - 2] &&
+                           punch_meshes[n_meshes - 2] == 2 * punch_meshes[n_meshes - 3];
   const std::vector<double> punch_spacings = options.quick ? std::vector<double>{0.005} : std::vector<double>{0.005, 0.0025};
   auto punch_csv = fmt::output_file((out / "punch.csv").string());
-  punch_csv.print("model,spacing_m,depth_m,calculix_n,point_n,error_pct,point_converged,point_inverted\n");
+  punch_csv.print("model,spacing_m,depth_m,calculix_n,point_n,error_pct,point_converged,point_inverted,calculix_extrapolated_n,"
+                  "error_extrapolated_pct\n");
+  auto fem_csv = fmt::output_file((out / "punch-calculix.csv").string());
+  fem_csv.print("model,elements,depth_m,force_n,seconds,converged\n");
+  std::string fem_md;
   md.print("\n## Flat punch (block 0.1 x 0.05 x 0.1 m, E = 1e4 Pa, nu = 0.45, 10 mm radius): force against depth\n\n"
-           "CalculiX {}x{}x{} elements (its punch: the nodes within 10 mm of the centre), the depth in 5 fixed increments; "
-           "the point model's punch: its points within 10 mm.\n\n| model | spacing (mm) | depth (mm) | CalculiX (N) | "
-           "point (N) | error |\n|---|---|---|---|---|---|\n", punch_mesh, punch_mesh / 2, punch_mesh);
+           "CalculiX {}x{}x{} elements (a quarter of them, with two mirror planes; its punch: the nodes within 10 mm of "
+           "the centre), the depth in 5 fixed increments; the point model's punch: its points within 10 mm.\n\n"
+           "| model | spacing (mm) | depth (mm) | CalculiX (N) | point (N) | error | against CalculiX extrapolated |\n"
+           "|---|---|---|---|---|---|---|\n",
+           punch_mesh, punch_mesh / 2, punch_mesh);
   for (const MaterialModel model : models) {
     const MaterialParams m = material_of(model, 1e4, 0.45);
-    const std::vector<Outcome> fem = fem_punch(m, depths.back(), static_cast<int>(depths.size()), punch_mesh, threads);
+    std::vector<Outcome> fem;
+    std::vector<std::vector<Outcome>> by_mesh;
+    for (const int n : punch_meshes) {
+      fem = fem_punch(m, depths.back(), static_cast<int>(depths.size()), n, threads);
+      by_mesh.push_back(fem);
+      std::string cells;
+      for (size_t k = 0; k < depths.size(); ++k) {
+        fem_csv.print("{},{},{},{:.6e},{:.2f},{}\n", to_string(model), n, depths[k], fem[k].value, fem[k].seconds, fem[k].ok);
+        cells += fem[k].ok ? fmt::format(" {:.4f} |", fem[k].value) : " did not converge |";
+      }
+      fmt::print("{} punch CalculiX {}x{}x{}: {:.4f} N at 5 mm ({:.0f} s)\n", to_string(model), n, n / 2, n, fem.back().value,
+                 fem.back().seconds);
+      fem_md += fmt::format("| {} | {}x{}x{} |{} {:.0f} |\n", to_string(model), n, n / 2, n, cells, fem.back().seconds);
+    }
+    std::vector<double> extrapolated(depths.size(), NAN);
+    if (extrapolate) {
+      std::string cells;
+      for (size_t k = 0; k < depths.size(); ++k) {
+        const Outcome &a = by_mesh[n_meshes - 3][k], &b = by_mesh[n_meshes - 2][k], &c = by_mesh[n_meshes - 1][k];
+        if (a.ok && b.ok && c.ok) extrapolated[k] = richardson(a.value, b.value, c.value, 2.0);
+        cells += std::isfinite(extrapolated[k]) ? fmt::format(" {:.4f} |", extrapolated[k]) : " - |";
+      }
+      fem_md += fmt::format("| {} | extrapolated |{} |\n", to_string(model), cells);
+    }
     for (const double spacing : punch_spacings)
       for (size_t k = 0; k < depths.size(); ++k) {
         const Outcome o = point_punch(m, depths[k], spacing, threads);
         const double error = fem[k].ok ? 100 * (o.value / fem[k].value - 1) : NAN;
-        punch_csv.print("{},{},{},{:.6e},{:.6e},{:.3f},{},{}\n", to_string(model), spacing, depths[k], fem[k].value, o.value,
-                        error, o.ok, o.note.find("inverted") != std::string::npos);
+        const double error_extrapolated = 100 * (o.value / extrapolated[k] - 1);
+        punch_csv.print("{},{},{},{:.6e},{:.6e},{:.3f},{},{},{:.6e},{:.3f}\n", to_string(model), spacing, depths[k], fem[k].value,
+                        o.value, error, o.ok, o.note.find("inverted") != std::string::npos, extrapolated[k], error_extrapolated);
         fmt::print("{} punch s = {} m, {} mm: CalculiX {} N, point {:.4f} N{} ({:+.2f}%, {:.1f} s)\n", to_string(model), spacing,
                    1e3 * depths[k], fem[k].ok ? fmt::format("{:.4f}", fem[k].value) : "no result", o.value,
                    o.ok ? "" : " NOT converged", error, o.seconds);
-        md.print("| {} | {} | {} | {} | {} | {} |\n", to_string(model), 1e3 * spacing, 1e3 * depths[k],
+        md.print("| {} | {} | {} | {} | {} | {} | {} |\n", to_string(model), 1e3 * spacing, 1e3 * depths[k],
                  fem[k].ok ? fmt::format("{:.4f}", fem[k].value) : "did not converge",
                  o.ok ? fmt::format("{:.4f}", o.value) : fmt::format("{:.4f} ({})", o.value, first_line(o.note)),
-                 fem[k].ok && o.ok ? fmt::format("{:+.2f}%", error) : "");
+                 fem[k].ok && o.ok ? fmt::format("{:+.2f}%", error) : "",
+                 std::isfinite(error_extrapolated) && o.ok ? fmt::format("{:+.2f}%", error_extrapolated) : "");
       }
   }
   punch_csv.close();
+  fem_csv.close();
+  md.print("\nCalculiX's punch force against its mesh (N; `punch-calculix.csv`; extrapolated: Richardson's extrapolation of the last three meshes with the order they show, the converged force's estimate):\n\n| model | elements | 1 mm | 2 mm | 3 mm | "
+           "4 mm | 5 mm | ccx (s) |\n|---|---|---|---|---|---|---|---|\n{}", fem_md);
   md.close();
   if (run_plot_script("plot_materials.py", out.string(), options.plot_script) != 0) return 1;
   fmt::print("wrote {}\n", out.string());

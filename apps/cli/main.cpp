@@ -325,6 +325,10 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   materials_cmd->add_option("--plot-script", materials.plot_script, "plot_materials.py to use");
   materials_cmd->add_option("--models", materials.models, "Only these models (svk, neo_hookean, mooney_rivlin)")->delimiter(',');
+  materials_cmd->add_option("--punch-meshes", materials.punch_meshes,
+                            "CalculiX's punch meshes, elements across the block (even), coarse to fine; the point model is "
+                            "compared with the finest (default 20,40; --quick: 10)")
+      ->delimiter(',')->check(CLI::Range(2, 200));
 
   ph::experiments::BeamOptions beam;
   CLI::App* beam_cmd = experiment_cmd->add_subcommand(

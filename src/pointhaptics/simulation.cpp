@@ -4,6 +4,7 @@
 #include <pointhaptics/mechanics/energy.hpp>
 #include <pointhaptics/mechanics/forces.hpp>
 #include <pointhaptics/mechanics/inversion.hpp>
+#include <pointhaptics/mechanics/viscoelasticity.hpp>
 #include <pointhaptics/solvers/reactions.hpp>
 
 #include <fmt/format.h>
@@ -143,6 +144,8 @@ RunSummary Simulation::summary() {
   s.cg_iterations = d.cg_iterations;
   s.budget_steps = d.budget_steps;
   s.stable_dt = sim.stable_dt();
+  // a viscoelastic material's stress at the state: its history's, not the last step's in ws
+  if (sim.solver().kind != SolverKind::STATIC) viscous_stress_at_state(model, state, ws);
   compute_internal_forces(model, state.u, ws);
   s.reactions = support_reactions(model, ws.f_int);
   check_physical(model, ws, d, s);

@@ -217,6 +217,24 @@ std::string write_inp(const BoxProblem& p) {
   out += "*SOLID SECTION, ELSET=EBODY, MATERIAL=MAT\n";
   for (size_t s = 0; s < p.inclusions.size(); ++s) out += fmt::format("*SOLID SECTION, ELSET=EINC{0}, MATERIAL=MAT{0}\n", s + 1);
   out += "*BOUNDARY\nNFIX, 1, 3\n";
+  // the mirror planes: one component of the nodes not held or moved already
+  for (size_t s = 0; s < p.symmetry.size(); ++s) {
+    const Symmetry& plane = p.symmetry[s];
+    if (plane.axis < 0 || plane.axis > 2) throw Error(fmt::format("CalculiX mesh: symmetry plane {} has axis {} (0, 1 or 2)", s + 1, plane.axis));
+    std::vector<int> on;
+    for (Eigen::Index k = 0; k < nodes.cols(); ++k) {
+      const int id = static_cast<int>(k + 1);
+      if (std::abs(nodes(plane.axis, k) - plane.at) > tol || std::binary_search(held.begin(), held.end(), id)) continue;
+      if (std::any_of(moved.begin(), moved.end(), [&](const std::vector<int>& m) { return std::binary_search(m.begin(), m.end(), id); }))
+        continue;
+      on.push_back(id);
+    }
+    if (on.empty()) throw Error(fmt::format("CalculiX mesh: symmetry plane {} holds no free node of the mesh", s + 1));
+    std::string set = fmt::format("*NSET, NSET=NSYM{}\n", s + 1);
+    write_id_list(set, on);
+    out.insert(out.rfind("*BOUNDARY\nNFIX"), set);  // sets before the boundary cards
+    out += fmt::format("NSYM{}, {}, {}\n", s + 1, plane.axis + 1, plane.axis + 1);
+  }
   if (p.nlgeom && p.fixed_increments > 0) {
     const double dt = 1.0 / p.fixed_increments;
     out += fmt::format("*STEP, NLGEOM, INC=1000\n*STATIC, DIRECT\n{:.13g}, 1.0\n*CONTROLS, PARAMETERS=FIELD\n1e-5, 1e-4\n", dt);

@@ -42,6 +42,13 @@ struct Prescribed {
   }
 };
 
+/// A plane of mirror symmetry: the nodes on X[axis] = at hold that component of their displacement (zero), so
+/// that a quarter or half of a symmetric problem gives the whole one's solution at a fraction of the cost.
+struct Symmetry {
+  int axis = 0;   ///< 0, 1, 2: x, y, z
+  double at = 0;  ///< m
+};
+
 /// The constitutive card: *ELASTIC (St. Venant-Kirchhoff with NLGEOM), or *HYPERELASTIC NEO HOOKE
 /// (W = C10 (I1bar - 3) + (J - 1)^2 / D1) or MOONEY-RIVLIN (+ C01 (I2bar - 3)).
 enum class FemMaterial { ELASTIC, NEO_HOOKE, MOONEY_RIVLIN };
@@ -62,6 +69,7 @@ struct BoxProblem {
   std::vector<Box> clamps;              ///< nodes inside are held (all three components)
   std::vector<Traction> tractions;
   std::vector<Prescribed> prescribed;   ///< moved nodes (after the clamps: a node in both is held)
+  std::vector<Symmetry> symmetry;       ///< mirror planes (their nodes not held or moved otherwise)
   Vec3 gravity = Vec3::Zero();          ///< m/s^2
   FemMaterial material = FemMaterial::ELASTIC;
   double c10 = 0, c01 = 0, d1 = 0;      ///< hyperelastic constants (Pa, Pa, 1/Pa)
@@ -96,7 +104,7 @@ struct Solution {
 /// The mesh's node positions, in id order (id = column + 1).
 Points mesh_nodes(const BoxProblem& problem);
 /// The complete input deck. Throws Error when the problem is malformed (no clamp, a traction region
-/// that holds no boundary face, non-positive sizes).
+/// that holds no boundary face, a symmetry plane with no node, non-positive sizes).
 std::string write_inp(const BoxProblem& problem);
 /// Displacements of nodes 1..n_nodes from the text of a ccx .dat file (the last "displacements" block
 /// of *NODE PRINT). Throws Error naming `source` on a missing block, a missing or repeated node, a

@@ -46,6 +46,10 @@ bool shear_stress_of(const ShearEnergy& shear, index_t i, const Mat3& G, Mat3& S
   return true;
 }
 
+bool has_history(const Model& model, const State& state) {
+  return state.viscous.rows() == State::viscous_rows(model) && state.viscous.cols() == model.n_points;
+}
+
 template <class Fn>
 decltype(auto) with_shear_part(const Model& model, Fn&& fn) {
   return with_material(model, ViscousStep{}, std::forward<Fn>(fn), /*bulk_factor=*/0.0);
@@ -67,6 +71,10 @@ void begin_viscous_step(const Model& model, const State& state, double dt, Works
   const auto terms = static_cast<Eigen::Index>(step.terms);
   ws.viscous_shear_factor = 1 - step.c_sum;
   ws.overstress_active = true;
+  if (!has_history(model, state)) {  // a state made without one (not State::at_rest's): at rest
+    ws.overstress.setZero();
+    return;
+  }
   ws.for_each_chunk([&](int chunk) {
     for (index_t i = ws.chunk_begin(chunk); i < ws.chunk_end(chunk); ++i) {
       const auto history = state.viscous.col(i);
@@ -82,6 +90,7 @@ void end_viscous_step(const Model& model, double dt, State& state, Workspace& ws
   if (model.material.prony.empty()) return;
   const PronyStep step = prony_step(model.material.prony, dt);
   const auto terms = static_cast<Eigen::Index>(step.terms);
+  if (!has_history(model, state)) state.viscous = Eigen::MatrixXd::Zero(State::viscous_rows(model), model.n_points);
   with_shear_part(model, [&](const auto& shear) {
     ws.for_each_chunk([&](int chunk) {
       const index_t end = std::min(ws.chunk_end(chunk), model.stencil_end());
@@ -96,6 +105,24 @@ void end_viscous_step(const Model& model, double dt, State& state, Workspace& ws
         history.segment<6>(6 * terms) = S;
       }
     });
+  });
+}
+
+void viscous_stress_at_state(const Model& model, const State& state, Workspace& ws) {
+  if (model.material.prony.empty()) return;
+  ws.viscous_shear_factor = 1;
+  ws.overstress_active = true;
+  if (!has_history(model, state)) {
+    ws.overstress.setZero();
+    return;
+  }
+  const auto terms = static_cast<Eigen::Index>(std::min(model.material.prony.size(), max_prony_terms));
+  ws.for_each_chunk([&](int chunk) {
+    for (index_t i = ws.chunk_begin(chunk); i < ws.chunk_end(chunk); ++i) {
+      Voigt6 Q = Voigt6::Zero();
+      for (Eigen::Index k = 0; k < terms; ++k) Q += state.viscous.col(i).segment<6>(6 * k);
+      ws.overstress.col(i) = Q;
+    }
   });
 }
 

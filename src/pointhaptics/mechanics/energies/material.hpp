@@ -29,8 +29,8 @@ using AnyMaterial = std::variant<StVenantKirchhoff, NeoHookean, MooneyRivlin, Co
 /// stress is linear in (mu, K), so bulk_factor = 0 leaves its shear part, which a Prony series relaxes,
 /// and shear_factor = 1 - c the material within a viscoelastic step (viscoelasticity.hpp). For St.
 /// Venant-Kirchhoff the split is exact (W = K tr(E)^2 / 2 + mu |dev E|^2); for neo-Hookean and
-/// Mooney-Rivlin it is the isochoric/volumetric one; for corotated the shear part mu |F - R|^2 - (2 mu / 3)
-/// (J - 1)^2 / 2 is deviatoric at small strain.
+/// Mooney-Rivlin it is the isochoric/volumetric one; for corotated the shear part mu |F - R|^2 - (mu / 3)
+/// tr(R^T F - I)^2 is mu |dev(S - I)|^2 of the stretch S = R^T F.
 inline AnyMaterial material_constants(const MaterialParams& params, double shear_factor = 1, double bulk_factor = 1) {
   const double mu = shear_factor * params.mu(), bulk = bulk_factor * params.bulk_modulus();
   const double lambda = shear_factor == 1 && bulk_factor == 1 ? params.lambda() : bulk - 2.0 / 3.0 * mu;
