@@ -174,16 +174,18 @@ std::vector<Outcome> fem_punch(const MaterialParams& m, double depth, int increm
   p.prescribed.push_back(punch);
   std::vector<Outcome> out(increments);
   try {
-    const fem::Solution sol = fem::solve(p, threads);
-    for (const fem::Reaction& r : sol.reactions[0]) {
+    // ccx may stop part way (St. Venant-Kirchhoff's collapse): the depths it reached are still results
+    const fem::Solution sol = fem::solve(p, threads, /*partial=*/true);
+    for (Outcome& o : out) o.note = sol.failure;
+    for (const fem::Reaction& r : sol.reactions.empty() ? std::vector<fem::Reaction>{} : sol.reactions[0]) {
       const int k = static_cast<int>(std::lround(r.time * increments)) - 1;
       if (k < 0 || k >= increments || std::abs(r.time * increments - (k + 1)) > 1e-6) continue;
       out[k].value = -4 * r.force.y();
       out[k].ok = true;
+      out[k].note.clear();
       out[k].seconds = sol.wall_s;
     }
   } catch (const Error& e) {
-    // ccx stopped (SVK's collapse): the increments it printed are still in no file we kept; report the failure
     for (Outcome& o : out) o.note = e.what();
   }
   return out;
@@ -266,7 +268,7 @@ int run_materials_experiment(const MaterialsOptions& options) {
   const std::vector<double> punch_spacings = options.quick ? std::vector<double>{0.005} : std::vector<double>{0.005, 0.0025};
   auto punch_csv = fmt::output_file((out / "punch.csv").string());
   punch_csv.print("model,spacing_m,depth_m,calculix_n,point_n,error_pct,point_converged,point_inverted,calculix_extrapolated_n,"
-                  "error_extrapolated_pct\n");
+                  "error_extrapolated_pct,calculix_elements\n");
   auto fem_csv = fmt::output_file((out / "punch-calculix.csv").string());
   fem_csv.print("model,elements,depth_m,force_n,seconds,converged\n");
   std::string fem_md;
@@ -292,6 +294,11 @@ int run_materials_experiment(const MaterialsOptions& options) {
                  fem.back().seconds);
       fem_md += fmt::format("| {} | {}x{}x{} |{} {:.0f} |\n", to_string(model), n, n / 2, n, cells, fem.back().seconds);
     }
+    // at each depth the finest mesh that reached it (ccx may stop part way on the finest)
+    std::vector<int> fem_mesh(depths.size(), punch_mesh);
+    for (size_t k = 0; k < depths.size(); ++k)
+      for (size_t mesh = by_mesh.size(); mesh-- > 0 && !fem[k].ok;)
+        if (by_mesh[mesh][k].ok) fem[k] = by_mesh[mesh][k], fem_mesh[k] = punch_meshes[mesh];
     std::vector<double> extrapolated(depths.size(), NAN);
     if (extrapolate) {
       std::string cells;
@@ -307,13 +314,15 @@ int run_materials_experiment(const MaterialsOptions& options) {
         const Outcome o = point_punch(m, depths[k], spacing, threads);
         const double error = fem[k].ok ? 100 * (o.value / fem[k].value - 1) : NAN;
         const double error_extrapolated = 100 * (o.value / extrapolated[k] - 1);
-        punch_csv.print("{},{},{},{:.6e},{:.6e},{:.3f},{},{},{:.6e},{:.3f}\n", to_string(model), spacing, depths[k], fem[k].value,
-                        o.value, error, o.ok, o.note.find("inverted") != std::string::npos, extrapolated[k], error_extrapolated);
+        punch_csv.print("{},{},{},{:.6e},{:.6e},{:.3f},{},{},{:.6e},{:.3f},{}\n", to_string(model), spacing, depths[k], fem[k].value,
+                        o.value, error, o.ok, o.note.find("inverted") != std::string::npos, extrapolated[k], error_extrapolated,
+                        fem_mesh[k]);
         fmt::print("{} punch s = {} m, {} mm: CalculiX {} N, point {:.4f} N{} ({:+.2f}%, {:.1f} s)\n", to_string(model), spacing,
                    1e3 * depths[k], fem[k].ok ? fmt::format("{:.4f}", fem[k].value) : "no result", o.value,
                    o.ok ? "" : " NOT converged", error, o.seconds);
         md.print("| {} | {} | {} | {} | {} | {} | {} |\n", to_string(model), 1e3 * spacing, 1e3 * depths[k],
-                 fem[k].ok ? fmt::format("{:.4f}", fem[k].value) : "did not converge",
+                 fem[k].ok ? fmt::format("{:.4f}{}", fem[k].value, fem_mesh[k] == punch_mesh ? "" : fmt::format(" ({} across)", fem_mesh[k]))
+                           : "did not converge",
                  o.ok ? fmt::format("{:.4f}", o.value) : fmt::format("{:.4f} ({})", o.value, first_line(o.note)),
                  fem[k].ok && o.ok ? fmt::format("{:+.2f}%", error) : "",
                  std::isfinite(error_extrapolated) && o.ok ? fmt::format("{:+.2f}%", error_extrapolated) : "");

@@ -99,6 +99,9 @@ struct Solution {
   /// per Prescribed set, the reaction totals at every printed increment, in time order
   std::vector<std::vector<Reaction>> reactions;
   double wall_s = 0;    ///< ccx run time, s
+  /// solve(..., partial = true) of a run ccx stopped (e.g. diverged): why, and the reactions are those of the
+  /// increments it finished (displacements empty); empty for a complete run
+  std::string failure;
 };
 
 /// The mesh's node positions, in id order (id = column + 1).
@@ -116,7 +119,8 @@ std::vector<Reaction> read_dat_totals(std::istream& dat, const std::string& set,
 /// The `ccx` program: $PH_CCX if set, else `ccx` on PATH; throws Error saying how to install it if absent.
 std::string find_ccx();
 /// Write the deck into a fresh temporary folder, run ccx there (threads = OMP_NUM_THREADS), read the
-/// displacements, remove the folder (kept, and named in the error, when ccx fails).
-Solution solve(const BoxProblem& problem, int threads = 1);
+/// displacements, remove the folder (kept, and named in the error, when ccx fails). `partial`: a run ccx
+/// stopped returns the reactions of the increments it finished, with Solution::failure, instead of throwing.
+Solution solve(const BoxProblem& problem, int threads = 1, bool partial = false);
 
 }  // namespace pointhaptics::fem
