@@ -44,7 +44,8 @@ const Model& bench_model(int n) {
 
 // the force loop's cost per material (issue 17): the bench box with each model, and with per-point materials
 // (a neo-Hookean inclusion, ten times stiffer, in the svk box: a stiff nodule in soft tissue), and a
-// viscoelastic neo-Hookean (two Prony terms: the force loop with its history's update, as an explicit sub-step)
+// viscoelastic neo-Hookean (two Prony terms: the force loop with its history's update, as in an implicit step's
+// solve or an explicit step of one sub-step)
 const std::array<std::string_view, 6> material_variants = {"svk", "neo_hookean", "mooney_rivlin", "corotated", "regions",
                                                            "viscoelastic"};
 

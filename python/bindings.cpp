@@ -112,8 +112,7 @@ std::unique_ptr<PySimulation> from_points(const RowPoints& X, double spacing, py
   material.density = density;
   material.damping = damping;
   material.model = enum_value<ph::MaterialModel>("material", "model", model_name);
-  for (const auto& [g, tau] : prony) material.prony.push_back({g, tau});
-  if (!prony.empty() && !ph::valid_prony(material.prony)) throw ph::Error(std::string("prony: ") + ph::prony_rule);
+  for (const auto& [g, tau] : prony) material.prony.push_back({g, tau});  // build_model checks it, as every material
   if (!(young > 0 && young <= 1e13) || !(poisson > -1 && poisson < 0.5) || !(density >= 1e-3 && density <= 1e5) ||
       !(damping >= 0 && std::isfinite(damping)))
     throw ph::Error("material: 0 < young <= 1e13 Pa, -1 < poisson < 0.5, 1e-3 <= density <= 1e5 kg/m^3 and damping >= 0 are "
@@ -249,8 +248,7 @@ names the problem.)doc")
             const auto lock = locked(p);
             const ph::Model& m = p.sim->simulated_model();
             ph::Workspace ws(m, 1);
-            if (p.sim->solver().kind != ph::SolverKind::STATIC) ph::viscous_stress_at_state(m, p.sim->simulated_state(), ws);
-            else ph::relaxed_material(m, ws);
+            ph::viscous_stress_at_state(m, p.sim->simulated_state(), ws, p.sim->solver().kind == ph::SolverKind::STATIC);
             ph::compute_internal_forces(m, p.sim->simulated_state().u, ws);
             // one row per point of the object, as every other array (with levels of detail the simulated
             // points carry theirs, the others none)

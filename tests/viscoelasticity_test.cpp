@@ -164,7 +164,7 @@ TEST(ViscousStep, TheStepsEndStressIsTheStatesStress) {
     compute_internal_forces(model, state.u, ws);
     const Points step_end = ws.f_int;
     end_viscous_step(model, dt, state, ws);
-    viscous_stress_at_state(model, state, ws);
+    viscous_stress_at_state(model, state, ws, false);
     compute_internal_forces(model, state.u, ws);
     EXPECT_LT((ws.f_int - step_end).norm(), 1e-10 * step_end.norm()) << dt;
   }

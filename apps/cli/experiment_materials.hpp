@@ -12,7 +12,7 @@ struct MaterialsOptions {
   std::string plot_script;            ///< plot_materials.py; empty: the built-in search
   std::vector<std::string> models;    ///< of svk, neo_hookean, mooney_rivlin; empty: all three
   /// CalculiX's punch meshes, elements across the block (even: it solves a quarter with half as many a side);
-  /// the point model is compared with the last. Empty: 20, 40 (quick: 10)
+  /// the point model is compared with the last. Empty: 10, 20, 40 (quick: 10)
   std::vector<int> punch_meshes;
 };
 

@@ -327,7 +327,7 @@ int main(int argc, char** argv) {
   materials_cmd->add_option("--models", materials.models, "Only these models (svk, neo_hookean, mooney_rivlin)")->delimiter(',');
   materials_cmd->add_option("--punch-meshes", materials.punch_meshes,
                             "CalculiX's punch meshes, elements across the block (even), coarse to fine; the point model is "
-                            "compared with the finest (default 20,40; --quick: 10)")
+                            "compared with the finest (default 10,20,40; --quick: 10)")
       ->delimiter(',')->check(CLI::Range(2, 200));
 
   ph::experiments::BeamOptions beam;

@@ -145,7 +145,7 @@ RunSummary Simulation::summary() {
   s.budget_steps = d.budget_steps;
   s.stable_dt = sim.stable_dt();
   // a viscoelastic material's stress at the state: its history's, not the last step's in ws
-  if (sim.solver().kind != SolverKind::STATIC) viscous_stress_at_state(model, state, ws);
+  viscous_stress_at_state(model, state, ws, sim.solver().kind == SolverKind::STATIC);
   compute_internal_forces(model, state.u, ws);
   s.reactions = support_reactions(model, ws.f_int);
   check_physical(model, ws, d, s);

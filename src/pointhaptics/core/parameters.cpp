@@ -9,7 +9,7 @@ double MaterialParams::p_wave_speed() const {
 }
 
 bool valid_prony(const std::vector<PronyTerm>& series) {
-  if (series.empty() || series.size() > 8) return false;
+  if (series.empty() || series.size() > max_prony_terms) return false;
   double sum = 0;
   for (const PronyTerm& t : series) {
     if (!(t.g > 0 && t.g < 1) || !(t.tau >= 1e-6 && t.tau <= 1e6)) return false;

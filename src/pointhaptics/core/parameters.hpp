@@ -71,6 +71,8 @@ struct MaterialParams {
   double p_wave_speed() const;
 };
 
+/// The most terms a Prony series may have.
+inline constexpr std::size_t max_prony_terms = 8;
 /// What a Prony series must be (scene files and Python say it the same way).
 inline constexpr const char* prony_rule =
     "expected [[g, tau], ...] with 1 to 8 terms, each g in (0, 1) and tau in [1e-6, 1e6] s, the g summing below 1";

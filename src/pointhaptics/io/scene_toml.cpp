@@ -283,7 +283,7 @@ void read_prony(TableReader& r, MaterialParams& m) {
   const toml::node* node = r.find("prony");
   if (!node) return;
   const toml::array* rows = node->as_array();
-  if (!rows || rows->empty() || rows->size() > 8) r.fail_at(*node, "prony", prony_rule);
+  if (!rows || rows->empty() || rows->size() > max_prony_terms) r.fail_at(*node, "prony", prony_rule);
   m.prony.clear();
   for (const toml::node& row : *rows) {
     const toml::array* pair = row.as_array();

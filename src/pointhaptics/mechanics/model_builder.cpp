@@ -26,6 +26,7 @@ void validate_material(const MaterialParams& m) {
   if (!(m.volume_stiffness >= 0) || !std::isfinite(m.volume_stiffness)) bad("volume_stiffness", m.volume_stiffness, "must be >= 0 and finite (Pa)");
   if (!(m.damping >= 0) || !std::isfinite(m.damping)) bad("damping", m.damping, "must be >= 0 and finite (1/s)");
   if (!(m.hourglass >= 0) || !std::isfinite(m.hourglass)) bad("hourglass", m.hourglass, "must be >= 0 and finite");
+  if (!m.prony.empty() && !valid_prony(m.prony)) throw Error(fmt::format("material: prony: {}", prony_rule));
 }
 
 namespace {

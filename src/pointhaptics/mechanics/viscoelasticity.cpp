@@ -108,8 +108,12 @@ void end_viscous_step(const Model& model, double dt, State& state, Workspace& ws
   });
 }
 
-void viscous_stress_at_state(const Model& model, const State& state, Workspace& ws) {
+void viscous_stress_at_state(const Model& model, const State& state, Workspace& ws, bool relaxed) {
   if (model.material.prony.empty()) return;
+  if (relaxed) {
+    relaxed_material(model, ws);
+    return;
+  }
   ws.viscous_shear_factor = 1;
   ws.overstress_active = true;
   if (!has_history(model, state)) {

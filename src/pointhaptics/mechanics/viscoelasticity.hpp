@@ -24,9 +24,6 @@
 
 namespace pointhaptics {
 
-/// The most terms a Prony series may have (the scene reader's limit).
-inline constexpr std::size_t max_prony_terms = 8;
-
 /// The coefficients of one step of length dt, per term.
 struct PronyStep {
   std::size_t terms = 0;
@@ -45,9 +42,10 @@ void begin_viscous_step(const Model& model, const State& state, double dt, Works
 /// The history at the end of the step: each point's shear stress at the state's displacement, and the Q_k.
 /// Where a neighbourhood is degenerate (det F < 0.05) the shear stress is kept from the step before.
 void end_viscous_step(const Model& model, double dt, State& state, Workspace& ws);
-/// The material at the state itself, between steps, into ws: the elastic stress less the history's overstress
-/// sum_k Q_k (reactions and forces reported after a step). No-op for an elastic model.
-void viscous_stress_at_state(const Model& model, const State& state, Workspace& ws);
+/// The material at the state itself, between steps, into ws (reactions and forces reported after a step):
+/// the elastic stress less the history's overstress sum_k Q_k, or after a static solve (`relaxed`) the
+/// long-term material. No-op for an elastic model.
+void viscous_stress_at_state(const Model& model, const State& state, Workspace& ws, bool relaxed);
 /// A static solve of a viscoelastic model: the equilibrium after all relaxation, with the long-term shear
 /// modulus mu (1 - sum_k g_k) and no history.
 void relaxed_material(const Model& model, Workspace& ws);

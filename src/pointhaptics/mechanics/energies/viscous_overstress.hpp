@@ -35,8 +35,6 @@ struct ViscousOverstress {
   double energy_density(index_t i, const Mat3& G) const { return -(at(i).array() * green_strain(G).array()).sum(); }
   PH_ALWAYS_INLINE Mat3 stress(index_t i, const Mat3& G) const { return -(Mat3::Identity() + G) * at(i); }
   PH_ALWAYS_INLINE Mat3 stress_derivative(index_t i, const Mat3& dG) const { return -dG * at(i); }
-  /// The 3x3 block of dP for dG = e_b d^T applied to d: -(d^T H_i d) I.
-  Mat3 stiffness_block(index_t i, const Vec3& d) const { return -d.dot(at(i) * d) * Mat3::Identity(); }
 };
 
 /// What a viscoelastic material is within one step: its shear modulus scaled by shear_factor (1 - c) and the
