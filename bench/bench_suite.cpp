@@ -231,6 +231,8 @@ class CollectingReporter : public benchmark::ConsoleReporter {
     ConsoleReporter::ReportRuns(runs);
     for (const Run& run : runs) {
       if (run.error_occurred) continue;
+      // repeated: the median of the repetitions (the other aggregates are printed only)
+      if (run.run_type == Run::RT_Aggregate && run.aggregate_name != "median") continue;
       if (run.benchmark_name().rfind("haptic", 0) == 0) {
         nlohmann::json row;
         for (const char* key : {"points", "rate_hz", "period_p50_us", "period_p99_us", "period_max_us", "tick_max_us",
@@ -305,9 +307,14 @@ int run_bench_suite(const BenchOptions& options) {
   }
   std::string filter_flag = "--benchmark_filter=" + options.filter;
   std::string name = "pointhaptics-bench";
-  char* argv[] = {name.data(), filter_flag.data(), nullptr};
-  int argc = 2;
-  benchmark::Initialize(&argc, argv);
+  // repetitions in random order, so that a shared machine's slow spells fall on every benchmark alike
+  std::string repetitions = fmt::format("--benchmark_repetitions={}", options.repetitions), interleave = "--benchmark_enable_random_interleaving=true",
+              aggregates = "--benchmark_report_aggregates_only=true";
+  std::vector<char*> argv = {name.data(), filter_flag.data()};
+  if (options.repetitions > 1) argv.insert(argv.end(), {repetitions.data(), interleave.data(), aggregates.data()});
+  int argc = static_cast<int>(argv.size());
+  argv.push_back(nullptr);
+  benchmark::Initialize(&argc, argv.data());
   CollectingReporter reporter;
   const std::size_t ran = benchmark::RunSpecifiedBenchmarks(&reporter);
   benchmark::Shutdown();
@@ -315,6 +322,11 @@ int run_bench_suite(const BenchOptions& options) {
     fmt::print(stderr, "pointhaptics bench: --filter '{}' matches no benchmark\n", options.filter);
     return 1;
   }
+  // each material's time relative to svk's at the same size and threads (the cost measure)
+  for (nlohmann::json& row : reporter.materials)
+    for (const nlohmann::json& svk : reporter.materials)
+      if (svk["model"] == "svk" && svk["points"] == row["points"] && svk["threads"] == row["threads"])
+        row["relative_to_svk"] = svk["point_steps_per_s"].get<double>() / row["point_steps_per_s"].get<double>();
   if (!options.json_path.empty()) {
     const std::string text =
         nlohmann::json{{"force", reporter.force}, {"step", reporter.step}, {"beam_4x1x1", reporter.beam}, {"haptic", reporter.haptic},

@@ -304,6 +304,8 @@ int main(int argc, char** argv) {
   bench_cmd->add_option("--min-time", bench.min_time, "Seconds per benchmark")->check(CLI::PositiveNumber);
   bench_cmd->add_option("--sizes", bench.sizes, "Approximate point counts")->check(CLI::PositiveNumber);
   bench_cmd->add_option("--threads", bench.threads, "Thread counts")->check(CLI::PositiveNumber);
+  bench_cmd->add_option("--repetitions", bench.repetitions, "Run each benchmark N times in random order and report medians (steadier on a shared machine)")
+      ->check(CLI::PositiveNumber);
 
   ph::experiments::CantileverOptions cantilever;
   CLI::App* experiment_cmd = app.add_subcommand("experiment", "Reproduce a seed experiment: CSV, markdown summary, PNG plots");

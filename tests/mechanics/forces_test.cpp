@@ -1,5 +1,5 @@
 // Tests for mechanics/forces and mechanics/energy: exact gradient, invariance, balance, patch test,
-// zero-energy modes; every energy term on and off, several kernels and volume modes.
+// zero-energy modes; every energy term on and off, several kernels and volume modes, every material model.
 #include <pointhaptics/mechanics/deformation.hpp>
 #include <pointhaptics/mechanics/energies/svk.hpp>
 #include <pointhaptics/mechanics/energy.hpp>
@@ -19,6 +19,7 @@ struct Config {
   KernelType kernel = KernelType::POLY6;
   VolumeMode volume = VolumeMode::CELL;
   double support_factor = 2.0;
+  MaterialModel model = MaterialModel::SVK;
 };
 
 std::ostream& operator<<(std::ostream& os, const Config& c) { return os << c.name; }
@@ -27,6 +28,7 @@ const double spacing = 0.01;
 
 Model make_model(const Config& c, double jitter = 0.2) {
   MaterialParams m;
+  m.model = c.model;
   m.young = 1e5;
   m.poisson = 0.4;
   m.volume_stiffness = c.volume_stiffness;
@@ -120,7 +122,11 @@ INSTANTIATE_TEST_SUITE_P(
                       Config{"all_terms", 3e5, 0.2}, Config{"spiky", 1e5, 0.05, KernelType::SPIKY},
                       Config{"viscosity", 1e5, 0.05, KernelType::VISCOSITY},
                       Config{"quadratic_wide", 1e5, 0.05, KernelType::QUADRATIC, VolumeMode::CELL, 2.6},
-                      Config{"kernel_volumes", 1e5, 0.05, KernelType::POLY6, VolumeMode::KERNEL}),
+                      Config{"kernel_volumes", 1e5, 0.05, KernelType::POLY6, VolumeMode::KERNEL},
+                      // each model through the force loop's four-point stresses (lanes.hpp)
+                      Config{"neo_hookean", 0.0, 0.05, KernelType::POLY6, VolumeMode::CELL, 2.0, MaterialModel::NEO_HOOKEAN},
+                      Config{"mooney_rivlin", 3e5, 0.05, KernelType::POLY6, VolumeMode::CELL, 2.0, MaterialModel::MOONEY_RIVLIN},
+                      Config{"corotated", 0.0, 0.05, KernelType::POLY6, VolumeMode::CELL, 2.0, MaterialModel::COROTATED}),
     [](const auto& info) { return std::string(info.param.name); });
 
 TEST(Deformation, AffineFieldGivesItsExactGradientEverywhere) {

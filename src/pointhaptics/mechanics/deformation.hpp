@@ -2,6 +2,7 @@
 /// @file Per-point kinematics: G_i (seed Eq. 10), F_i, the Green strain (Eq. 2), cof F; the materials build on them
 /// (mechanics/energies/).
 #include <pointhaptics/core/model.hpp>
+#include <pointhaptics/mechanics/energies/lanes.hpp>
 
 #include <Eigen/Eigenvalues>
 
@@ -23,16 +24,10 @@ inline Mat3 displacement_gradient(const Model& model, const Points& u, index_t i
 /// Green strain E = 0.5 (F^T F - I) = 0.5 (G + G^T + G^T G) from the displacement gradient G (seed Eq. 2).
 /// Written in G: forming F^T F - I cancels catastrophically at small strain (at |G| ~ 1e-9 only 7 digits
 /// survive, which puts a floor under Newton's residual).
-PH_ALWAYS_INLINE inline Mat3 green_strain(const Mat3& G) { return 0.5 * (G + G.transpose() + G.transpose() * G); }
+PH_ALWAYS_INLINE inline Mat3 green_strain(const Mat3& G) { return to_eigen(green_strain(to_matrix3(G))); }
 
 /// Cofactor matrix cof F = det(F) F^-T; its rows are (r1 x r2, r2 x r0, r0 x r1) for rows r_a of F.
-inline Mat3 cofactor(const Mat3& F) {
-  Mat3 C;
-  C.row(0) = F.row(1).cross(F.row(2));
-  C.row(1) = F.row(2).cross(F.row(0));
-  C.row(2) = F.row(0).cross(F.row(1));
-  return C;
-}
+inline Mat3 cofactor(const Mat3& F) { return to_eigen(cofactor(to_matrix3(F))); }
 
 /// A symmetric matrix with its negative eigenvalues set to zero.
 inline Mat3 positive_part(const Mat3& S) {

@@ -19,18 +19,17 @@
 #endif
 #include <pointhaptics/core/workspace.hpp>
 #include <pointhaptics/mechanics/energies/hourglass.hpp>
+#include <pointhaptics/mechanics/energies/lanes.hpp>
 
 #include <algorithm>
+#include <concepts>
 #include <cstring>
 #include <type_traits>
 
 namespace pointhaptics::detail {
 
-#if !defined(__GNUC__)
-#error "stencil_loop.hpp uses GCC/Clang vector extensions"
-#endif
 /// x, y, z and a zero pad; arithmetic with a double broadcasts it.
-typedef double Lane4 __attribute__((vector_size(4 * sizeof(double))));
+using Lane4 = Lanes;
 
 inline Lane4 load4(const double* p) {
   Lane4 v;
@@ -76,11 +75,18 @@ inline void gradient_pass(const Model& model, const PaddedPoints& u, index_t fir
   }
 }
 
+/// A stress map that also takes four consecutive points at once: stress(i, count, G) for the points
+/// i .. i + count - 1 (lanes.hpp).
+template <class StressMap>
+concept FourPointStressMap = requires(const StressMap& stress, const Matrix3<Lanes>& G) {
+  { stress(index_t{}, int{}, G) } -> std::same_as<Matrix3<Lanes>>;
+};
+
 /// Pass 2: adds, for the stencils i in [first, last), the terms of y = -dW/du into `out` (padded), with
 /// the stress map A_i = stress(i, G_i) and the gradients of pass 1. With the hourglass penalty
 /// (energies/hourglass.hpp) its exact gradient is added per pair:
 ///   y_j -= k_ij r_ij,  y_i += k_ij r_ij,   and A_i -= Q_i = sum_j k_ij r_ij X_ij^T,
-/// then y_j -= A_i d_ij, y_i -= A_i d_ii.
+/// then y_j -= A_i d_ij, y_i -= A_i d_ii. A FourPointStressMap is asked for four stencils' A_i at once.
 template <bool hourglass, class StressMap>
 void stencil_loop(const Model& model, const PaddedPoints& u, const PaddedGradients& gradients, index_t first,
                   index_t last, PaddedPoints& y, StressMap&& stress) {
@@ -97,17 +103,13 @@ void stencil_loop(const Model& model, const PaddedPoints& u, const PaddedGradien
   // written below, so they stay in registers instead of being reloaded for every stencil (5% of the loop)
   const std::decay_t<StressMap> stress_map = stress;
 
-  for (index_t i = first; i < last; ++i) {
+  // the stencil of i with its stress map A_i = (A0 A1 A2)
+  auto stencil_of = [&](index_t i, Lane4 A0, Lane4 A1, Lane4 A2) PH_ALWAYS_INLINE {
     const index_t e0 = nbr.begin(i), e1 = nbr.end(i);
-    const double* gi = Gall + 12 * static_cast<std::ptrdiff_t>(i);
-    const Lane4 Gi0 = load4(gi), Gi1 = load4(gi + 4), Gi2 = load4(gi + 8);
-    Mat3 G;
-    G << Gi0[0], Gi1[0], Gi2[0], Gi0[1], Gi1[1], Gi2[1], Gi0[2], Gi1[2], Gi2[2];
-    const Mat3 A = stress_map(i, G);
-    Lane4 A0 = {A(0, 0), A(1, 0), A(2, 0), 0.0}, A1 = {A(0, 1), A(1, 1), A(2, 1), 0.0},
-          A2 = {A(0, 2), A(1, 2), A(2, 2), 0.0};
     Lane4 self = {};
     if constexpr (hourglass) {
+      const double* gi = Gall + 12 * static_cast<std::ptrdiff_t>(i);
+      const Lane4 Gi0 = load4(gi), Gi1 = load4(gi + 4), Gi2 = load4(gi + 8);
       const Lane4 ui = load4(U + 4 * i);
       const double Xi0 = X[3 * i], Xi1 = X[3 * i + 1], Xi2 = X[3 * i + 2];
       Lane4 Q0 = {}, Q1 = {}, Q2 = {};
@@ -135,6 +137,31 @@ void stencil_loop(const Model& model, const PaddedPoints& u, const PaddedGradien
     for (index_t e = e0; e < e1; ++e) {
       double* oj = out + 4 * nbr_index[e];
       store4(oj, load4(oj) - (A0 * d[3 * e] + A1 * d[3 * e + 1] + A2 * d[3 * e + 2]));
+    }
+  };
+
+  if constexpr (FourPointStressMap<StressMap>) {
+    for (index_t i = first; i < last; i += lane_count) {
+      const int count = static_cast<int>(std::min<index_t>(lane_count, last - i));
+      Matrix3<Lanes> G{};  // lanes past `count` stay zero: a rest state, never read back
+      for (int p = 0; p < count; ++p) {
+        const double* g = Gall + 12 * static_cast<std::ptrdiff_t>(i + p);
+        for (int c = 0; c < 3; ++c)
+          for (int r = 0; r < 3; ++r) G.m[r + 3 * c][p] = g[4 * c + r];
+      }
+      const Matrix3<Lanes> A = stress_map(i, count, G);
+      for (int p = 0; p < count; ++p)
+        stencil_of(i + p, Lane4{A.m[0][p], A.m[1][p], A.m[2][p], 0.0}, Lane4{A.m[3][p], A.m[4][p], A.m[5][p], 0.0},
+                   Lane4{A.m[6][p], A.m[7][p], A.m[8][p], 0.0});
+    }
+  } else {
+    for (index_t i = first; i < last; ++i) {
+      const double* gi = Gall + 12 * static_cast<std::ptrdiff_t>(i);
+      Mat3 G;
+      G << gi[0], gi[4], gi[8], gi[1], gi[5], gi[9], gi[2], gi[6], gi[10];
+      const Mat3 A = stress_map(i, G);
+      stencil_of(i, Lane4{A(0, 0), A(1, 0), A(2, 0), 0.0}, Lane4{A(0, 1), A(1, 1), A(2, 1), 0.0},
+                 Lane4{A(0, 2), A(1, 2), A(2, 2), 0.0});
     }
   }
 }

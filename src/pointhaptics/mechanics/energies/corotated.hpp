@@ -7,28 +7,50 @@
 
 namespace pointhaptics {
 
-/// The rotation R of F = R S (S symmetric). For det F > 0 the polar decomposition, by Newton's iteration
-/// X <- (g X + X^-T / g) / 2 (Higham 1986; g = |det X|^-1/3 while X is far from orthogonal), which from a
-/// near-rotation converges in three or four 3x3 inversions, far cheaper than an SVD. For det F <= 0 (an
-/// inverted neighbourhood) the rotation of the SVD with the smallest singular value's sign flipped (Irving,
-/// Teran and Fedkiw 2004), so that S has a negative eigenvalue and the energy pushes the point back.
+/// Below this det F the corotated rotation comes from the SVD (rotation_of).
+inline constexpr double polar_floor = 1e-6;
+
+/// The scaling g = |det X|^-1/3 of the polar iteration while X is far from orthogonal (det outside (0.5, 2)),
+/// else 1.
+PH_ALWAYS_INLINE inline double polar_scaling(double det) { return det > 0.5 && det < 2 ? 1.0 : std::cbrt(1.0 / std::abs(det)); }
+PH_ALWAYS_INLINE inline Lanes polar_scaling(const Lanes& det) {
+  Lanes g = Lanes{} + 1.0;
+  const LaneMask far = !((det > 0.5) & (det < 2.0));
+  if (any_lane(far)) [[unlikely]]
+    for (int k = 0; k < lane_count; ++k)
+      if (far[k]) g[k] = polar_scaling(det[k]);
+  return g;
+}
+
+/// The polar rotation of F (det F = J > 0) by Newton's iteration X <- (g X + X^-T / g) / 2 (Higham 1986; g:
+/// polar_scaling), which from a near-rotation converges in three or four 3x3 inversions, far cheaper than
+/// an SVD; for one point or four, each lane stopping when its own step is below 1e-6 (so that four points
+/// get what each would alone).
+template <class T>
+PH_ALWAYS_INLINE inline Matrix3<T> polar_rotation(const Matrix3<T>& F, T det) {
+  Matrix3<T> X = F;
+  MaskOf<T> active = det == det;  // every lane
+  for (int iteration = 0; iteration < 30; ++iteration) {
+    const T g = polar_scaling(det);
+    const Matrix3<T> next = 0.5 * (g * X + T(1.0 / (g * det)) * cofactor(X));
+    const T change = max_abs(next - X);
+    X = where(active, next, X);
+    // quadratic convergence: the error is now about change^2 / 2, below 1e-12 (a third iteration from
+    // the small strains of a haptic step cost a tenth of the force loop)
+    active = active & !(change < 1e-6);
+    if (none(active)) break;
+    det = determinant(X, cofactor(X));
+  }
+  return X;
+}
+
+/// The rotation R of F = R S (S symmetric). For det F > 0 the polar decomposition (polar_rotation). For
+/// det F <= 0 (an inverted neighbourhood) the rotation of the SVD with the smallest singular value's sign
+/// flipped (Irving, Teran and Fedkiw 2004), so that S has a negative eigenvalue and the energy pushes the
+/// point back.
 inline Mat3 rotation_of(const Mat3& F) {
   const double J = F.determinant();
-  if (J > 1e-6) {
-    Mat3 X = F;
-    double det = J;
-    for (int iteration = 0; iteration < 30; ++iteration) {
-      const double g = det > 0.5 && det < 2 ? 1.0 : std::cbrt(1.0 / std::abs(det));
-      const Mat3 next = 0.5 * (g * X + cofactor(X) / (g * det));
-      const double change = (next - X).cwiseAbs().maxCoeff();
-      X = next;
-      // quadratic convergence: the error is now about change^2 / 2, below 1e-12 (a third iteration from
-      // the small strains of a haptic step cost a tenth of the force loop)
-      if (change < 1e-6) break;
-      det = X.determinant();
-    }
-    return X;
-  }
+  if (J > polar_floor) return to_eigen(polar_rotation(to_matrix3(F), J));
   Eigen::JacobiSVD<Mat3> svd(F, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Mat3 U = svd.matrixU();
   const Mat3 V = svd.matrixV();
@@ -56,9 +78,23 @@ struct Corotated : HessianTangent<Corotated> {
   /// times `scale`.
   PH_ALWAYS_INLINE Mat3 scaled_stress(const Mat3& G, double scale) const {
     const Mat3 F = Mat3::Identity() + G;
-    const Mat3 R = rotation_of(F);
-    const double t = (R.transpose() * F).trace() - 3;
-    return (2 * mu * scale) * (F - R) + (lambda * t * scale) * R;
+    return to_eigen(stress_with_rotation(to_matrix3(F), to_matrix3(rotation_of(F)), scale));
+  }
+  /// Four points' stresses; the lanes with det F <= the polar floor (or not finite) are marked in `general`,
+  /// for the one-point form above.
+  PH_ALWAYS_INLINE Matrix3<Lanes> scaled_stress(const Matrix3<Lanes>& G, const Lanes& scale, LaneMask& general) const {
+    const Matrix3<Lanes> F = plus_identity(G, 1.0);
+    const Lanes J = determinant(F, cofactor(F));
+    general = !(J > polar_floor);
+    if (none(general)) return stress_with_rotation(F, polar_rotation(F, J), scale);
+    // the general lanes iterate from the identity, which stops at once
+    const Matrix3<Lanes> start = where(general, plus_identity(Matrix3<Lanes>{}, 1.0), F);
+    return stress_with_rotation(F, polar_rotation(start, where(general, Lanes{} + 1.0, J)), scale);
+  }
+  template <class T>
+  PH_ALWAYS_INLINE Matrix3<T> stress_with_rotation(const Matrix3<T>& F, const Matrix3<T>& R, const T& scale) const {
+    const T t = inner(R, F) - 3;
+    return T((2 * mu) * scale) * (F - R) + T(lambda * t * scale) * R;
   }
   PH_ALWAYS_INLINE Mat3 stress(const Mat3& G) const { return scaled_stress(G, 1.0); }
 

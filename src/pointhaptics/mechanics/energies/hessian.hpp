@@ -87,11 +87,7 @@ struct PowerOfJ {
 };
 
 /// J - 1 = det(I + G) - 1 = tr G + I2(G) + det G, written in G (no cancellation at small strain).
-PH_ALWAYS_INLINE inline double volume_change(const Mat3& G) {
-  const double t = G.trace();
-  const double trace_of_square = (G.array() * G.transpose().array()).sum();  // tr(G G) without the product
-  return t + 0.5 * (t * t - trace_of_square) + G.determinant();
-}
+PH_ALWAYS_INLINE inline double volume_change(const Mat3& G) { return volume_change(to_matrix3(G)); }
 
 /// The derivative of cof F along dF: rows of cof F are cross products of rows of F (product rule).
 PH_ALWAYS_INLINE inline Mat3 cofactor_differential(const Mat3& F, const Mat3& dF) {
@@ -103,7 +99,7 @@ PH_ALWAYS_INLINE inline Mat3 cofactor_differential(const Mat3& F, const Mat3& dF
 }
 
 /// The deviatoric part of a 3x3 matrix.
-PH_ALWAYS_INLINE inline Mat3 deviator(const Mat3& A) { return A - (A.trace() / 3.0) * Mat3::Identity(); }
+PH_ALWAYS_INLINE inline Mat3 deviator(const Mat3& A) { return to_eigen(deviator(to_matrix3(A))); }
 
 /// Upper bounds of the extreme eigenvalues of C = F^T F by Gershgorin's discs: s1 <= lambda_min, s3 >=
 /// lambda_max (cheap; the explicit stable step's stiffening estimates use them every step).

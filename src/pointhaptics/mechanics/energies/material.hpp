@@ -13,6 +13,7 @@
 #include <pointhaptics/mechanics/energies/viscous_overstress.hpp>
 #include <pointhaptics/mechanics/energies/volume_penalty.hpp>
 
+#include <algorithm>
 #include <array>
 #include <type_traits>
 #include <variant>
@@ -66,44 +67,85 @@ HessianLinearisation as_hessian(const Material& material, const Mat3& G, bool pr
   }
 }
 
-/// A stencil's energy per unit volume when every point has the same material: the material's, plus the
-/// volume penalty's. Every function takes the point i (ignored here; see MixedEnergy).
-template <class Material>
-struct PointEnergy {
-  Material material;
+/// What every energy adds to its material's: the volume penalty and, within a viscoelastic step, the viscous
+/// overstress; each only when active.
+struct AddedTerms {
   VolumePenalty volume;
   ViscousOverstress viscous;  ///< within a viscoelastic step (viscous_overstress.hpp); else none
 
-  /// The material's energy per unit volume, without the volume term, J/m^3.
-  double material_energy_density(index_t, const Mat3& G) const { return material.energy_density(G); }
+  bool active() const { return volume.active() || viscous.active(); }
   /// The viscous overstress's term of a step's energy, J/m^3 (0 outside a viscoelastic step).
   double viscous_energy_density(index_t i, const Mat3& G) const { return viscous.active() ? viscous.energy_density(i, G) : 0.0; }
   double energy_density(index_t i, const Mat3& G) const {
-    return material_energy_density(i, G) + (volume.active() ? volume.energy_density(G) : 0.0) + viscous_energy_density(i, G);
+    return (volume.active() ? volume.energy_density(G) : 0.0) + viscous_energy_density(i, G);
   }
-  /// The material's own first Piola-Kirchhoff stress, without the volume and viscous terms, Pa.
-  Mat3 material_stress(index_t, const Mat3& G) const { return material.scaled_stress(G, 1.0); }
+  PH_ALWAYS_INLINE void add_scaled_stress(index_t i, const Mat3& G, double scale, Mat3& P) const {
+    if (volume.active()) P += scale * volume.stress(G);
+    if (viscous.active()) P += scale * viscous.stress(i, G);
+  }
+  /// `projected` keeps the volume's Gauss-Newton part and drops the viscous overstress's term (its sign
+  /// follows the history's).
+  PH_ALWAYS_INLINE void add_stress_derivative(index_t i, const Mat3& F, const Mat3& dG, bool projected, Mat3& dP) const {
+    if (volume.active()) dP += volume.stress_derivative(F, dG, !projected);
+    if (viscous.active() && !projected) dP += viscous.stress_derivative(i, dG);
+  }
+  void add_stiffness_block(const Mat3& F, const Vec3& d, Mat3& K) const {
+    if (volume.active()) K += volume.stiffness_block(F, d);
+  }
+};
+
+/// Four consecutive points' stresses P (points i .. i + count - 1, count <= 4) completed lane by lane: the
+/// lanes the material's four-point form leaves (`general`: inverted or degenerate neighbourhoods) by the
+/// one-point form, and the added terms when active.
+template <class Energy>
+void complete_lanes(const Energy& energy, index_t i, int count, const Matrix3<Lanes>& G, const Lanes& scale, const LaneMask& general,
+                    Matrix3<Lanes>& P) {
+  for (int k = 0; k < count; ++k) {
+    Mat3 Gk, Pk;
+    for (int e = 0; e < 9; ++e) Gk.data()[e] = G.m[e][k], Pk.data()[e] = P.m[e][k];
+    if (general[k]) Pk = energy.material_scaled_stress(i + k, Gk, scale[k]);
+    energy.add_scaled_stress(i + k, Gk, scale[k], Pk);
+    for (int e = 0; e < 9; ++e) P.m[e][k] = Pk.data()[e];
+  }
+}
+
+/// A stencil's energy per unit volume when every point has the same material: the material's, plus the
+/// added terms. Every function takes the point i (ignored by the material here; see MixedEnergy).
+template <class Material>
+struct PointEnergy : AddedTerms {
+  Material material;
+
+  /// The material's energy per unit volume, without the added terms, J/m^3.
+  double material_energy_density(index_t, const Mat3& G) const { return material.energy_density(G); }
+  double energy_density(index_t i, const Mat3& G) const { return material_energy_density(i, G) + AddedTerms::energy_density(i, G); }
+  /// The material's own first Piola-Kirchhoff stress, without the added terms, Pa, times `scale`.
+  PH_ALWAYS_INLINE Mat3 material_scaled_stress(index_t, const Mat3& G, double scale) const { return material.scaled_stress(G, scale); }
+  Mat3 material_stress(index_t i, const Mat3& G) const { return material_scaled_stress(i, G, 1.0); }
   /// First Piola-Kirchhoff stress P = dW/dF, Pa, times `scale` (the force loop's v_i).
   PH_ALWAYS_INLINE Mat3 scaled_stress(index_t i, const Mat3& G, double scale) const {
     Mat3 P = material.scaled_stress(G, scale);
-    if (volume.active()) P += scale * volume.stress(G);
-    if (viscous.active()) P += scale * viscous.stress(i, G);
+    add_scaled_stress(i, G, scale, P);
+    return P;
+  }
+  /// The same for the points i .. i + count - 1 (count <= 4) at once (lanes.hpp).
+  PH_ALWAYS_INLINE Matrix3<Lanes> scaled_stress(index_t i, int count, const Matrix3<Lanes>& G, const Lanes& scale) const {
+    LaneMask general;
+    Matrix3<Lanes> P = material.scaled_stress(G, scale, general);
+    if (AddedTerms::active() || any_lane(general)) [[unlikely]] complete_lanes(*this, i, count, G, scale, general, P);
     return P;
   }
   PH_ALWAYS_INLINE Mat3 stress(index_t i, const Mat3& G) const { return scaled_stress(i, G, 1.0); }
   using Linearisation = typename Material::Linearisation;
   /// `projected`: the positive semi-definite part (the material's projection, the volume's Gauss-Newton part).
   Linearisation linearise(index_t, const Mat3& G, bool projected) const { return material.linearise(G, projected); }
-  /// `projected` drops the viscous overstress's term (its sign follows the history's).
   PH_ALWAYS_INLINE Mat3 stress_derivative(index_t i, const Linearisation& at, const Mat3& dG, bool projected) const {
     Mat3 dP = material.stress_derivative(at, dG);
-    if (volume.active()) dP += volume.stress_derivative(at.F, dG, !projected);
-    if (viscous.active() && !projected) dP += viscous.stress_derivative(i, dG);
+    add_stress_derivative(i, at.F, dG, projected, dP);
     return dP;
   }
   Mat3 stiffness_block(index_t, const Linearisation& at, const Vec3& d) const {
     Mat3 K = material.stiffness_block(at, d);
-    if (volume.active()) K += volume.stiffness_block(at.F, d);
+    add_stiffness_block(at.F, d, K);
     return K;
   }
   /// How much stiffer than at rest the material is at G (the explicit stable step).
@@ -115,12 +157,11 @@ inline constexpr std::size_t max_materials = 32;
 
 /// A stencil's energy when points have their own materials (Model::material_of): each call dispatches on
 /// the point's material, whose constants sit in a small table. Regions are contiguous in space, so the
-/// branch is predicted; the linearisation is the 9 x 9 dP/dF of any model.
-struct MixedEnergy {
+/// branch is predicted, and four consecutive points mostly share a material; the linearisation is the
+/// 9 x 9 dP/dF of any model.
+struct MixedEnergy : AddedTerms {
   std::array<AnyMaterial, max_materials> materials;
   const std::uint8_t* material_of = nullptr;
-  VolumePenalty volume;
-  ViscousOverstress viscous;
 
   template <class Fn>
   PH_ALWAYS_INLINE decltype(auto) visit(index_t i, Fn&& fn) const {
@@ -129,17 +170,23 @@ struct MixedEnergy {
   double material_energy_density(index_t i, const Mat3& G) const {
     return visit(i, [&](const auto& m) { return m.energy_density(G); });
   }
-  double viscous_energy_density(index_t i, const Mat3& G) const { return viscous.active() ? viscous.energy_density(i, G) : 0.0; }
-  double energy_density(index_t i, const Mat3& G) const {
-    return material_energy_density(i, G) + (volume.active() ? volume.energy_density(G) : 0.0) + viscous_energy_density(i, G);
+  double energy_density(index_t i, const Mat3& G) const { return material_energy_density(i, G) + AddedTerms::energy_density(i, G); }
+  PH_ALWAYS_INLINE Mat3 material_scaled_stress(index_t i, const Mat3& G, double scale) const {
+    return visit(i, [&](const auto& m) -> Mat3 { return m.scaled_stress(G, scale); });
   }
-  Mat3 material_stress(index_t i, const Mat3& G) const {
-    return visit(i, [&](const auto& m) -> Mat3 { return m.scaled_stress(G, 1.0); });
-  }
+  Mat3 material_stress(index_t i, const Mat3& G) const { return material_scaled_stress(i, G, 1.0); }
   PH_ALWAYS_INLINE Mat3 scaled_stress(index_t i, const Mat3& G, double scale) const {
-    Mat3 P = visit(i, [&](const auto& m) -> Mat3 { return m.scaled_stress(G, scale); });
-    if (volume.active()) P += scale * volume.stress(G);
-    if (viscous.active()) P += scale * viscous.stress(i, G);
+    Mat3 P = material_scaled_stress(i, G, scale);
+    add_scaled_stress(i, G, scale, P);
+    return P;
+  }
+  /// Four points at once when they share a material, else lane by lane.
+  PH_ALWAYS_INLINE Matrix3<Lanes> scaled_stress(index_t i, int count, const Matrix3<Lanes>& G, const Lanes& scale) const {
+    LaneMask general = LaneMask{} - 1;  // every lane
+    Matrix3<Lanes> P{};
+    if (std::all_of(material_of + i + 1, material_of + i + count, [&](std::uint8_t m) { return m == material_of[i]; }))
+      P = visit(i, [&](const auto& m) { return m.scaled_stress(G, scale, general); });
+    if (AddedTerms::active() || any_lane(general)) [[unlikely]] complete_lanes(*this, i, count, G, scale, general, P);
     return P;
   }
   PH_ALWAYS_INLINE Mat3 stress(index_t i, const Mat3& G) const { return scaled_stress(i, G, 1.0); }
@@ -149,13 +196,12 @@ struct MixedEnergy {
   }
   PH_ALWAYS_INLINE Mat3 stress_derivative(index_t i, const Linearisation& at, const Mat3& dG, bool projected) const {
     Mat3 dP = at.apply(dG);
-    if (volume.active()) dP += volume.stress_derivative(at.F, dG, !projected);
-    if (viscous.active() && !projected) dP += viscous.stress_derivative(i, dG);
+    add_stress_derivative(i, at.F, dG, projected, dP);
     return dP;
   }
   Mat3 stiffness_block(index_t, const Linearisation& at, const Vec3& d) const {
     Mat3 K = at.block(d);
-    if (volume.active()) K += volume.stiffness_block(at.F, d);
+    add_stiffness_block(at.F, d, K);
     return K;
   }
   double stiffening(index_t i, const Mat3& G) const {
@@ -180,7 +226,7 @@ decltype(auto) with_material(const Model& model, const ViscousStep& step, Fn&& f
     return fn(static_cast<const MixedEnergy&>(mixed));
   }
   return std::visit([&](const auto& material) -> decltype(auto) {
-    return fn(PointEnergy<std::decay_t<decltype(material)>>{material, volume, step.overstress});
+    return fn(PointEnergy<std::decay_t<decltype(material)>>{{volume, step.overstress}, material});
   }, material_constants(model.material, step.shear_factor, bulk_factor));
 }
 

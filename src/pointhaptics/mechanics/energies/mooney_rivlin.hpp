@@ -9,19 +9,6 @@ namespace pointhaptics {
 /// I2 = (I1^2 - tr(C^2)) / 2, D1 = 2 / K: CalculiX's *HYPERELASTIC, MOONEY-RIVLIN for J >= PowerOfJ::j_floor,
 /// finite and restoring below (hessian.hpp). Small-strain shear modulus mu = 2 (C10 + C01); C01 = 0 is
 /// neo-Hookean. C01 stiffens shear at large stretch, as measured for many soft tissues.
-/// S^2 of a symmetric S from its six distinct entries (18 products instead of 27).
-PH_ALWAYS_INLINE inline Mat3 symmetric_square(const Mat3& S) {
-  const double a = S(0, 0), b = S(1, 1), c = S(2, 2), d = S(1, 2), e = S(0, 2), f = S(0, 1);
-  Mat3 Q;
-  Q(0, 0) = a * a + f * f + e * e;
-  Q(1, 1) = f * f + b * b + d * d;
-  Q(2, 2) = e * e + d * d + c * c;
-  Q(0, 1) = Q(1, 0) = a * f + f * b + e * d;
-  Q(0, 2) = Q(2, 0) = a * e + f * d + e * c;
-  Q(1, 2) = Q(2, 1) = f * e + b * d + d * c;
-  return Q;
-}
-
 struct MooneyRivlin : HessianTangent<MooneyRivlin> {
   double c10 = 0, c01 = 0, bulk = 0;  ///< Pa
   MooneyRivlin() = default;
@@ -43,26 +30,34 @@ struct MooneyRivlin : HessianTangent<MooneyRivlin> {
     return c10 * (g1.value * i1m3 + 3 * g1m1) + c01 * (g2.value * i2m3 + 3 * g2m1) + 0.5 * bulk * jm1 * jm1;
   }
 
-  /// P = C10 (g1' I1 cof + 2 g1 F) + C01 (g2' I2 cof + 2 g2 (I1 F - F C)) + K (J - 1) cof, Pa, times
-  /// `scale`. For J >= j_floor the deviatoric parts are 4 (cof / J) [C10 g1 dev E + C01 g2 ((1 + 2 t) dev E
-  /// - 2 dev(E^2))] (no cancellation at small strain).
+  /// P = C10 (g1' I1 cof + 2 g1 F) + C01 (g2' I2 cof + 2 g2 (I1 F - F C)) + K (J - 1) cof, Pa, times `scale`.
   PH_ALWAYS_INLINE Mat3 scaled_stress(const Mat3& G, double scale) const {
+    const double jm1 = volume_change(G), J = 1 + jm1;
+    if (J >= PowerOfJ::j_floor) return to_eigen(regular_stress(to_matrix3(G), jm1, scale));
     const Mat3 F = Mat3::Identity() + G;
     const Mat3 cof = cofactor(F);
-    const double jm1 = volume_change(G), J = 1 + jm1;
-    if (J >= PowerOfJ::j_floor) {
-      // J^-2/3 and J^-4/3 by one cube root (std::pow cost a third of the force loop)
-      const double c = std::cbrt(J), g1 = 1 / (c * c), g2 = g1 * g1;
-      const Mat3 E = green_strain(G);
-      const Mat3 devE = deviator(E);
-      const Mat3 inner = (c10 * g1 + c01 * g2 * (1 + 2 * E.trace())) * devE - (2 * c01 * g2) * deviator(symmetric_square(E));
-      return (scale * 4 / J) * (cof * inner) + (scale * bulk * jm1) * cof;
-    }
     const PowerOfJ g1(J, 2.0 / 3.0), g2(J, 4.0 / 3.0);
     const Mat3 C = F.transpose() * F;
     const double i1 = C.trace(), i2 = 0.5 * (i1 * i1 - (C * C).trace());
     return scale * (c10 * (g1.first * i1 * cof + 2 * g1.value * F) + c01 * (g2.first * i2 * cof + 2 * g2.value * (i1 * F - F * C)) +
                     bulk * jm1 * cof);
+  }
+  /// Four points' stresses; the lanes with J < j_floor (or not finite) are marked in `general`, for the
+  /// one-point form above.
+  PH_ALWAYS_INLINE Matrix3<Lanes> scaled_stress(const Matrix3<Lanes>& G, const Lanes& scale, LaneMask& general) const {
+    const Lanes jm1 = volume_change(G);
+    general = !(1 + jm1 >= PowerOfJ::j_floor);
+    return regular_stress(G, jm1, scale);
+  }
+  /// The stress for J >= j_floor: the deviatoric parts are 4 (cof / J) [C10 g1 dev E + C01 g2 ((1 + 2 t) dev E
+  /// - 2 dev(E^2))] with g1 = J^-2/3, g2 = J^-4/3 (no cancellation at small strain), for one point or four.
+  template <class T>
+  PH_ALWAYS_INLINE Matrix3<T> regular_stress(const Matrix3<T>& G, const T& jm1, const T& scale) const {
+    const Matrix3<T> cof = cofactor(plus_identity(G, 1.0));
+    const T y = inverse_cube_root(T(1 + jm1)), g1 = y * y, g2 = g1 * g1;  // std::pow cost a third of the force loop
+    const Matrix3<T> E = green_strain(G);
+    const Matrix3<T> inner = T(c10 * g1 + c01 * g2 * (1 + 2 * trace(E))) * deviator(E) - T((2 * c01) * g2) * deviator(symmetric_square(E));
+    return T(scale * 4 * (g1 * y)) * (cof * inner) + T(scale * bulk * jm1) * cof;
   }
   PH_ALWAYS_INLINE Mat3 stress(const Mat3& G) const { return scaled_stress(G, 1.0); }
 

@@ -29,21 +29,30 @@ struct NeoHookean : HessianTangent<NeoHookean> {
     return c10() * (g.value * i1m3 + 3 * gm1) + 0.5 * bulk * jm1 * jm1;
   }
 
-  /// P = C10 (g' I1 cof F + 2 g F) + K (J - 1) cof F, Pa, times `scale`. For J >= j_floor, where g' = -2/3 g / J,
-  /// the deviatoric part is 4 C10 (g / J) cof F dev(E) (no cancellation at small strain).
+  /// P = C10 (g' I1 cof F + 2 g F) + K (J - 1) cof F, Pa, times `scale`.
   PH_ALWAYS_INLINE Mat3 scaled_stress(const Mat3& G, double scale) const {
+    const double jm1 = volume_change(G), J = 1 + jm1;
+    if (J >= PowerOfJ::j_floor) return to_eigen(regular_stress(to_matrix3(G), jm1, scale));
     const Mat3 F = Mat3::Identity() + G;
     const Mat3 cof = cofactor(F);
-    const double jm1 = volume_change(G), J = 1 + jm1;
-    if (J >= PowerOfJ::j_floor) {
-      // J^-2/3 / J by one cube root (std::pow cost a third of the force loop)
-      const double c = std::cbrt(J);
-      const Mat3 E = green_strain(G);
-      return (scale * 4 * c10() / (c * c * J)) * (cof * deviator(E)) + (scale * bulk * jm1) * cof;
-    }
     const PowerOfJ g(J, 2.0 / 3.0);
     const double i1 = (F.array() * F.array()).sum();
     return scale * (c10() * (g.first * i1 * cof + 2 * g.value * F) + bulk * jm1 * cof);
+  }
+  /// Four points' stresses; the lanes with J < j_floor (or not finite) are marked in `general`, for the
+  /// one-point form above.
+  PH_ALWAYS_INLINE Matrix3<Lanes> scaled_stress(const Matrix3<Lanes>& G, const Lanes& scale, LaneMask& general) const {
+    const Lanes jm1 = volume_change(G);
+    general = !(1 + jm1 >= PowerOfJ::j_floor);
+    return regular_stress(G, jm1, scale);
+  }
+  /// The stress for J >= j_floor, where g' = -2/3 g / J: the deviatoric part is 4 C10 J^-5/3 cof F dev(E)
+  /// (no cancellation at small strain), for one point or four (lanes.hpp).
+  template <class T>
+  PH_ALWAYS_INLINE Matrix3<T> regular_stress(const Matrix3<T>& G, const T& jm1, const T& scale) const {
+    const Matrix3<T> cof = cofactor(plus_identity(G, 1.0));
+    const T y = inverse_cube_root(T(1 + jm1)), y2 = y * y;  // J^-1/3 (std::pow cost a third of the force loop)
+    return T(scale * (4 * c10()) * (y2 * y2 * y)) * (cof * deviator(green_strain(G))) + T(scale * bulk * jm1) * cof;
   }
   PH_ALWAYS_INLINE Mat3 stress(const Mat3& G) const { return scaled_stress(G, 1.0); }
 

@@ -3,6 +3,7 @@
 /// stress derivative side by side (tests/mechanics/energies/svk_test.cpp checks each against finite
 /// differences of the one before).
 #include <pointhaptics/mechanics/deformation.hpp>
+#include <pointhaptics/mechanics/energies/lanes.hpp>
 
 namespace pointhaptics {
 
@@ -21,12 +22,18 @@ struct StVenantKirchhoff {
   }
 
   /// First Piola-Kirchhoff stress P = dW/dF = F S, Pa (seed Eq. 12-13 in exact form), times `scale` (the
-  /// force loop's volume v_i): folded into the product, which the force loop measured 5-10% faster than
-  /// scaling the returned matrix (F named too: Eigen otherwise re-evaluates I + G inside the product).
-  PH_ALWAYS_INLINE Mat3 scaled_stress(const Mat3& G, double scale) const {
-    const Mat3 F = Mat3::Identity() + G;
-    const Mat3 S = second_piola(green_strain(G));
-    return scale * (F * S);
+  /// force loop's volume v_i), for one point (T = double) or four (T = Lanes, lanes.hpp).
+  template <class T>
+  PH_ALWAYS_INLINE Matrix3<T> scaled_stress(const Matrix3<T>& G, const T& scale) const {
+    const Matrix3<T> E = green_strain(G);
+    const Matrix3<T> S = plus_identity((2.0 * mu) * E, T(lambda * trace(E)));
+    return scale * (plus_identity(G, 1.0) * S);
+  }
+  PH_ALWAYS_INLINE Mat3 scaled_stress(const Mat3& G, double scale) const { return to_eigen(scaled_stress(to_matrix3(G), scale)); }
+  /// Four points' stresses (every lane is handled: `general` is left clear).
+  PH_ALWAYS_INLINE Matrix3<Lanes> scaled_stress(const Matrix3<Lanes>& G, const Lanes& scale, LaneMask& general) const {
+    general = LaneMask{};
+    return scaled_stress<Lanes>(G, scale);
   }
   PH_ALWAYS_INLINE Mat3 stress(const Mat3& G) const { return scaled_stress(G, 1.0); }
 
