@@ -1,0 +1,113 @@
+#include <pointhaptics/mechanics/surface_map.hpp>
+
+#include <pointhaptics/core/error.hpp>
+#include <pointhaptics/geometry/kd_tree.hpp>
+#include <pointhaptics/mechanics/kernels.hpp>
+
+#include <Eigen/Eigenvalues>
+#include <fmt/format.h>
+#include <oneapi/tbb/parallel_for.h>
+
+#include <algorithm>
+
+namespace pointhaptics {
+namespace {
+
+using Mat4 = Eigen::Matrix4d;
+using Vec4 = Eigen::Vector4d;
+
+struct VertexWeights {
+  std::vector<index_t> points;
+  std::vector<double> weight;
+  bool widened = false;
+};
+
+/// The MLS weights of vertex y with support h, widened until the moment matrix is well conditioned.
+VertexWeights vertex_weights(const Model& model, const KdTree& tree, const Vec3& y, double h, index_t vertex) {
+  std::vector<std::pair<index_t, double>> found;
+  nanoflann::SearchParams params;
+  params.sorted = false;
+  VertexWeights out;
+  for (int widening = 0; widening <= 5; ++widening, h *= 1.5) {
+    found.clear();
+    tree.index().radiusSearch(y.data(), h * h, found, params);
+    if (found.size() < 4) {
+      out.widened = true;
+      continue;
+    }
+    Mat4 M = Mat4::Zero();
+    out.points.clear();
+    out.weight.clear();
+    std::vector<Vec4> basis;
+    for (const auto& [j, r2] : found) {
+      const Vec3 x = (model.X.col(j) - y) / h;
+      // the viscosity kernel is infinite at r = 0: a vertex on a point gets a large finite weight instead
+      const double w = kernel_value(model.kernel.type, std::max(std::sqrt(r2), 1e-6 * h), h);
+      if (!(w > 0)) continue;
+      const Vec4 p(1, x.x(), x.y(), x.z());
+      M += w * p * p.transpose();
+      out.points.push_back(j);
+      out.weight.push_back(w);
+      basis.push_back(p);
+    }
+    const Eigen::SelfAdjointEigenSolver<Mat4> eig(M, Eigen::EigenvaluesOnly);
+    if (out.points.size() < 4 || !(eig.eigenvalues()[0] > 1e-8 * eig.eigenvalues()[3])) {
+      out.widened = true;
+      continue;
+    }
+    const Vec4 a = M.ldlt().solve(Vec4::UnitX());  // M^-1 p(0)
+    for (std::size_t k = 0; k < out.points.size(); ++k) out.weight[k] *= a.dot(basis[k]);
+    return out;
+  }
+  throw Error(fmt::format("surface vertex {} at ({:.4g}, {:.4g}, {:.4g}) m: too few points around it to carry it "
+                          "(none or only a flat set within {:.3g} m)",
+                          vertex, y.x(), y.y(), y.z(), h / 1.5));
+}
+
+}  // namespace
+
+SurfaceMap build_surface_map(const Model& model, const Points& Y) {
+  if (model.n_points < 4) throw Error(fmt::format("surface: {} points cannot carry a surface (at least 4)", model.n_points));
+  if (!Y.allFinite()) throw Error("surface: a vertex is not finite");
+  const index_t m = static_cast<index_t>(Y.cols());
+  const KdTree tree(model.X);
+  std::vector<VertexWeights> rows(static_cast<std::size_t>(m));
+  tbb::parallel_for(tbb::blocked_range<index_t>(0, m, 256), [&](const tbb::blocked_range<index_t>& range) {
+    for (index_t v = range.begin(); v != range.end(); ++v) {
+      const Vec3 y = Y.col(v);
+      double h = model.h;
+      if (model.support.size() == model.n_points) {  // per-point supports: the nearest point's
+        index_t nearest = 0;
+        double d2 = 0;
+        tree.index().knnSearch(y.data(), 1, &nearest, &d2);
+        h = model.support[nearest];
+      }
+      rows[static_cast<std::size_t>(v)] = vertex_weights(model, tree, y, h, v);
+    }
+  });
+  SurfaceMap map;
+  map.points.offset.reserve(static_cast<std::size_t>(m) + 1);
+  for (const VertexWeights& row : rows) {
+    map.points.index.insert(map.points.index.end(), row.points.begin(), row.points.end());
+    map.weight.insert(map.weight.end(), row.weight.begin(), row.weight.end());
+    map.points.offset.push_back(static_cast<index_t>(map.points.index.size()));
+    map.widened += row.widened;
+  }
+  return map;
+}
+
+void carry_surface(const SurfaceMap& map, const Points& Y, const Points& u, Points& y) {
+  y.resize(3, map.n_vertices());
+  for (index_t v = 0; v < map.n_vertices(); ++v) {
+    Vec3 moved = Y.col(v);
+    for (index_t e = map.points.begin(v); e < map.points.end(v); ++e) moved += map.weight[e] * u.col(map.points.index[e]);
+    y.col(v) = moved;
+  }
+}
+
+void spread_surface_forces(const SurfaceMap& map, const Points& f_vertices, Points& f_points) {
+  for (index_t v = 0; v < map.n_vertices(); ++v)
+    for (index_t e = map.points.begin(v); e < map.points.end(v); ++e) f_points.col(map.points.index[e]) += map.weight[e] * f_vertices.col(v);
+}
+
+}  // namespace pointhaptics
