@@ -3,8 +3,10 @@
 #include <pointhaptics/core/error.hpp>
 #include <pointhaptics/core/workspace.hpp>
 #include <pointhaptics/geometry/sampling.hpp>
+#include <pointhaptics/geometry/shape_surfaces.hpp>
 #include <pointhaptics/mechanics/forces.hpp>
 #include <pointhaptics/mechanics/model_builder.hpp>
+#include <pointhaptics/mechanics/surface_map.hpp>
 #include <pointhaptics/mechanics/viscoelasticity.hpp>
 #include <pointhaptics/haptics/devices/virtual_device.hpp>
 #include <pointhaptics/interactive.hpp>
@@ -136,6 +138,25 @@ void step_benchmark(benchmark::State& state) {
   set_counters(state, model, threads);
 }
 
+// carrying the object's surface (issue 15): the bench box's exact boundary at half the spacing, moved by the
+// points' displacement through the MLS map (y = Y + W u), as a frame or a contact query needs it
+void surface_benchmark(benchmark::State& state) {
+  const Model& model = bench_model(static_cast<int>(state.range(0)));
+  const TriangleMesh surface = box_surface(model.X.rowwise().minCoeff(), model.X.rowwise().maxCoeff() - model.X.rowwise().minCoeff(),
+                                           0.5 * model.spacing);
+  const SurfaceMap map = build_surface_map(model, surface.V);
+  const Points u = random_displacement(model);
+  Points y;
+  for (auto _ : state) {
+    carry_surface(map, surface.V, u, y);
+    benchmark::DoNotOptimize(y.data());
+  }
+  state.counters["points"] = model.n_points;
+  state.counters["vertices"] = static_cast<double>(surface.V.cols());
+  state.counters["triangles"] = static_cast<double>(surface.F.size());
+  state.counters["weights_per_vertex"] = static_cast<double>(map.weight.size()) / static_cast<double>(surface.V.cols());
+}
+
 // scenes/beam-4x1x1.toml: a 4 x 1 x 1 m beam, E = 5e6 Pa, nu = 0.33, clamped at x = 0, sagging under
 // gravity, spacing 1/13 m (10388 points), damping 10 1/s
 Scene beam_4x1x1(SolverKind kind) {
@@ -226,7 +247,7 @@ void haptic_benchmark(benchmark::State& state) {
 class CollectingReporter : public benchmark::ConsoleReporter {
  public:
   nlohmann::json force = nlohmann::json::array(), step = nlohmann::json::array(), beam = nlohmann::json::array(),
-                 haptic = nlohmann::json::array(), materials = nlohmann::json::array();
+                 haptic = nlohmann::json::array(), materials = nlohmann::json::array(), surface = nlohmann::json::array();
   void ReportRuns(const std::vector<Run>& runs) override {
     ConsoleReporter::ReportRuns(runs);
     for (const Run& run : runs) {
@@ -248,6 +269,14 @@ class CollectingReporter : public benchmark::ConsoleReporter {
                              {"points", static_cast<long long>(run.counters.at("points").value)},
                              {"threads", static_cast<int>(run.counters.at("threads").value)},
                              {"point_steps_per_s", static_cast<double>(run.counters.at("point_steps_per_s").value)}});
+        continue;
+      }
+      if (run.benchmark_name().rfind("surface/", 0) == 0) {
+        surface.push_back({{"points", static_cast<long long>(run.counters.at("points").value)},
+                           {"vertices", static_cast<long long>(run.counters.at("vertices").value)},
+                           {"triangles", static_cast<long long>(run.counters.at("triangles").value)},
+                           {"weights_per_vertex", static_cast<double>(run.counters.at("weights_per_vertex").value)},
+                           {"carry_us", run.GetAdjustedRealTime()}});  // the benchmark's unit is microseconds
         continue;
       }
       if (run.benchmark_name().rfind("beam4x1x1", 0) == 0) {
@@ -283,6 +312,9 @@ int run_bench_suite(const BenchOptions& options) {
                                      material_benchmark)
             ->Args({n, t, v})->Unit(benchmark::kMicrosecond)->MinTime(options.min_time)->UseRealTime();
     }
+  for (int n : options.sizes)
+    benchmark::RegisterBenchmark(fmt::format("surface/points:{}/threads:1", n).c_str(), surface_benchmark)
+        ->Args({n})->Unit(benchmark::kMicrosecond)->MinTime(options.min_time)->UseRealTime();
   for (int t : options.threads)
     for (int solver : {0, 1})
       benchmark::RegisterBenchmark(fmt::format("beam4x1x1/{}/threads:{}", solver ? "implicit" : "explicit", t).c_str(),
@@ -330,7 +362,7 @@ int run_bench_suite(const BenchOptions& options) {
   if (!options.json_path.empty()) {
     const std::string text =
         nlohmann::json{{"force", reporter.force}, {"step", reporter.step}, {"beam_4x1x1", reporter.beam}, {"haptic", reporter.haptic},
-                       {"materials", reporter.materials}}.dump(1);
+                       {"materials", reporter.materials}, {"surface", reporter.surface}}.dump(1);
     try {
       write_text_file(options.json_path, "--json", [&](TextOutput& out) { out.print("{}\n", text); });
     } catch (const Error& e) {

@@ -16,6 +16,7 @@
 #include <cmath>
 #include <memory>
 #include <mutex>
+#include <optional>
 
 namespace py = pybind11;
 namespace ph = pointhaptics;
@@ -70,7 +71,25 @@ void raise_if_failed(const ph::StepReport& report) {
 struct PySimulation {
   std::unique_ptr<ph::Simulation> sim;
   ph::Scene scene;
+  bool from_scene = false;                  ///< scene.object describes the object (not from_points)
+  std::optional<ph::ObjectSurface> surface;  ///< built on the first surface_* call
+  ph::Points surface_vertices;               ///< its deformed vertices, 3 x m, kept current after every step
   std::mutex mutex;
+
+  // the surface's vertices follow the points (after every step, run or probe, once asked for)
+  void carry_surface() {
+    if (surface) ph::carry_surface(surface->map, surface->mesh.V, sim->state().u, surface_vertices);
+  }
+  const ph::ObjectSurface& object_surface() {
+    if (!surface) {
+      if (!from_scene)
+        throw ph::Error("surface: a Simulation made from_points has no surface (reconstructing one from points is not "
+                        "implemented yet); from_scene with a box, sphere, half-sphere or surface mesh has one");
+      surface = ph::build_object_surface(scene, sim->model());
+      carry_surface();
+    }
+    return *surface;
+  }
 };
 
 // The object's lock for a call that holds the GIL: waiting for it (a step on another thread may hold it
@@ -93,6 +112,7 @@ std::unique_ptr<PySimulation> from_scene(const std::string& path, int threads) {
   ph::SceneSession session = ph::open_scene_file(path, options);
   p->scene = std::move(session.scene);
   p->sim = std::move(session.simulation);
+  p->from_scene = true;
   return p;
 }
 
@@ -178,7 +198,9 @@ names the problem.)doc")
           "step", [](PySimulation& p) {
             py::gil_scoped_release release;
             const std::lock_guard<std::mutex> lock(p.mutex);
-            raise_if_failed(p.sim->step());
+            const ph::StepReport report = p.sim->step();
+            p.carry_surface();
+            raise_if_failed(report);
           },
           "Advance by one solver step: dt of explicit dynamics (sub-stepped below the stable step) or implicit "
           "dynamics; a static solver solves for the equilibrium under the full load. Raises pointhaptics.Error on a "
@@ -189,6 +211,7 @@ names the problem.)doc")
             py::gil_scoped_release release;
             const std::lock_guard<std::mutex> lock(p.mutex);
             p.sim->run(duration);
+            p.carry_surface();
             if (p.sim->diagnostics().failed) throw ph::Error(p.sim->diagnostics().failure);
           },
           py::arg("duration"),
@@ -268,6 +291,30 @@ names the problem.)doc")
                                return a;
                              },
                              "Held points, an (n,) boolean array (a copy): the [[fixed]] boxes or the `fixed` mask")
+      .def_property_readonly(
+          "surface_vertices",
+          [](py::object self) {
+            PySimulation& p = self.cast<PySimulation&>();
+            const auto lock = locked(p);
+            p.object_surface();
+            return view(p.surface_vertices, self);
+          },
+          "The object's surface (docs/surface.md): its deformed vertices, an (m, 3) read-only view (m) that follows the "
+          "simulation as it steps. Boxes, spheres and half-spheres have their exact boundary, surface meshes their own; "
+          "built on first use (Error for a Simulation from_points, or a point cloud or volume image scene).")
+      .def_property_readonly(
+          "surface_triangles",
+          [](PySimulation& p) {
+            const auto lock = locked(p);
+            const ph::ObjectSurface& surface = p.object_surface();
+            py::array_t<std::int64_t> a({static_cast<py::ssize_t>(surface.mesh.F.size()), py::ssize_t{3}});
+            auto w = a.mutable_unchecked<2>();
+            for (std::size_t t = 0; t < surface.mesh.F.size(); ++t)
+              for (int k = 0; k < 3; ++k) w(static_cast<py::ssize_t>(t), k) = surface.mesh.F[t][static_cast<std::size_t>(k)];
+            return a;
+          },
+          "The object's surface triangles, a (t, 3) integer array of rows of surface_vertices (a copy), counter-clockwise "
+          "seen from outside")
       .def("energy",
            [](PySimulation& p) {
              const auto lock = locked(p);
@@ -318,6 +365,7 @@ names the problem.)doc")
               py::gil_scoped_release release;
               const std::lock_guard<std::mutex> lock(p.mutex);
               r = ph::run_interactive(*p.sim, device, o);
+              p.carry_surface();
             }
             if (p.sim->diagnostics().failed) throw ph::Error(p.sim->diagnostics().failure);
             // the columns of --force-log: t, x, y, z, vx, vy, vz, buttons, fx, fy, fz

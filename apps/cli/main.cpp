@@ -6,6 +6,7 @@
 #include "experiment_materials.hpp"
 #include "progress_bar.hpp"
 
+#include <pointhaptics/io/mesh_file.hpp>
 #include <pointhaptics/pointhaptics.hpp>
 
 #include "bench_suite.hpp"
@@ -35,6 +36,7 @@ struct RunOptions {
   std::string force_log;
   std::string vtk;
   std::string csv;
+  std::string surface;
   int vtk_every = 0;
   bool deterministic = false;
   bool quiet = false;
@@ -121,6 +123,7 @@ int run_command(const RunOptions& opt) {
   if (!opt.vtk.empty()) vtk.emplace(opt.vtk);
   if (!opt.json.empty()) ph::check_output_path(opt.json, "--json");
   if (!opt.csv.empty()) ph::check_output_path(opt.csv, "--csv");
+  if (!opt.surface.empty()) ph::check_output_path(opt.surface, "--surface");
   if (!opt.force_log.empty()) ph::check_output_path(opt.force_log, "--force-log");
   ph::SessionOptions session_options;
   session_options.threads = opt.threads;
@@ -129,7 +132,12 @@ int run_command(const RunOptions& opt) {
   const ph::Scene& scene = session.scene;
   ph::Simulation& sim = *session.simulation;
   const double setup_s = session.setup_seconds;
-  if (vtk) ph::add_vtk_frame(*vtk, sim);  // the initial state
+  // the object's surface, built before the run so that --surface of an object without one is refused at
+  // once; the ParaView frames carry it when the object has one
+  std::optional<ph::ObjectSurface> surface;
+  if (!opt.surface.empty() || (vtk && ph::has_object_surface(scene))) surface = ph::build_object_surface(scene, sim.model());
+  const ph::ObjectSurface* vtk_surface = vtk && surface ? &*surface : nullptr;
+  if (vtk) ph::add_vtk_frame(*vtk, sim, vtk_surface);  // the initial state
   const double start_time = sim.time();
   const bool options_real_time = !opt.deterministic;
   interrupted.store(false);
@@ -154,7 +162,7 @@ int run_command(const RunOptions& opt) {
     // run's step count is not known in advance)
     if (vtk && opt.vtk_every > 0)
       options.after_step = [&](long long step) {
-        if (step % opt.vtk_every == 0) errors.attempt([&] { ph::add_vtk_frame(*vtk, sim); });
+        if (step % opt.vtk_every == 0) errors.attempt([&] { ph::add_vtk_frame(*vtk, sim, vtk_surface); });
       };
     interactive = ph::run_interactive(sim, *session.device, options);
     if (force_log) errors.attempt([&] { force_log->commit(); });
@@ -189,15 +197,17 @@ int run_command(const RunOptions& opt) {
       }
       // frames: every vtk_every steps (default: about 50 over the run), and the last state below
       const long long every = opt.vtk_every > 0 ? opt.vtk_every : std::max<long long>(1, n_steps / 50);
-      if (vtk && step % every == 0 && step < n_steps) errors.attempt([&] { ph::add_vtk_frame(*vtk, sim); });
+      if (vtk && step % every == 0 && step < n_steps) errors.attempt([&] { ph::add_vtk_frame(*vtk, sim, vtk_surface); });
       return !interrupted.load();
     });
   }
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);
   // the last state (an interactive run writes only the first and the last)
-  if (vtk) errors.attempt([&] { ph::add_vtk_frame(*vtk, sim); });
+  if (vtk) errors.attempt([&] { ph::add_vtk_frame(*vtk, sim, vtk_surface); });
   if (!opt.csv.empty()) errors.attempt([&] { ph::write_points_csv(opt.csv, sim); });
+  if (!opt.surface.empty())
+    errors.attempt([&] { ph::write_mesh(opt.surface, ph::TriangleMesh{ph::deformed_surface(*surface, sim.state().u), surface->mesh.F}, "--surface"); });
   ph::RunSummary summary = sim.summary();
   summary.interrupted = interrupted.load();
   if (scene.probe.present) {
@@ -267,6 +277,8 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--force-log", run.force_log, "With a [probe]: write the haptic log (CSV, one row per tick) to FILE");
   run_cmd->add_option("--vtk", run.vtk, "Write a ParaView time series (DIR/frame.pvd and DIR/frame_*.vtp)");
   run_cmd->add_option("--csv", run.csv, "Write the final state as CSV, one row per point (x, y, z, u, stress, energy, flags)");
+  run_cmd->add_option("--surface", run.surface,
+                      "Write the object's deformed surface at the end (FILE.stl, .ply or .obj; boxes, spheres, half-spheres and meshes)");
   run_cmd->add_option("--vtk-every", run.vtk_every, "Steps between VTK frames (default: about 50 frames per run)")
       ->check(CLI::PositiveNumber);
   run_cmd->add_flag("--deterministic", run.deterministic,

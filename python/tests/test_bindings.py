@@ -37,6 +37,28 @@ def test_a_scene_runs_and_its_arrays_are_views_of_the_simulation():
         u[0, 0] = 1.0  # read-only
 
 
+def test_the_surface_follows_the_points():
+    sim = ph.Simulation.from_scene(scene("cantilever_static.toml"), threads=1)
+    triangles = sim.surface_triangles
+    y = sim.surface_vertices
+    assert triangles.shape[1] == 3 and triangles.min() == 0 and triangles.max() == len(y) - 1
+    assert not y.flags.owndata and not y.flags.writeable  # a view
+    # at rest: the box's exact boundary, [0, 0.15] x [0, 0.03] x [0, 0.03]
+    np.testing.assert_allclose(y.min(axis=0), [0, 0, 0], atol=1e-15)
+    np.testing.assert_allclose(y.max(axis=0), [0.15, 0.03, 0.03], atol=1e-15)
+    # closed: every edge in two triangles
+    edges = np.sort(np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]]), axis=1)
+    _, counts = np.unique(edges, axis=0, return_counts=True)
+    assert np.all(counts == 2)
+    sim.step()
+    # the same view has moved with the points: the tip's bottom edge sags as the lowest point does
+    lowest_point = sim.positions[:, 1].min()
+    assert lowest_point < -0.01
+    assert abs(y[:, 1].min() - lowest_point) < 0.03 * abs(lowest_point)
+    with pytest.raises(ph.Error, match="from_points"):
+        ph.Simulation.from_points(sim.reference, 0.0075).surface_vertices
+
+
 def test_a_model_from_arrays_matches_forces_and_energy():
     # a 6 x 3 x 3 bar, 1 cm spacing, held at x = 0, pulled along x at the far end
     g = np.stack(np.meshgrid(np.arange(6), np.arange(3), np.arange(3), indexing="ij"), axis=-1).reshape(-1, 3) * 0.01

@@ -14,3 +14,4 @@
 #include <pointhaptics/simulation.hpp>
 #include <pointhaptics/vtk_output.hpp>
 #include <pointhaptics/csv_output.hpp>
+#include <pointhaptics/object_surface.hpp>

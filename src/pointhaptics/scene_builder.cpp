@@ -67,6 +67,12 @@ void check_model_fits(double n_points, const Scene& scene, double max_memory) {
                             asked ? "" : " (or allow more with --max-memory)"));
 }
 
+bool is_point_cloud_file(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext == ".xyz" || ext == ".csv" || ext == ".txt" || (ext == ".ply" && !ply_has_faces(path));
+}
+
 PointCloud sample_object(const Scene& scene) {
   const ObjectSpec& o = scene.object;
   switch (o.shape) {
@@ -75,16 +81,13 @@ PointCloud sample_object(const Scene& scene) {
     case ShapeKind::HALF_SPHERE: return sample_half_sphere(o.origin, o.radius, o.spacing);
     case ShapeKind::FILE: {
       // point clouds as they are; surface meshes (and PLY files with faces) volume-sampled at the spacing
-      std::string ext = std::filesystem::path(o.file).extension().string();
-      std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
       if (is_volume_file(o.file)) {
         if (!std::isfinite(o.threshold_low))
           throw Error(fmt::format("{}:{}: object.threshold: a volume image needs threshold = [low, high] (the intensities "
                                   "to sample)", scene.path, o.line));
         return sample_volume(read_volume(o.file), o.threshold_low, o.threshold_high, o.spacing, o.file);
       }
-      const bool cloud = ext == ".xyz" || ext == ".csv" || ext == ".txt" || (ext == ".ply" && !ply_has_faces(o.file));
-      if (cloud) return read_point_cloud(o.file, o.spacing);
+      if (is_point_cloud_file(o.file)) return read_point_cloud(o.file, o.spacing);
       return sample_mesh_volume(read_mesh(o.file), o.spacing, o.file);
     }
   }

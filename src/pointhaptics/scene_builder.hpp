@@ -24,6 +24,10 @@ double available_memory();
 /// available memory): a run too big for the machine is refused before it allocates.
 void check_model_fits(double n_points, const Scene& scene, double max_memory);
 
+/// Whether an object file is a point cloud (.xyz, .csv, .txt, or a .ply without faces) rather than a surface
+/// mesh or a volume image.
+bool is_point_cloud_file(const std::string& path);
+
 /// Sample the scene's object into points.
 PointCloud sample_object(const Scene& scene);
 

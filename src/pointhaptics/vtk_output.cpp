@@ -24,10 +24,23 @@ std::vector<VtkArray> vtk_arrays(Simulation& sim) {
   return arrays;
 }
 
-void add_vtk_frame(VtkSeries& series, Simulation& sim) {
+std::vector<VtkArray> surface_vtk_arrays(const ObjectSurface& surface, const std::vector<VtkArray>& point_arrays) {
+  std::vector<VtkArray> out;
+  Eigen::MatrixXd at_vertices;
+  for (const VtkArray& a : point_arrays) {
+    if (a.integer) continue;  // flags do not interpolate
+    const Eigen::Index n = static_cast<Eigen::Index>(a.values.size()) / a.components;
+    interpolate_at_surface(surface.map, Eigen::Map<const Eigen::MatrixXd>(a.values.data(), a.components, n), at_vertices);
+    out.push_back({a.name, a.components, std::vector<double>(at_vertices.data(), at_vertices.data() + at_vertices.size()), false});
+  }
+  return out;
+}
+
+void add_vtk_frame(VtkSeries& series, Simulation& sim, const ObjectSurface* surface) {
   std::vector<VtkArray> arrays = vtk_arrays(sim);
   const Points x = sim.model().X + sim.state().u;
   series.add(sim.state().time, x, arrays);
+  if (surface) series.add_surface(deformed_surface(*surface, sim.state().u), surface->mesh.F, surface_vtk_arrays(*surface, arrays));
 }
 
 }  // namespace pointhaptics

@@ -1,6 +1,7 @@
 #pragma once
 /// @file A simulation's state as ParaView frames (io/vtk.hpp): the fields design.md names.
 #include <pointhaptics/io/vtk.hpp>
+#include <pointhaptics/object_surface.hpp>
 #include <pointhaptics/simulation.hpp>
 
 namespace pointhaptics {
@@ -10,7 +11,13 @@ namespace pointhaptics {
 /// (1 where the point is simulated) and `fixed` (1 where held). Points are the current positions X + u.
 std::vector<VtkArray> vtk_arrays(Simulation& sim);
 
-/// Add the simulation's current state to the series at its time.
-void add_vtk_frame(VtkSeries& series, Simulation& sim);
+/// The surface's arrays: the float arrays of `point_arrays` (vtk_arrays()) carried to its vertices by its
+/// map (displacement, cauchy_stress, von_mises, strain_energy_density; each vertex's MLS interpolation of
+/// its points' values).
+std::vector<VtkArray> surface_vtk_arrays(const ObjectSurface& surface, const std::vector<VtkArray>& point_arrays);
+
+/// Add the simulation's current state to the series at its time; with `surface`, its deformed surface too
+/// (part 1 of the time step).
+void add_vtk_frame(VtkSeries& series, Simulation& sim, const ObjectSurface* surface = nullptr);
 
 }  // namespace pointhaptics

@@ -115,7 +115,9 @@ print("ok: " + err.splitlines()[0])
 frames = os.path.join(work, "probe_frames")
 p, _ = run(probe, "--deterministic", "--vtk", frames, "--vtk-every", "100")
 assert p.returncode == 0, p.stderr
-vtp = [f for f in os.listdir(frames) if f.endswith(".vtp")]
+vtp = [f for f in os.listdir(frames) if f.endswith(".vtp") and "_surface_" not in f]
 assert len(vtp) == 3000 // 100 + 2, len(vtp)  # every 100 of 3000 steps, the first and the last state
+surfaces = [f for f in os.listdir(frames) if f.endswith(".vtp") and "_surface_" in f]
+assert len(surfaces) == len(vtp), (len(surfaces), len(vtp))  # each with the object's surface
 print(f"ok: --vtk-every 100 wrote {len(vtp)} frames of a probe run")
 print("outputs ok")

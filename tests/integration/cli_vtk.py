@@ -2,7 +2,8 @@
 """End to end: `pointhaptics run --vtk DIR --csv FILE` writes a ParaView time series: a .pvd collection whose frames
 exist, each a VTK XML PolyData file with one vertex per point and the point data arrays of the contract,
 with finite values; the last frame's displacements are the result JSON's; with levels of detail the
-`active` flags count the simulated points."""
+`active` flags count the simulated points; every frame has the object's deformed surface as part 1 (polygons,
+with the float arrays carried to its vertices), enclosing the points' current positions."""
 import csv
 import json
 import math
@@ -53,8 +54,11 @@ def check(scene, extra, name):
     table = os.path.join(out, name + ".csv")
     subprocess.run([exe, "run", os.path.join(scenes, scene), "--quiet", "--vtk", folder, "--json", result, "--csv", table] + extra,
                    check=True)
-    series = ET.parse(os.path.join(folder, "frame.pvd")).getroot().findall("Collection/DataSet")
+    every = ET.parse(os.path.join(folder, "frame.pvd")).getroot().findall("Collection/DataSet")
+    series = [d for d in every if d.get("part") == "0"]
+    surfaces = [d for d in every if d.get("part") == "1"]
     assert len(series) >= 2, len(series)
+    assert [d.get("timestep") for d in surfaces] == [d.get("timestep") for d in series], "one surface per frame"
     times = [float(d.get("timestep")) for d in series]
     assert times == sorted(times), times
     for d in series:
@@ -75,7 +79,36 @@ def check(scene, extra, name):
     assert [int(r["active"]) for r in rows] == [int(v) for v in arrays["active"][1]]
     x = [c for p in doc["points"]["reference"] for c in p]
     assert max(abs(p - (a + b)) for p, a, b in zip(points, x, u)) < 1e-9  # points are the current positions
+    check_surface(os.path.join(folder, surfaces[-1].get("file")), points)
     return doc, arrays, len(series)
+
+
+def check_surface(path, points):
+    """The last surface: polygons, the float arrays, finite; its bounding box that of the points' current
+    positions to within a tenth of the extent (the exact boundary, carried: a box's points lie on its faces, a
+    half-sphere's within a spacing of its dome)."""
+    import vtk
+    reader = vtk.vtkXMLPolyDataReader()
+    reader.SetFileName(path)
+    reader.Update()
+    out = reader.GetOutput()
+    assert out.GetNumberOfPolys() > 100 and out.GetNumberOfVerts() == 0, (out.GetNumberOfPolys(), out.GetNumberOfVerts())
+    pd = out.GetPointData()
+    arrays = {pd.GetArrayName(i): pd.GetArray(i).GetNumberOfComponents() for i in range(pd.GetNumberOfArrays())}
+    assert arrays == {k: v for k, v in ARRAYS.items() if k not in ("active", "fixed")}, arrays
+    vm = pd.GetArray("von_mises")
+    assert all(math.isfinite(vm.GetValue(i)) for i in range(vm.GetNumberOfTuples()))
+    lo, hi = [1e300] * 3, [-1e300] * 3
+    for i in range(out.GetNumberOfPoints()):
+        p = out.GetPoint(i)
+        lo = [min(a, b) for a, b in zip(lo, p)]
+        hi = [max(a, b) for a, b in zip(hi, p)]
+    plo = [min(points[c::3]) for c in range(3)]
+    phi = [max(points[c::3]) for c in range(3)]
+    extent = max(b - a for a, b in zip(plo, phi))
+    # encloses them (to the interpolation's difference from the points' own displacements)
+    assert all(a <= b + 0.01 * extent and d >= c - 0.01 * extent for a, b, c, d in zip(lo, plo, phi, hi)), (lo, hi, plo, phi)
+    assert max(max(b - a for a, b in zip(lo, plo)), max(d - c for c, d in zip(phi, hi))) < 0.1 * extent, (lo, hi, plo, phi)
 
 
 doc, arrays, frames = check("beam_fixed_both_ends.toml", ["--vtk-every", "100"], "beam")

@@ -29,6 +29,7 @@ struct ObjectSpec {
   Vec3 origin = Vec3::Zero();          ///< box: min corner; sphere, half_sphere: centre, m
   double radius = 0.05;                ///< sphere, half_sphere, m
   double spacing = 0.0075;             ///< sample spacing, m
+  double surface_edge = 0;             ///< the surface's edge length, m (0: half the spacing)
   std::string file;                    ///< shape = file: path, resolved against the scene file's folder
   double threshold_low = NAN, threshold_high = NAN;  ///< volume images: the intensity window sampled
   /// volume images: [intensity, young (Pa)] rows, intensities increasing; each point's Young's modulus is

@@ -203,6 +203,8 @@ auto non_negative = [](double x) { return x >= 0; };
 void read_object(TableReader& r, ObjectSpec& o, const Context& ctx) {
   o.shape = r.enumeration("shape", o.shape);
   o.spacing = r.number("spacing", o.spacing, positive, "must be > 0 (m)");
+  o.surface_edge = r.number("surface_edge", o.surface_edge, [&](double e) { return e > 0 && e >= 1e-3 * o.spacing; },
+                            "must be > 0 (m) and at least a thousandth of the spacing");
   if (o.shape == ShapeKind::BOX) {
     if (!r.find("size")) r.fail_table("size", "a box needs size = [lx, ly, lz] (m)");
     o.size = r.vec3("size", o.size);

@@ -96,13 +96,29 @@ SurfaceMap build_surface_map(const Model& model, const Points& Y) {
   return map;
 }
 
+namespace {
+
+// out_v = start_v + sum_j phi_j(Y_v) field_j, vertex by vertex (Rows: the field's rows when fixed, else Dynamic)
+template <int Rows, class Start, class Field, class Out>
+void apply_map(const SurfaceMap& map, const Start& start, const Field& field, Out& out) {
+  using Column = Eigen::Matrix<double, Rows, 1>;
+  for (index_t v = 0; v < map.n_vertices(); ++v) {
+    Column sum = start(v);
+    for (index_t e = map.points.begin(v); e < map.points.end(v); ++e) sum += map.weight[e] * field.col(map.points.index[e]);
+    out.col(v) = sum;
+  }
+}
+
+}  // namespace
+
+void interpolate_at_surface(const SurfaceMap& map, const Eigen::MatrixXd& field, Eigen::MatrixXd& out) {
+  out.resize(field.rows(), map.n_vertices());
+  apply_map<Eigen::Dynamic>(map, [&](index_t) { return Eigen::VectorXd::Zero(field.rows()); }, field, out);
+}
+
 void carry_surface(const SurfaceMap& map, const Points& Y, const Points& u, Points& y) {
   y.resize(3, map.n_vertices());
-  for (index_t v = 0; v < map.n_vertices(); ++v) {
-    Vec3 moved = Y.col(v);
-    for (index_t e = map.points.begin(v); e < map.points.end(v); ++e) moved += map.weight[e] * u.col(map.points.index[e]);
-    y.col(v) = moved;
-  }
+  apply_map<3>(map, [&](index_t v) { return Vec3(Y.col(v)); }, u, y);
 }
 
 void spread_surface_forces(const SurfaceMap& map, const Points& f_vertices, Points& f_points) {
