@@ -301,8 +301,10 @@ int main(int argc, char** argv) {
   view_cmd->add_option("--probe", view.probe, "What drives the probe: auto (a device if present, else the mouse), mouse, "
                                               "script (the scene's trajectory), device")
       ->check(CLI::IsMember({"auto", "mouse", "script", "device"}));
-  view_cmd->add_option("--colour", view.colour, "Colour points by displacement or by level-of-detail band (seed Fig. 6)")
-      ->check(CLI::IsMember({"displacement", "band"}));
+  view_cmd->add_option("--colour", view.colour, "Colour the object by displacement, von Mises stress or level-of-detail band (seed Fig. 6)")
+      ->check(CLI::IsMember({"displacement", "von_mises", "band"}));
+  view_cmd->add_option("--draw", view.draw, "Draw the object's surface (boxes, spheres, half-spheres, meshes) or its points")
+      ->check(CLI::IsMember({"surface", "points"}));
   view_cmd->add_flag("--no-panels", [&view](std::int64_t) { view.panels = false; }, "Only the 3-D view");
   view_cmd->add_option("--frames", view.frames, "Headless: draw this many frames and report the time per frame")
       ->check(CLI::Range(1, 100000));

@@ -111,19 +111,31 @@ bool parameter_panels(Scene& s) {
   return changed;
 }
 
-void display_panel(SceneView& view) {
+void display_panel(const Prepared& p, SceneView& view) {
   if (!ImGui::CollapsingHeader("Display", ImGuiTreeNodeFlags_DefaultOpen)) return;
   int by = static_cast<int>(view.colour_by);
   ImGui::RadioButton("displacement", &by, 0);
   ImGui::SameLine();
   ImGui::RadioButton("LOD band", &by, 1);
+  ImGui::SameLine();
+  ImGui::RadioButton("von Mises", &by, 2);
   view.colour_by = static_cast<ColourBy>(by);
   ImGui::Checkbox("auto scale", &view.auto_scale);
-  if (!view.auto_scale) {
+  if (!view.auto_scale && view.colour_by == ColourBy::VON_MISES) {
+    float kpa = view.stress_max * 1e-3f;
+    if (ImGui::SliderFloat("scale (kPa)", &kpa, 1e-3f, 1e4f, "%.3g", ImGuiSliderFlags_Logarithmic)) view.stress_max = kpa * 1e3f;
+  } else if (!view.auto_scale) {
     float mm = view.scale_max * 1e3f;
     if (ImGui::SliderFloat("scale (mm)", &mm, 1e-3f, 100.0f, "%.3g", ImGuiSliderFlags_Logarithmic)) view.scale_max = mm * 1e-3f;
   }
   ImGui::SliderFloat("point size", &view.point_scale, 0.2f, 1.5f, "%.2f");
+  if (p.surface) {
+    ImGui::Checkbox("surface", &view.draw_surface);
+    if (view.draw_surface) {
+      ImGui::SameLine();
+      ImGui::Checkbox("points too", &view.points_too);
+    }
+  }
   ImGui::Checkbox("interior points (hidden in a solid)", &view.interior);
 }
 
@@ -164,7 +176,7 @@ void draw_panels(const ViewerSession* session, const Prepared& p, const DisplayF
   ImGui::SameLine();
   if (ImGui::Button("revert")) state.edit = p.scene;
   if (busy) ImGui::EndDisabled();
-  display_panel(view);
+  display_panel(p, view);
   if (session) {
     live_panel(f, live);
   } else if (ImGui::CollapsingHeader("Live", ImGuiTreeNodeFlags_DefaultOpen)) {

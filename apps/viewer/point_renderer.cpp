@@ -1,5 +1,7 @@
 #include "point_renderer.hpp"
 
+#include "gl_program.hpp"
+
 #include <pointhaptics/core/error.hpp>
 
 #include <epoxy/gl.h>
@@ -54,37 +56,10 @@ void main() {
 }
 )";
 
-// The status of a shader or program step, and its log when it failed (glGetShaderiv and glGetShaderInfoLog,
-// or their program versions).
-template <class GetStatus, class GetLog>
-void check(unsigned object, unsigned what, GetStatus get_status, GetLog get_log, const char* step) {
-  GLint ok = 0;
-  get_status(object, what, &ok);
-  if (ok) return;
-  char log[2048] = {};
-  get_log(object, static_cast<GLsizei>(sizeof log), nullptr, log);
-  throw Error(fmt::format("viewer: the shaders failed to {}: {}", step, log));
-}
-
-unsigned compile(unsigned kind, const char* source) {
-  const unsigned shader = glCreateShader(kind);
-  glShaderSource(shader, 1, &source, nullptr);
-  glCompileShader(shader);
-  check(shader, GL_COMPILE_STATUS, glGetShaderiv, glGetShaderInfoLog, "compile");
-  return shader;
-}
-
 }  // namespace
 
 PointRenderer::PointRenderer() {
-  const unsigned vs = compile(GL_VERTEX_SHADER, vertex_shader), fs = compile(GL_FRAGMENT_SHADER, fragment_shader);
-  program_ = glCreateProgram();
-  glAttachShader(program_, vs);
-  glAttachShader(program_, fs);
-  glLinkProgram(program_);
-  glDeleteShader(vs);
-  glDeleteShader(fs);
-  check(program_, GL_LINK_STATUS, glGetProgramiv, glGetProgramInfoLog, "link");
+  program_ = link_program(vertex_shader, fragment_shader);
   view_ = glGetUniformLocation(program_, "view");
   projection_ = glGetUniformLocation(program_, "projection");
   pixels_per_unit_ = glGetUniformLocation(program_, "pixels_per_unit");
@@ -115,10 +90,7 @@ void PointRenderer::draw(const std::vector<Sphere>& spheres, const OrbitCamera& 
   glClearDepth(1.0);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   if (spheres.empty()) return;
-  const Viewport vp{viewport.x * pixel_ratio, viewport.y * pixel_ratio, viewport.width * pixel_ratio,
-                    viewport.height * pixel_ratio};
-  glViewport(static_cast<GLint>(vp.x), static_cast<GLint>(fb_height - vp.y - vp.height), static_cast<GLsizei>(vp.width),
-             static_cast<GLsizei>(vp.height));
+  const Viewport vp = use_viewport(viewport, fb_height, pixel_ratio);
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
   glEnable(GL_PROGRAM_POINT_SIZE);

@@ -1,6 +1,8 @@
 #include "scene_view.hpp"
 
 #include <pointhaptics/core/error.hpp>
+#include <pointhaptics/mechanics/point_fields.hpp>
+#include <pointhaptics/mechanics/surface_map.hpp>
 
 #include <fmt/format.h>
 #include <imgui.h>
@@ -28,6 +30,23 @@ Rgb probe_colour_of(const SceneView& view) { return view.colour_by == ColourBy::
 
 Rgb paler(const Rgb& c) { return {0.35f * c[0] + 0.65f * 0.55f, 0.35f * c[1] + 0.65f * 0.57f, 0.35f * c[2] + 0.65f * 0.6f}; }
 
+// rise at once, fall slowly, so the colours do not flicker
+void follow_scale(float& top, double largest, float floor) { top = std::max({static_cast<float>(largest), 0.97f * top, floor}); }
+
+bool surface_drawn(const Prepared& p, const SceneView& view) { return p.surface && view.draw_surface; }
+
+/// The colour of point i (its flags first, then the chosen field: `magnitude` is its displacement's norm,
+/// m, or its von Mises stress, Pa, as view.colour_by says); with `pale_unsimulated`, paler where levels of
+/// detail do not simulate it (points; on a surface the dithered selection's scattered points made blotches).
+Rgb point_colour(const Prepared& p, const DisplayFrame& f, const SceneView& view, std::size_t i, double magnitude, bool pale_unsimulated) {
+  const bool bands = f.lod_band.size() == p.fixed.size();
+  if (p.fixed[i]) return held_colour;
+  if (view.grabbed[i]) return grabbed_colour;
+  if (view.colour_by == ColourBy::LOD_BAND && bands) return band_colour(f.lod_band[i]);
+  const Rgb c = viridis(magnitude / (view.colour_by == ColourBy::VON_MISES ? view.stress_max : view.scale_max));
+  return pale_unsimulated && bands && f.lod_band[i] < 0 ? paler(c) : c;
+}
+
 }  // namespace
 
 void build_spheres(const Prepared& p, const DisplayFrame& f, SceneView& view) {
@@ -38,37 +57,77 @@ void build_spheres(const Prepared& p, const DisplayFrame& f, SceneView& view) {
   for (const index_t i : f.grabbed)
     if (i >= 0 && i < n) view.grabbed[static_cast<std::size_t>(i)] = 1;
   const bool displacement_ok = f.u.cols() == n && f.u.allFinite();
-  if (view.auto_scale && displacement_ok && n > 0) {
-    // rise at once, fall slowly, so the colours do not flicker
-    const auto largest = static_cast<float>(f.u.colwise().norm().maxCoeff());
-    view.scale_max = std::max({largest, 0.97f * view.scale_max, 1e-6f});
+  if (view.auto_scale && displacement_ok && n > 0) follow_scale(view.scale_max, f.u.colwise().norm().maxCoeff(), 1e-6f);
+  // von Mises stress of every point, on this thread from the frame's displacements (the model is static)
+  const bool stress = view.colour_by == ColourBy::VON_MISES && displacement_ok;
+  if (stress) {
+    view.von_mises = point_fields(p.simulation->model(), f.u).von_mises;
+    if (view.auto_scale && n > 0) follow_scale(view.stress_max, view.von_mises.maxCoeff(), 1e-3f);
   }
-  const bool bands = f.lod_band.size() == static_cast<std::size_t>(n);
   const double radius = p.point_radius * view.point_scale;
-  // the surface shell only, unless asked (a point scaled below full size leaves gaps to see inside by)
+  // the surface shell only, unless asked (a point scaled below full size leaves gaps to see inside by); none
+  // under a drawn surface unless asked
   const bool all = view.interior || view.point_scale < 0.9f;
-  const Eigen::Index count = all ? n : static_cast<Eigen::Index>(p.shell.size());
+  const Eigen::Index count = surface_drawn(p, view) && !view.points_too ? 0 : all ? n : static_cast<Eigen::Index>(p.shell.size());
   for (Eigen::Index m = 0; m < count; ++m) {
     const Eigen::Index i = all ? m : p.shell[static_cast<std::size_t>(m)];
-    const auto k = static_cast<std::size_t>(i);
     const Vec3 u = displacement_ok ? Vec3(f.u.col(i)) : Vec3::Zero();
-    Rgb c;
-    if (p.fixed[k]) {
-      c = held_colour;
-    } else if (view.grabbed[k]) {
-      c = grabbed_colour;
-    } else if (view.colour_by == ColourBy::LOD_BAND && bands) {
-      c = band_colour(f.lod_band[k]);
-    } else {
-      c = viridis(u.norm() / view.scale_max);
-      if (bands && f.lod_band[k] < 0) c = paler(c);
-    }
-    view.spheres.push_back(sphere(p.reference.col(i) + u, c, radius));
+    const double magnitude = stress ? view.von_mises[i] : u.norm();
+    view.spheres.push_back(sphere(p.reference.col(i) + u, point_colour(p, f, view, static_cast<std::size_t>(i), magnitude, true), radius));
   }
   const double probe_radius = p.options.probe.radius;
   if (f.probe.allFinite()) view.spheres.push_back(sphere(f.probe, probe_colour_of(view), probe_radius));
   if (f.device.allFinite() && f.probe.allFinite() && (f.device - f.probe).norm() > 0.3 * probe_radius)
     view.spheres.push_back(sphere(f.device, {0.8f, 0.8f, 0.85f}, 0.25 * probe_radius));
+}
+
+void build_surface(const Prepared& p, const DisplayFrame& f, SceneView& view) {
+  view.surface_vertices.clear();
+  if (!surface_drawn(p, view)) return;
+  const ObjectSurface& surface = *p.surface;
+  const Eigen::Index n = p.reference.cols(), m = surface.mesh.V.cols();
+  if (view.surface_indices.size() != 3 * surface.mesh.F.size()) {
+    view.surface_indices.clear();
+    for (const auto& t : surface.mesh.F)
+      for (const index_t v : t) view.surface_indices.push_back(static_cast<unsigned>(v));
+  }
+  const bool displacement_ok = f.u.cols() == n && f.u.allFinite();
+  if (displacement_ok) carry_surface(surface.map, surface.mesh.V, f.u, view.surface_positions);
+  else view.surface_positions = surface.mesh.V;
+  // smooth normals: each vertex the sum of its triangles' area vectors
+  view.surface_normals.setZero(3, m);
+  for (const auto& t : surface.mesh.F) {
+    const Vec3 a = view.surface_positions.col(t[0]), b = view.surface_positions.col(t[1]), c = view.surface_positions.col(t[2]);
+    const Vec3 area = (b - a).cross(c - a);
+    for (const index_t v : t) view.surface_normals.col(v) += area;
+  }
+  Eigen::VectorXd stress_at;
+  const bool stress = view.colour_by == ColourBy::VON_MISES && view.von_mises.size() == n;
+  if (stress) {
+    Eigen::MatrixXd at;
+    interpolate_at_surface(surface.map, view.von_mises.transpose(), at);
+    stress_at = at.row(0).transpose();
+  }
+  view.surface_vertices.reserve(static_cast<std::size_t>(m));
+  for (Eigen::Index v = 0; v < m; ++v) {
+    const Vec3 y = view.surface_positions.col(v);
+    const Vec3 normal = view.surface_normals.col(v).normalized();
+    const double magnitude = stress ? stress_at[v] : (y - surface.mesh.V.col(v)).norm();
+    const Rgb c = point_colour(p, f, view, static_cast<std::size_t>(p.surface_point[static_cast<std::size_t>(v)]), magnitude, false);
+    view.surface_vertices.push_back({static_cast<float>(y.x()), static_cast<float>(y.y()), static_cast<float>(y.z()),
+                                     static_cast<float>(normal.x()), static_cast<float>(normal.y()), static_cast<float>(normal.z()), c[0],
+                                     c[1], c[2]});
+  }
+}
+
+void build_scene(const Prepared& p, const DisplayFrame& f, SceneView& view) {
+  build_spheres(p, f, view);
+  build_surface(p, f, view);
+}
+
+void Renderers::draw(const SceneView& view, const Viewport& viewport, int fb_width, int fb_height, double pixel_ratio) {
+  points.draw(view.spheres, view.camera, viewport, fb_width, fb_height, pixel_ratio);
+  surface.draw(view.surface_vertices, view.surface_indices, view.camera, viewport, fb_width, fb_height, pixel_ratio);
 }
 
 void draw_overlay(const Prepared& p, const DisplayFrame& f, const SceneView& view, const Viewport& vp) {
@@ -77,18 +136,20 @@ void draw_overlay(const Prepared& p, const DisplayFrame& f, const SceneView& vie
   // colour bar at the right edge of the view
   const float x1 = static_cast<float>(vp.x + vp.width) - 24.0f, x0 = x1 - 16.0f;
   const float y0 = static_cast<float>(vp.y) + 40.0f, y1 = static_cast<float>(vp.y + vp.height) - 40.0f;
-  if (view.colour_by == ColourBy::DISPLACEMENT && y1 > y0 + 40) {
+  if (view.colour_by != ColourBy::LOD_BAND && y1 > y0 + 40) {
+    const bool stress = view.colour_by == ColourBy::VON_MISES;
     constexpr int steps = 32;
     for (int s = 0; s < steps; ++s) {
       const float a = y1 - (y1 - y0) * static_cast<float>(s) / steps, b = y1 - (y1 - y0) * static_cast<float>(s + 1) / steps;
       draw->AddRectFilled(ImVec2(x0, b), ImVec2(x1, a), pack_rgba(viridis((s + 0.5) / steps)));
     }
     draw->AddRect(ImVec2(x0, y0), ImVec2(x1, y1), IM_COL32(200, 200, 205, 255));
-    const std::string top = fmt::format("{:.3g} mm", 1e3 * view.scale_max);
+    const std::string top = stress ? fmt::format("{:.3g} kPa", 1e-3 * view.stress_max) : fmt::format("{:.3g} mm", 1e3 * view.scale_max);
     const float w = ImGui::CalcTextSize(top.c_str()).x;
     draw->AddText(ImVec2(x1 - w, y0 - 20), text, top.c_str());
     draw->AddText(ImVec2(x1 - ImGui::CalcTextSize("0").x, y1 + 4), text, "0");
-    draw->AddText(ImVec2(x0 - 4 - ImGui::CalcTextSize("|u|").x, 0.5f * (y0 + y1)), text, "|u|");
+    const char* label = stress ? "von Mises" : "|u|";
+    draw->AddText(ImVec2(x0 - 4 - ImGui::CalcTextSize(label).x, 0.5f * (y0 + y1)), text, label);
   } else if (view.colour_by == ColourBy::LOD_BAND && y1 > y0 + 40) {
     const char* names[] = {"T_r1", "T_r2", "level 1", "level 2", "level 3", "level 4+", "not simulated"};
     for (int b = 0; b < 7; ++b) {
@@ -134,6 +195,15 @@ void write_frame_info(const std::string& path, const Prepared& p, const DisplayF
   const Eigen::Index stride = std::max<Eigen::Index>(1, x.cols() / 300);
   for (Eigen::Index i = 0; i < x.cols(); i += stride) samples.push_back(vec(x.col(i)));
   j["sample_points"] = std::move(samples);
+  // the drawn surface: its triangles, and a few deformed vertices for tests to project
+  j["surface"] = {{"drawn", !view.surface_vertices.empty()}, {"triangles", view.surface_indices.size() / 3}};
+  json surface_samples = json::array();
+  const std::size_t vertex_stride = std::max<std::size_t>(1, view.surface_vertices.size() / 300);
+  for (std::size_t v = 0; v < view.surface_vertices.size(); v += vertex_stride) {
+    const SurfaceVertex& s = view.surface_vertices[v];
+    surface_samples.push_back({s.x, s.y, s.z});
+  }
+  j["surface"]["sample_vertices"] = std::move(surface_samples);
   j["displacement_max"] = f.u.cols() ? f.u.colwise().norm().maxCoeff() : 0.0;
   j["colour_scale_max"] = view.scale_max;
   j["time"] = f.time;

@@ -77,7 +77,8 @@ struct MouseProbe {
 // The view a window or a screenshot starts with: the colours asked for, the object framed.
 SceneView initial_view(const ViewerOptions& o, const Prepared& prepared) {
   SceneView view;
-  view.colour_by = o.colour == "band" ? ColourBy::LOD_BAND : ColourBy::DISPLACEMENT;
+  view.colour_by = o.colour == "band" ? ColourBy::LOD_BAND : o.colour == "von_mises" ? ColourBy::VON_MISES : ColourBy::DISPLACEMENT;
+  view.draw_surface = o.draw == "surface";
   view.camera.frame(prepared.lo, prepared.hi);
   return view;
 }
@@ -96,7 +97,7 @@ int render_screenshot(const ViewerOptions& o) {
   HeadlessContext context(o.width, o.height);
   ImGuiContextGuard imgui;
   if (!ImGui_ImplOpenGL3_Init("#version 330")) throw Error("viewer: Dear ImGui's OpenGL 3 renderer did not start");
-  PointRenderer renderer;
+  Renderers renderer;
   SceneView view = initial_view(o, *prepared);
   const Viewport vp = scene_viewport(o.width, o.height, o.panels);
   PanelState state{prepared->scene, false, {}};
@@ -105,12 +106,12 @@ int render_screenshot(const ViewerOptions& o) {
   const auto start = std::chrono::steady_clock::now();
   for (int k = 0; k < std::max(o.frames, 1); ++k) {
     if (k > 0) view.camera.yaw += 0.01;
-    build_spheres(*prepared, frame, view);
+    build_scene(*prepared, frame, view);
     begin_headless_imgui_frame(o.width, o.height);
     if (o.panels) draw_panels(nullptr, *prepared, frame, view, state, live, o.width, o.height);
     draw_overlay(*prepared, frame, view, vp);
     ImGui::Render();
-    renderer.draw(view.spheres, view.camera, vp, o.width, o.height);
+    renderer.draw(view, vp, o.width, o.height);
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
     glFinish();
   }
@@ -154,7 +155,7 @@ int run_window(const ViewerOptions& o) {
     }
   } backends;
 
-  PointRenderer renderer;
+  Renderers renderer;
   SceneView view = initial_view(o, session.current());
   PanelState state{session.current().scene, false, {}};
   LiveStats live;
@@ -235,7 +236,7 @@ int run_window(const ViewerOptions& o) {
       p.mouse->set_target(session.device_of_scene(mouse.target), grab ? 1u : 0u);
     }
 
-    build_spheres(p, frame, view);
+    build_scene(p, frame, view);
     ImGui_ImplOpenGL3_NewFrame();
     ImGui_ImplGlfw_NewFrame();
     ImGui::NewFrame();
@@ -243,7 +244,7 @@ int run_window(const ViewerOptions& o) {
     draw_overlay(p, frame, view, vp);
     ImGui::Render();
     const int fw = window.framebuffer_width(), fh = window.framebuffer_height();
-    renderer.draw(view.spheres, view.camera, vp, fw, fh, window.pixel_ratio());
+    renderer.draw(view, vp, fw, fh, window.pixel_ratio());
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
 
     const bool last = o.run_for > 0 && t >= o.run_for;

@@ -15,7 +15,8 @@ struct ViewerOptions {
   int threads = 0;
   int frames = 1;               ///< headless: draw this many frames (the camera turning) and report the time per frame
   bool panels = true;           ///< draw the panels (left column)
-  std::string colour = "displacement";  ///< displacement | band (levels of detail, seed Fig. 6)
+  std::string colour = "displacement";  ///< displacement | von_mises | band (levels of detail, seed Fig. 6)
+  std::string draw = "surface";         ///< surface (the object's, when it has one) | points
 };
 
 /// The default scene file: scenes/beam_probe.toml from the source tree, else the installed copy.

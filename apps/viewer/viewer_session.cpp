@@ -92,6 +92,17 @@ std::unique_ptr<Prepared> prepare(const Scene& scene_in, ProbeSource source, int
   p->lo = model.X.rowwise().minCoeff();
   p->hi = model.X.rowwise().maxCoeff();
   p->shell = visible_shell(model.neighbours);
+  if (has_object_surface(p->scene)) {
+    p->surface = build_object_surface(p->scene, model);
+    const SurfaceMap& map = p->surface->map;
+    p->surface_point.resize(static_cast<std::size_t>(map.n_vertices()));
+    for (index_t v = 0; v < map.n_vertices(); ++v) {
+      index_t heaviest = map.points.begin(v);
+      for (index_t e = map.points.begin(v); e < map.points.end(v); ++e)
+        if (map.weight[e] > map.weight[heaviest]) heaviest = e;
+      p->surface_point[static_cast<std::size_t>(v)] = map.points.index[heaviest];
+    }
+  }
   // the mouse pushes, and grabs while its button is held; a scene's grab mode grabs only
   if (!scene.probe.grab) p->options.probe.mode = ProbeMode::PUSH_GRAB;
   p->options.duration = std::numeric_limits<double>::infinity();

@@ -4,10 +4,12 @@
 /// script), and rebuilds from edited parameters on a worker thread while the old run goes on.
 #include <pointhaptics/haptics/devices/mouse_device.hpp>
 #include <pointhaptics/interactive.hpp>
+#include <pointhaptics/object_surface.hpp>
 
 #include <atomic>
 #include <future>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -34,6 +36,10 @@ struct Prepared {
   /// and their neighbours (the two outer layers of a lattice sampling; every point of an irregular cloud).
   /// An opaque object hides the rest, and not drawing them is 2-4x less to draw at 100k points.
   std::vector<index_t> shell;
+  /// The object's surface (docs/surface.md) when it has one, and each vertex's point of largest weight
+  /// (whose flags, band and grab the vertex shows).
+  std::optional<ObjectSurface> surface;
+  std::vector<index_t> surface_point;
   Vec3 lo, hi;                   ///< bounding box of the reference configuration
   std::string note;              ///< what was changed to run the scene here (a static solver), else empty
   std::unique_ptr<TripleBuffer<DisplayFrame>> display;

@@ -91,12 +91,22 @@ def check_picture(png, info_path, expect_contact):
         if np.linalg.norm(p - pc) < 1.3 * r_px:
             continue  # may be behind the probe
         considered += 1
-        c = img[int(round(p[1])), int(round(p[0]))]
-        chroma = c / max(c.sum(), 1)
+        # the pixel or one within 2 px of it (a point on a box's edge lies on the surface's outline)
+        x0, y0 = int(round(p[0])), int(round(p[1]))
+        window = img[max(y0 - 2, 0):y0 + 3, max(x0 - 2, 0):x0 + 3].reshape(-1, 3)
+        chroma = window / np.maximum(window.sum(axis=1, keepdims=True), 1)
         # the background is one flat colour; even a sphere's dark rim differs from it
-        if np.linalg.norm(c - BACKGROUND) > 8 and np.linalg.norm(chroma - hue) > 0.05:
+        if np.any((np.linalg.norm(window - BACKGROUND, axis=1) > 8) & (np.linalg.norm(chroma - hue, axis=1) > 0.05)):
             hits += 1
     assert considered > 20 and hits / considered > 0.95, f"{png}: {hits} of {considered} object points on object pixels"
+    # the surface (the default for a box): drawn, and its vertices land on object pixels too; a smooth
+    # surface, unlike a heap of balls, has few pixels as dark as a sphere's rim inside its outline
+    if info["surface"]["drawn"]:
+        assert info["surface"]["triangles"] > 100, info["surface"]
+        vpix, _, _ = project(info, np.array(info["surface"]["sample_vertices"], float))
+        on = [np.linalg.norm(img[min(int(round(p[1])), h - 1), min(int(round(p[0])), w - 1)] - BACKGROUND) > 8
+              for p in vpix if np.linalg.norm(p - pc) > 1.3 * r_px and 0 <= p[0] < w and 0 <= p[1] < h]
+        assert len(on) > 20 and np.mean(on) > 0.9, f"{png}: {np.mean(on):.2f} of the surface's vertices on drawn pixels"
     lo, hi = pix.min(axis=0), pix.max(axis=0)
     margin = 3 * info["point_radius"] * ppm[0] + 10
     for corner in ((vx + 5, vy + 40), (vx + vw - 80, vy + vh - 5), (vx + 5, vy + vh - 5)):
@@ -128,6 +138,24 @@ if mode == "headless":
     png, info = os.path.join(out, "headless.png"), os.path.join(out, "headless.json")
     run([block, "--screenshot", png, "--info", info, "--time", "1.5", *size], env=env)
     i1 = check_picture(png, info, expect_contact=True)
+    assert i1["surface"]["drawn"], i1["surface"]
+    # the points instead of the surface, on request
+    pngp, infop = os.path.join(out, "points.png"), os.path.join(out, "points.json")
+    run([block, "--screenshot", pngp, "--info", infop, "--time", "1.5", "--draw", "points", *size], env=env)
+    ip = check_picture(pngp, infop, expect_contact=True)
+    assert not ip["surface"]["drawn"], ip["surface"]
+    # the surface is smooth where the points are balls: far fewer distinct shades over the object
+    surf = np.asarray(Image.open(png).convert("RGB")).astype(float)
+    balls = np.asarray(Image.open(pngp).convert("RGB")).astype(float)
+    def edges(img):  # strong colour jumps between neighbouring pixels inside the view
+        vx, vy, vw, vh = i1["viewport"]
+        v = img[int(vy) + 40:int(vy + vh) - 40, int(vx) + 40:int(vx + vw) - 80]
+        return (np.linalg.norm(np.diff(v, axis=1), axis=2) > 40).sum()
+    assert edges(surf) < 0.5 * edges(balls), (edges(surf), edges(balls))
+    # coloured by von Mises stress: the colour bar says kPa (the ramp is checked by check_picture)
+    pngs, infos = os.path.join(out, "stress.png"), os.path.join(out, "stress.json")
+    run([block, "--screenshot", pngs, "--info", infos, "--time", "1.5", "--colour", "von_mises", *size], env=env)
+    check_picture(pngs, infos, expect_contact=True)
     # deterministic: the same frame twice
     png2, info2 = os.path.join(out, "headless2.png"), os.path.join(out, "headless2.json")
     run([block, "--screenshot", png2, "--info", info2, "--time", "1.5", *size], env=env)
