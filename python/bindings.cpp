@@ -82,10 +82,11 @@ struct PySimulation {
   }
   const ph::ObjectSurface& object_surface() {
     if (!surface) {
-      if (!from_scene)
-        throw ph::Error("surface: a Simulation made from_points has no surface (reconstructing one from points is not "
-                        "implemented yet); from_scene with a box, sphere, half-sphere or surface mesh has one");
-      surface = ph::build_object_surface(scene, sim->model());
+      const ph::Model& model = sim->model();
+      // from points: reconstructed from them (the half level of their kernel density), edges of half the spacing
+      surface = from_scene ? ph::build_object_surface(scene, model)
+                           : ph::carried_surface(ph::reconstruct_surface(model, 0.5 * model.spacing), "reconstructed from the points", model,
+                                                 "the points' surface");
       carry_surface();
     }
     return *surface;
@@ -300,8 +301,8 @@ names the problem.)doc")
             return view(p.surface_vertices, self);
           },
           "The object's surface (docs/surface.md): its deformed vertices, an (m, 3) read-only view (m) that follows the "
-          "simulation as it steps. Boxes, spheres and half-spheres have their exact boundary, surface meshes their own; "
-          "built on first use (Error for a Simulation from_points, or a point cloud or volume image scene).")
+          "simulation as it steps. Boxes, spheres and half-spheres have their exact boundary, surface meshes their own, "
+          "point clouds, volume images and Simulations from_points one reconstructed from the points; built on first use.")
       .def_property_readonly(
           "surface_triangles",
           [](PySimulation& p) {

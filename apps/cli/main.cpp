@@ -132,10 +132,10 @@ int run_command(const RunOptions& opt) {
   const ph::Scene& scene = session.scene;
   ph::Simulation& sim = *session.simulation;
   const double setup_s = session.setup_seconds;
-  // the object's surface, built before the run so that --surface of an object without one is refused at
-  // once; the ParaView frames carry it when the object has one
+  // the object's surface, for --surface and the ParaView frames, built before the run (a reconstruction
+  // too fine for the machine is refused at once)
   std::optional<ph::ObjectSurface> surface;
-  if (!opt.surface.empty() || (vtk && ph::has_object_surface(scene))) surface = ph::build_object_surface(scene, sim.model());
+  if (!opt.surface.empty() || vtk) surface = ph::build_object_surface(scene, sim.model());
   const ph::ObjectSurface* vtk_surface = vtk && surface ? &*surface : nullptr;
   if (vtk) ph::add_vtk_frame(*vtk, sim, vtk_surface);  // the initial state
   const double start_time = sim.time();
@@ -278,7 +278,7 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--vtk", run.vtk, "Write a ParaView time series (DIR/frame.pvd and DIR/frame_*.vtp)");
   run_cmd->add_option("--csv", run.csv, "Write the final state as CSV, one row per point (x, y, z, u, stress, energy, flags)");
   run_cmd->add_option("--surface", run.surface,
-                      "Write the object's deformed surface at the end (FILE.stl, .ply or .obj; boxes, spheres, half-spheres and meshes)");
+                      "Write the object's deformed surface at the end (FILE.stl, .ply or .obj)");
   run_cmd->add_option("--vtk-every", run.vtk_every, "Steps between VTK frames (default: about 50 frames per run)")
       ->check(CLI::PositiveNumber);
   run_cmd->add_flag("--deterministic", run.deterministic,

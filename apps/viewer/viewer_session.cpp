@@ -92,8 +92,12 @@ std::unique_ptr<Prepared> prepare(const Scene& scene_in, ProbeSource source, int
   p->lo = model.X.rowwise().minCoeff();
   p->hi = model.X.rowwise().maxCoeff();
   p->shell = visible_shell(model.neighbours);
-  if (has_object_surface(p->scene)) {
+  try {
     p->surface = build_object_surface(p->scene, model);
+  } catch (const Error& e) {  // the points are drawn instead, and the panel says why
+    p->note += std::string(p->note.empty() ? "" : "; ") + "no surface: " + e.what();
+  }
+  if (p->surface) {
     const SurfaceMap& map = p->surface->map;
     p->surface_point.resize(static_cast<std::size_t>(map.n_vertices()));
     for (index_t v = 0; v < map.n_vertices(); ++v) {

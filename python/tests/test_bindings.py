@@ -55,8 +55,13 @@ def test_the_surface_follows_the_points():
     lowest_point = sim.positions[:, 1].min()
     assert lowest_point < -0.01
     assert abs(y[:, 1].min() - lowest_point) < 0.03 * abs(lowest_point)
-    with pytest.raises(ph.Error, match="from_points"):
-        ph.Simulation.from_points(sim.reference, 0.0075).surface_vertices
+    # from points: a surface reconstructed from them, closed, around them
+    cloud = ph.Simulation.from_points(sim.reference, 0.0075)
+    t = cloud.surface_triangles
+    edges = np.sort(np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]]), axis=1)
+    assert np.all(np.unique(edges, axis=0, return_counts=True)[1] == 2)
+    v = cloud.surface_vertices
+    assert np.all(v.min(axis=0) < sim.reference.min(axis=0) + 0.0075) and np.all(v.max(axis=0) > sim.reference.max(axis=0) - 0.0075)
 
 
 def test_a_model_from_arrays_matches_forces_and_energy():

@@ -17,14 +17,20 @@ struct ObjectSurface {
   std::string source;  ///< what it was built from, for the summary ("exact box boundary, edge 3.75 mm", ...)
 };
 
-/// Whether the scene's object has a surface (a box, sphere, half-sphere or surface mesh; point clouds and
-/// volume images not yet).
-bool has_object_surface(const Scene& scene);
+/// The surface of a solid known only by its points (a point cloud, a volume image): the half level of their
+/// smoothed indicator, the kernel density phi(x) = sum_j V_j w(|x - X_j|, h_j) with the model's kernel,
+/// supports and volumes (about 1 inside, 0 outside, 1/2 on a flat boundary), by marching tetrahedra over a
+/// grid of `edge` (geometry/marching_tetrahedra.hpp). Throws Error if the grid would exceed `max_nodes`.
+TriangleMesh reconstruct_surface(const Model& model, double edge, double max_nodes = 2e8);
+
+/// `mesh` checked closed (Error naming `name` otherwise) and carried by `model`'s points.
+ObjectSurface carried_surface(TriangleMesh mesh, std::string source, const Model& model, const std::string& name);
 
 /// The surface of the scene's object over `model`'s points, with edges of about object.surface_edge
-/// (default half the spacing). A mesh file's own surface is kept as it is (its edges may differ from the
-/// asked length: `source` says by how much). Point clouds and volume images have no surface yet: an Error
-/// says so. Throws Error naming the scene for a surface that is not closed.
+/// (default half the spacing): the exact boundary of a box, sphere or half-sphere; a mesh file's own
+/// surface as it is (its edges may differ from the asked length: `source` says by how much); for a point
+/// cloud or a volume image, reconstruct_surface() of the model's points. Throws Error naming the scene for a
+/// surface that is not closed.
 ObjectSurface build_object_surface(const Scene& scene, const Model& model);
 
 /// The deformed surface's vertices y = Y + W u.
