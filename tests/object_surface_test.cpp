@@ -1,9 +1,11 @@
 // Tests for object_surface and io/mesh_file's writer: every shape of a scene gets its closed surface at the
-// asked edge length, carried by the model's points; a mesh file keeps its own surface; a point cloud gets
+// asked edge length, carried by the model's points; a mesh file keeps its own surface, split toward the asked
+// edge; a point cloud gets
 // one reconstructed; surfaces written as STL, PLY and OBJ read back closed and unchanged (to single
 // precision); the deformed surface follows the points; a sampled sphere's reconstruction lies within a
 // fraction of a spacing of the sphere.
 #include <pointhaptics/core/error.hpp>
+#include <pointhaptics/geometry/remesh.hpp>
 #include <pointhaptics/geometry/sampling.hpp>
 #include <pointhaptics/geometry/shape_surfaces.hpp>
 #include <pointhaptics/io/mesh_file.hpp>
@@ -24,13 +26,6 @@ namespace {
 
 std::string temp(const std::string& name) { return (std::filesystem::temp_directory_path() / ("ph_surface_" + name)).string(); }
 
-double mean_edge(const TriangleMesh& mesh) {
-  double sum = 0;
-  for (const auto& f : mesh.F)
-    for (int k = 0; k < 3; ++k) sum += (mesh.V.col(f[k]) - mesh.V.col(f[(k + 1) % 3])).norm();
-  return sum / (3.0 * static_cast<double>(mesh.F.size()));
-}
-
 TEST(ObjectSurface, EveryShapeGetsItsClosedSurfaceAtTheAskedEdge) {
   const std::string material = "\n[material]\nyoung = 1e5\npoisson = 0.3\n";
   for (const std::string object : {"shape = \"box\"\nsize = [0.06, 0.03, 0.03]\nspacing = 0.0075",
@@ -42,8 +37,8 @@ TEST(ObjectSurface, EveryShapeGetsItsClosedSurfaceAtTheAskedEdge) {
     EXPECT_NO_THROW(check_closed_manifold(surface.mesh, object));
     EXPECT_GT(enclosed_volume(surface.mesh), 0) << object;
     const double asked = scene.object.surface_edge > 0 ? scene.object.surface_edge : 0.5 * scene.object.spacing;
-    EXPECT_GT(mean_edge(surface.mesh), 0.6 * asked) << object;
-    EXPECT_LT(mean_edge(surface.mesh), 1.3 * asked) << object;
+    EXPECT_GT(mean_edge_length(surface.mesh), 0.6 * asked) << object;
+    EXPECT_LT(mean_edge_length(surface.mesh), 1.3 * asked) << object;
     EXPECT_EQ(surface.map.n_vertices(), surface.mesh.V.cols());
     EXPECT_FALSE(surface.source.empty());
     // at rest the surface is its reference
@@ -51,13 +46,15 @@ TEST(ObjectSurface, EveryShapeGetsItsClosedSurfaceAtTheAskedEdge) {
   }
 }
 
-TEST(ObjectSurface, AMeshFileKeepsItsSurfaceAndAPointCloudGetsOneReconstructed) {
+TEST(ObjectSurface, AMeshFileIsBroughtToTheAskedEdgeAndAPointCloudGetsOneReconstructed) {
   const std::string mesh_path = temp("cube.stl");
   write_mesh(mesh_path, box_surface(Vec3::Zero(), Vec3(0.04, 0.04, 0.04), 0.02), "test");
   const Scene scene = parse_scene("[object]\nshape = \"file\"\nfile = \"" + mesh_path + "\"\nspacing = 0.008\n");
   const ObjectSurface surface = build_object_surface(scene, build_scene_model(scene));
-  EXPECT_EQ(surface.mesh.F.size(), 6u * 2 * 4);  // the file's 48 triangles, not remeshed
-  EXPECT_NE(surface.source.find("as it is"), std::string::npos) << surface.source;
+  // the file's 48 triangles (edges of about 23 mm) split twice toward the 4 mm asked
+  EXPECT_EQ(surface.mesh.F.size(), 48u * 16);
+  EXPECT_NE(surface.source.find("split 2 times"), std::string::npos) << surface.source;
+  EXPECT_NEAR(enclosed_volume(surface.mesh), 0.04 * 0.04 * 0.04, 1e-6 * 0.04 * 0.04 * 0.04);  // the STL's single precision
 
   const std::string cloud_path = temp("cloud.xyz");
   {

@@ -2,6 +2,7 @@
 
 #include <pointhaptics/core/error.hpp>
 #include <pointhaptics/geometry/marching_tetrahedra.hpp>
+#include <pointhaptics/geometry/remesh.hpp>
 #include <pointhaptics/geometry/shape_surfaces.hpp>
 #include <pointhaptics/io/mesh_file.hpp>
 #include <pointhaptics/io/volume_file.hpp>
@@ -14,16 +15,6 @@
 #include <cmath>
 
 namespace pointhaptics {
-namespace {
-
-double mean_edge(const TriangleMesh& mesh) {
-  double sum = 0;
-  for (const auto& f : mesh.F)
-    for (int k = 0; k < 3; ++k) sum += (mesh.V.col(f[k]) - mesh.V.col(f[(k + 1) % 3])).norm();
-  return mesh.F.empty() ? 0.0 : sum / (3.0 * static_cast<double>(mesh.F.size()));
-}
-
-}  // namespace
 
 TriangleMesh reconstruct_surface(const Model& model, double edge, double max_nodes) {
   if (!(edge > 0) || !std::isfinite(edge)) throw Error(fmt::format("surface reconstruction: the grid edge must be > 0 (m), got {}", edge));
@@ -89,9 +80,11 @@ ObjectSurface build_object_surface(const Scene& scene, const Model& model) {
                                      cloud ? "point cloud" : "volume image", 1e3 * edge);
         break;
       }
-      surface.mesh = read_mesh(o.file);
-      surface.source = fmt::format("the input surface {} as it is ({} triangles, mean edge {:.3g} mm; {:.3g} mm asked)", o.file,
-                                   surface.mesh.F.size(), 1e3 * mean_edge(surface.mesh), 1e3 * edge);
+      TriangleMesh input = read_mesh(o.file);
+      check_closed_manifold(input, o.file);
+      Remeshed remeshed = adapt_to_edge(input, edge);
+      surface.mesh = std::move(remeshed.mesh);
+      surface.source = fmt::format("the input surface {} ({} mm asked): {}", o.file, 1e3 * edge, remeshed.change);
       break;
     }
   }
