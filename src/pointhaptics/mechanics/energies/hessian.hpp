@@ -86,6 +86,17 @@ struct PowerOfJ {
   }
 };
 
+/// Four points' stresses of a model whose material.regular_stress(G, J - 1, scale) holds for J >= j_floor
+/// (neo-Hookean, Mooney-Rivlin); the lanes below the floor (or not finite) are marked in `general`, for the
+/// model's one-point form.
+template <class Material>
+PH_ALWAYS_INLINE inline Matrix3<Lanes> regular_lanes_stress(const Material& material, const Matrix3<Lanes>& G, const Lanes& scale,
+                                                            LaneMask& general) {
+  const Lanes jm1 = volume_change(G);
+  general = !(1 + jm1 >= PowerOfJ::j_floor);
+  return material.regular_stress(G, jm1, scale);
+}
+
 /// J - 1 = det(I + G) - 1 = tr G + I2(G) + det G, written in G (no cancellation at small strain).
 PH_ALWAYS_INLINE inline double volume_change(const Mat3& G) { return volume_change(to_matrix3(G)); }
 

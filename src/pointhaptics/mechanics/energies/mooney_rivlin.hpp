@@ -42,12 +42,9 @@ struct MooneyRivlin : HessianTangent<MooneyRivlin> {
     return scale * (c10 * (g1.first * i1 * cof + 2 * g1.value * F) + c01 * (g2.first * i2 * cof + 2 * g2.value * (i1 * F - F * C)) +
                     bulk * jm1 * cof);
   }
-  /// Four points' stresses; the lanes with J < j_floor (or not finite) are marked in `general`, for the
-  /// one-point form above.
+  /// Four points' stresses (hessian.hpp's regular_lanes_stress; the other lanes by the form above).
   PH_ALWAYS_INLINE Matrix3<Lanes> scaled_stress(const Matrix3<Lanes>& G, const Lanes& scale, LaneMask& general) const {
-    const Lanes jm1 = volume_change(G);
-    general = !(1 + jm1 >= PowerOfJ::j_floor);
-    return regular_stress(G, jm1, scale);
+    return regular_lanes_stress(*this, G, scale, general);
   }
   /// The stress for J >= j_floor: the deviatoric parts are 4 (cof / J) [C10 g1 dev E + C01 g2 ((1 + 2 t) dev E
   /// - 2 dev(E^2))] with g1 = J^-2/3, g2 = J^-4/3 (no cancellation at small strain), for one point or four.

@@ -39,12 +39,9 @@ struct NeoHookean : HessianTangent<NeoHookean> {
     const double i1 = (F.array() * F.array()).sum();
     return scale * (c10() * (g.first * i1 * cof + 2 * g.value * F) + bulk * jm1 * cof);
   }
-  /// Four points' stresses; the lanes with J < j_floor (or not finite) are marked in `general`, for the
-  /// one-point form above.
+  /// Four points' stresses (hessian.hpp's regular_lanes_stress; the other lanes by the form above).
   PH_ALWAYS_INLINE Matrix3<Lanes> scaled_stress(const Matrix3<Lanes>& G, const Lanes& scale, LaneMask& general) const {
-    const Lanes jm1 = volume_change(G);
-    general = !(1 + jm1 >= PowerOfJ::j_floor);
-    return regular_stress(G, jm1, scale);
+    return regular_lanes_stress(*this, G, scale, general);
   }
   /// The stress for J >= j_floor, where g' = -2/3 g / J: the deviatoric part is 4 C10 J^-5/3 cof F dev(E)
   /// (no cancellation at small strain), for one point or four (lanes.hpp).
