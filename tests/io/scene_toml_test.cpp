@@ -125,6 +125,13 @@ TEST(SceneToml, OutOfRangeValuesAreNamed) {
   EXPECT_NE(error_of("density = 1000.0", "density = nan").find("material.density: nan is not a finite number"),
             std::string::npos);
   EXPECT_NE(error_of("spacing = 0.0075", "spacing = 0").find("object.spacing"), std::string::npos);
+  // the surface's edge: positive, and not so fine that a surface of it could not be held
+  for (const char* edge : {"spacing = 0.0075\nsurface_edge = -0.001", "spacing = 0.0075\nsurface_edge = 1e-9"})
+    EXPECT_NE(error_of("spacing = 0.0075", edge).find("object.surface_edge"), std::string::npos) << edge;
+  EXPECT_DOUBLE_EQ(parse_scene(std::string(full_scene)).object.surface_edge, 0.0);  // default: half the spacing
+  std::string with_edge = full_scene;
+  with_edge.replace(with_edge.find("spacing = 0.0075"), 16, "spacing = 0.0075\nsurface_edge = 0.002");
+  EXPECT_DOUBLE_EQ(parse_scene(with_edge).object.surface_edge, 0.002);
   EXPECT_NE(error_of("dt = 2e-3", "dt = -1").find("solver.dt"), std::string::npos);
   EXPECT_NE(error_of("point = 111", "point = -3").find("load[2].point"), std::string::npos);
   EXPECT_NE(error_of("max = [0.0, 1.0, 1.0] }", "max = [-2.0, 1.0, 1.0] }").find("fixed[0].box"), std::string::npos);
