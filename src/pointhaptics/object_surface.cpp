@@ -33,7 +33,7 @@ TriangleMesh reconstruct_surface(const Model& model, double edge, double max_nod
                             "coarser surface_edge", edge, total, max_nodes));
   for (int a = 0; a < 3; ++a) field.nodes[static_cast<std::size_t>(a)] = static_cast<index_t>(std::ceil((hi[a] - lo[a]) / edge)) + 1;
   field.values.assign(static_cast<std::size_t>(total), 0.0);
-  const auto [nx, ny, nz] = field.nodes;
+  const index_t nx = field.nodes[0], ny = field.nodes[1];
   // each point adds its share V_j w(r, h_j) to the nodes within its support
   for (index_t j = 0; j < model.n_points; ++j) {
     const double h = own_support ? model.support[j] : model.h;
@@ -51,7 +51,6 @@ TriangleMesh reconstruct_surface(const Model& model, double edge, double max_nod
           if (r < h) field.values[static_cast<std::size_t>(i + nx * (jj + ny * k))] += model.volume[j] * kernel_value(model.kernel.type, std::max(r, 1e-3 * h), h);
         }
   }
-  (void)nz;
   return marching_tetrahedra(field, 0.5);
 }
 

@@ -15,7 +15,8 @@ constexpr int tetrahedra[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7}, {0, 
 TriangleMesh marching_tetrahedra(const GridField& field, double level) {
   TriangleMesh mesh;
   std::vector<Vec3> vertices;
-  const auto [nx, ny, nz] = field.nodes;
+  // plain names, not a structured binding: clang 14 (the fuzz build) cannot capture one in a lambda
+  const index_t nx = field.nodes[0], ny = field.nodes[1], nz = field.nodes[2];
   auto node_index = [&](index_t i, index_t j, index_t k) { return static_cast<std::uint64_t>(i + nx * (j + ny * k)); };
   auto position = [&](std::uint64_t node) {
     const auto n = static_cast<index_t>(node);
