@@ -221,6 +221,28 @@ def test_the_probe_pushes_and_the_log_comes_back():
     assert sim.displacement[:, 1].min() < -0.002
 
 
+def test_with_levels_of_detail_the_surface_follows_the_active_points():
+    sim = ph.Simulation.from_scene(scene("half_sphere_lod.toml"), threads=1)
+    y = sim.surface_vertices
+    y0 = np.array(y)
+    # press 16 mm down from two radii above the dome's top (4 mm into it), hold
+    sim.probe([[0, 0, 0, 0], [0.3, 0, -0.016, 0], [0.6, 0, -0.016, 0]], radius=0.006, duration=0.6)
+    lod = sim.summary()["lod"]
+    assert lod["enabled"] and lod["selected"] < sim.n_points
+    top_vertex = np.argmax(y0[:, 1])
+    top_point = np.argmax(sim.reference[:, 1])
+    u_top = sim.displacement[top_point, 1]
+    assert u_top < -1e-3, u_top
+    # the vertex on top was carried down with the dimple (the map over the full displacement: the simulated
+    # points near the contact), by at least half the top point's displacement, and stays above that point
+    top_now = sim.reference[top_point, 1] + u_top
+    assert y[top_vertex, 1] - y0[top_vertex, 1] < 0.5 * u_top
+    assert top_now < y[top_vertex, 1] < y0[top_vertex, 1]
+    # far from the contact (the rim) the surface stays where it was
+    rim = y0[:, 1] < 0.005
+    assert np.abs(y[rim] - y0[rim]).max() < 0.1 * abs(u_top)
+
+
 def test_a_stranger_can_find_their_way():
     # issue 21: docstrings with units and shapes, a repr, a version, keyframes as in scene files
     assert ph.__version__ == "0.1.0"
