@@ -2,6 +2,7 @@
 
 #include <pointhaptics/core/error.hpp>
 #include <pointhaptics/geometry/sampling.hpp>
+#include <pointhaptics/io/input_file.hpp>
 #include <pointhaptics/io/mesh_file.hpp>
 #include <pointhaptics/io/point_cloud_file.hpp>
 #include <pointhaptics/io/volume_file.hpp>
@@ -68,8 +69,7 @@ void check_model_fits(double n_points, const Scene& scene, double max_memory) {
 }
 
 bool is_point_cloud_file(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string ext = file_extension(path);
   return ext == ".xyz" || ext == ".csv" || ext == ".txt" || (ext == ".ply" && !ply_has_faces(path));
 }
 

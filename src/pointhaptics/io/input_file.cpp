@@ -6,6 +6,8 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
 #include <filesystem>
 
 namespace pointhaptics {
@@ -22,6 +24,12 @@ std::uintmax_t check_input_file(const std::string& path, std::string_view what) 
   const std::uintmax_t size = fs::file_size(path, ec);
   if (ec) throw Error(fmt::format("{}: cannot read the {} ({})", path, what, ec.message()));
   return size;
+}
+
+std::string file_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
 }
 
 }  // namespace pointhaptics

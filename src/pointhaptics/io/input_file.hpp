@@ -11,4 +11,8 @@ namespace pointhaptics {
 /// `what` says which input it is (e.g. "point cloud").
 std::uintmax_t check_input_file(const std::string& path, std::string_view what);
 
+/// The extension of `path` in lower case, with its dot (".ply" for "Scan.PLY"; "" without one): what the
+/// readers and writers choose a format by.
+std::string file_extension(const std::string& path);
+
 }  // namespace pointhaptics

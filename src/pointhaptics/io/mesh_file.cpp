@@ -10,8 +10,6 @@
 #include <assimp/scene.h>
 #include <fmt/format.h>
 
-#include <algorithm>
-#include <cctype>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -61,8 +59,7 @@ TriangleMesh read_mesh(const std::string& path) {
 }
 
 void write_mesh(const std::string& path, const TriangleMesh& mesh, std::string_view what) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string ext = file_extension(path);
   const char* format = ext == ".stl" ? "stlb" : ext == ".ply" ? "plyb" : ext == ".obj" ? "objnomtl" : nullptr;
   if (!format) throw Error(fmt::format("{} {}: '{}' is not a mesh format this writes (.stl, .ply or .obj)", what, path, ext));
   // one mesh under the root node; aiScene's destructor frees what is given to it

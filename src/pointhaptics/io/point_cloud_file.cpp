@@ -456,7 +456,7 @@ PointCloud point_cloud_from_positions(const Points& X, const std::string& name, 
 }
 
 PointCloud read_point_cloud(const std::string& path, double spacing) {
-  const std::string ext = lower(std::filesystem::path(path).extension().string());
+  const std::string ext = file_extension(path);
   const auto size = check_input_file(path, "point cloud file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(fmt::format("{}: cannot open the point cloud file", path));
