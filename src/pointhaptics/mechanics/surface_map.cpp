@@ -111,7 +111,7 @@ void apply_map(const SurfaceMap& map, const Start& start, const Field& field, Ou
 
 }  // namespace
 
-void interpolate_at_surface(const SurfaceMap& map, const Eigen::MatrixXd& field, Eigen::MatrixXd& out) {
+void interpolate_at_surface(const SurfaceMap& map, const Eigen::Ref<const Eigen::MatrixXd>& field, Eigen::MatrixXd& out) {
   out.resize(field.rows(), map.n_vertices());
   apply_map<Eigen::Dynamic>(map, [&](index_t) { return Eigen::VectorXd::Zero(field.rows()); }, field, out);
 }

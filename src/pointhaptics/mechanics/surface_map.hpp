@@ -28,7 +28,7 @@ SurfaceMap build_surface_map(const Model& model, const Points& Y);
 
 /// W f: a field of the points (k x n, e.g. k = 1 von Mises stress, 9 a stress tensor) at the vertices (k x m),
 /// into `out` (resized once).
-void interpolate_at_surface(const SurfaceMap& map, const Eigen::MatrixXd& field, Eigen::MatrixXd& out);
+void interpolate_at_surface(const SurfaceMap& map, const Eigen::Ref<const Eigen::MatrixXd>& field, Eigen::MatrixXd& out);
 
 /// y = Y + W u (3 x m), into `y` (resized once; no allocation after).
 void carry_surface(const SurfaceMap& map, const Points& Y, const Points& u, Points& y);
