@@ -86,7 +86,8 @@ void build_surface(const Prepared& p, const DisplayFrame& f, SceneView& view) {
   if (!surface_drawn(p, view)) return;
   const ObjectSurface& surface = *p.surface;
   const Eigen::Index n = p.reference.cols(), m = surface.mesh.V.cols();
-  if (view.surface_indices.size() != 3 * surface.mesh.F.size()) {
+  if (view.indexed_surface != &surface) {  // a new object (a rebuild): its triangles
+    view.indexed_surface = &surface;
     view.surface_indices.clear();
     for (const auto& t : surface.mesh.F)
       for (const index_t v : t) view.surface_indices.push_back(static_cast<unsigned>(v));
@@ -101,18 +102,13 @@ void build_surface(const Prepared& p, const DisplayFrame& f, SceneView& view) {
     const Vec3 area = (b - a).cross(c - a);
     for (const index_t v : t) view.surface_normals.col(v) += area;
   }
-  Eigen::VectorXd stress_at;
   const bool stress = view.colour_by == ColourBy::VON_MISES && view.von_mises.size() == n;
-  if (stress) {
-    Eigen::MatrixXd at;
-    interpolate_at_surface(surface.map, view.von_mises.transpose(), at);
-    stress_at = at.row(0).transpose();
-  }
+  if (stress) interpolate_at_surface(surface.map, view.von_mises.transpose(), view.surface_stress);
   view.surface_vertices.reserve(static_cast<std::size_t>(m));
   for (Eigen::Index v = 0; v < m; ++v) {
     const Vec3 y = view.surface_positions.col(v);
     const Vec3 normal = view.surface_normals.col(v).normalized();
-    const double magnitude = stress ? stress_at[v] : (y - surface.mesh.V.col(v)).norm();
+    const double magnitude = stress ? view.surface_stress(0, v) : (y - surface.mesh.V.col(v)).norm();
     const Rgb c = point_colour(p, f, view, static_cast<std::size_t>(p.surface_point[static_cast<std::size_t>(v)]), magnitude, false);
     view.surface_vertices.push_back({static_cast<float>(y.x()), static_cast<float>(y.y()), static_cast<float>(y.z()),
                                      static_cast<float>(normal.x()), static_cast<float>(normal.y()), static_cast<float>(normal.z()), c[0],

@@ -30,7 +30,9 @@ struct SceneView {
   Eigen::VectorXd von_mises;    ///< per point, Pa, when coloured by it (reused)
   std::vector<SurfaceVertex> surface_vertices;  ///< the drawn surface, reused every frame (empty: none drawn)
   std::vector<unsigned> surface_indices;
+  const ObjectSurface* indexed_surface = nullptr;  ///< whose triangles surface_indices holds
   Points surface_positions, surface_normals;    ///< reused
+  Eigen::MatrixXd surface_stress;               ///< von Mises stress at the vertices (1 x m), reused
 };
 
 /// The 3-D view's rectangle of a window of width x height (window coordinates): right of the panels.
