@@ -359,6 +359,11 @@ int run_bench_suite(const BenchOptions& options) {
     for (const nlohmann::json& svk : reporter.materials)
       if (svk["model"] == "svk" && svk["points"] == row["points"] && svk["threads"] == row["threads"])
         row["relative_to_svk"] = svk["point_steps_per_s"].get<double>() / row["point_steps_per_s"].get<double>();
+  // issue 15's bound: a carry of the surface against one explicit step of the same points on one thread
+  for (nlohmann::json& row : reporter.surface)
+    for (const nlohmann::json& step : reporter.step)
+      if (step["points"] == row["points"] && step["threads"] == 1)
+        row["relative_to_step"] = row["carry_us"].get<double>() * step["point_steps_per_s"].get<double>() / (1e6 * step["points"].get<double>());
   if (!options.json_path.empty()) {
     const std::string text =
         nlohmann::json{{"force", reporter.force}, {"step", reporter.step}, {"beam_4x1x1", reporter.beam}, {"haptic", reporter.haptic},

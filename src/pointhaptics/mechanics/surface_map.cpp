@@ -2,6 +2,7 @@
 
 #include <pointhaptics/core/error.hpp>
 #include <pointhaptics/geometry/kd_tree.hpp>
+#include <pointhaptics/mechanics/energies/lanes.hpp>
 #include <pointhaptics/mechanics/kernels.hpp>
 
 #include <Eigen/Eigenvalues>
@@ -96,29 +97,36 @@ SurfaceMap build_surface_map(const Model& model, const Points& Y) {
   return map;
 }
 
-namespace {
-
-// out_v = start_v + sum_j phi_j(Y_v) field_j, vertex by vertex (Rows: the field's rows when fixed, else Dynamic)
-template <int Rows, class Start, class Field, class Out>
-void apply_map(const SurfaceMap& map, const Start& start, const Field& field, Out& out) {
-  using Column = Eigen::Matrix<double, Rows, 1>;
-  for (index_t v = 0; v < map.n_vertices(); ++v) {
-    Column sum = start(v);
-    for (index_t e = map.points.begin(v); e < map.points.end(v); ++e) sum += map.weight[e] * field.col(map.points.index[e]);
-    out.col(v) = sum;
-  }
-}
-
-}  // namespace
-
 void interpolate_at_surface(const SurfaceMap& map, const Eigen::Ref<const Eigen::MatrixXd>& field, Eigen::MatrixXd& out) {
-  out.resize(field.rows(), map.n_vertices());
-  apply_map<Eigen::Dynamic>(map, [&](index_t) { return Eigen::VectorXd::Zero(field.rows()); }, field, out);
+  out.setZero(field.rows(), map.n_vertices());
+  for (index_t v = 0; v < map.n_vertices(); ++v)
+    for (index_t e = map.points.begin(v); e < map.points.end(v); ++e) out.col(v) += map.weight[e] * field.col(map.points.index[e]);
 }
 
+// The carry runs for every frame drawn or written (and, with contact on the surface, every step), so it is
+// written for speed (issue 15: under 10% of a 10k-point explicit step): the displacements are first padded to
+// four doubles per point, so that a weight's term is one load and one multiply-add of a SIMD register, and
+// each vertex keeps four partial sums, so that its multiply-adds do not wait on one another. Measured on the
+// bench box (10.6k vertices, 20 weights each): 0.6 of the three-scalar loop's time.
 void carry_surface(const SurfaceMap& map, const Points& Y, const Points& u, Points& y) {
-  y.resize(3, map.n_vertices());
-  apply_map<3>(map, [&](index_t v) { return Vec3(Y.col(v)); }, u, y);
+  const index_t n_vertices = map.n_vertices();
+  y.resize(3, n_vertices);
+  thread_local std::vector<Lanes> padded;  // grown once per thread, reused: no allocation per carry
+  padded.resize(static_cast<std::size_t>(u.cols()));
+  for (index_t j = 0; j < u.cols(); ++j) padded[static_cast<std::size_t>(j)] = Lanes{u(0, j), u(1, j), u(2, j), 0.0};
+  const index_t* point = map.points.index.data();
+  const double* weight = map.weight.data();
+  const Lanes* displacement = padded.data();
+  for (index_t v = 0; v < n_vertices; ++v) {
+    Lanes sum[4] = {Lanes{Y(0, v), Y(1, v), Y(2, v), 0.0}, Lanes{}, Lanes{}, Lanes{}};
+    index_t e = map.points.begin(v);
+    const index_t end = map.points.end(v);
+    for (; e + 4 <= end; e += 4)
+      for (int k = 0; k < 4; ++k) sum[k] += weight[e + k] * displacement[point[e + k]];
+    for (; e < end; ++e) sum[0] += weight[e] * displacement[point[e]];
+    const Lanes total = (sum[0] + sum[1]) + (sum[2] + sum[3]);
+    y.col(v) = Vec3(total[0], total[1], total[2]);
+  }
 }
 
 void spread_surface_forces(const SurfaceMap& map, const Points& f_vertices, Points& f_points) {
