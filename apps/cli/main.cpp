@@ -83,6 +83,11 @@ void print_summary(ph::Simulation& sim, const ph::RunSummary& s, double setup_s)
   for (size_t g = 0; g < s.reactions.size(); ++g)
     fmt::print("reaction        {}: ({:.4g}, {:.4g}, {:.4g}) N on {} points\n", m.fixed_groups[g].name, s.reactions[g][0],
                s.reactions[g][1], s.reactions[g][2], m.fixed_groups[g].points.size());
+  if (s.tool.present)
+    fmt::print("tool            {} at ({:.4g}, {:.4g}, {:.4g}) m: the object pushes it with ({:.4g}, {:.4g}, {:.4g}) N, torque "
+               "({:.3g}, {:.3g}, {:.3g}) N m; {} contacts, deepest {:.3g} m inside\n",
+               s.tool.kind, s.tool.position.x(), s.tool.position.y(), s.tool.position.z(), s.tool.force.x(), s.tool.force.y(),
+               s.tool.force.z(), s.tool.torque.x(), s.tool.torque.y(), s.tool.torque.z(), s.tool.contacts, s.tool.penetration);
   if (s.lod.enabled) {
     std::string bands;
     for (size_t b = 0; b < s.lod.band_count.size(); ++b)
@@ -145,7 +150,9 @@ int run_command(const RunOptions& opt) {
   std::signal(SIGTERM, on_interrupt);
   ph::InteractiveResult interactive;
   OutputErrors errors;
-  if (scene.probe.present) {
+  // a probe driven by a device runs the haptic loop; a tool held at a position is part of the scene's solve
+  const bool haptic = scene.probe.present && !scene.probe.held();
+  if (haptic) {
     // with a probe: the haptic loop at 1 kHz and the simulation, in real time unless asked otherwise
     ph::InteractiveOptions options = session.interactive;
     options.real_time = !opt.deterministic;
@@ -210,7 +217,7 @@ int run_command(const RunOptions& opt) {
     errors.attempt([&] { ph::write_mesh(opt.surface, ph::TriangleMesh{ph::deformed_surface(*surface, sim.state().u), surface->mesh.F}, "--surface"); });
   ph::RunSummary summary = sim.summary();
   summary.interrupted = interrupted.load();
-  if (scene.probe.present) {
+  if (haptic) {
     summary.haptic_ticks = interactive.haptic.ticks;
     summary.haptic_rate_hz = interactive.haptic.rate_hz;
     summary.haptic_period_p99_us = interactive.haptic.period_p99_us;
@@ -219,7 +226,7 @@ int run_command(const RunOptions& opt) {
   if (!opt.json.empty()) errors.attempt([&] { ph::write_result_json(opt.json, sim.model(), sim.state(), summary); });
   if (!opt.quiet) {
     print_summary(sim, summary, setup_s);
-    if (scene.probe.present) {
+    if (haptic) {
       const ph::HapticStats& h = interactive.haptic;
       fmt::print("haptics         {} ticks at {:.0f} Hz, period error p50 {:.0f} us, p99 {:.0f} us, max {:.0f} us; "
                  "longest tick {:.1f} us, spin-wait {:.0f} us on average; max force {:.3g} N; up to {} points in contact; "
@@ -246,7 +253,7 @@ int run_command(const RunOptions& opt) {
     return 130;
   }
   if (!errors.messages.empty()) return 1;
-  if (scene.probe.present && interactive.haptic.device_failed) {
+  if (haptic && interactive.haptic.device_failed) {
     fmt::print(stderr, "pointhaptics: {}: the device failed: {} (force set to zero, run stopped)\n", opt.scene,
                interactive.haptic.device_error);
     return 1;

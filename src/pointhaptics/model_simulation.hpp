@@ -4,6 +4,7 @@
 /// (levels_of_detail.hpp) drives one of these over the active model. Most users want Simulation.
 #include <pointhaptics/core/state.hpp>
 #include <pointhaptics/core/workspace.hpp>
+#include <pointhaptics/haptics/held_tool.hpp>
 #include <pointhaptics/haptics/probe_tool.hpp>
 #include <pointhaptics/solvers/solver.hpp>
 
@@ -71,6 +72,9 @@ class ModelSimulation {
   const StepDiagnostics& diagnostics() const { return diagnostics_; }
   std::optional<ProbeAttachment>& probe() { return probe_; }
   const std::optional<ProbeAttachment>& probe() const { return probe_; }
+  /// A tool held at a pose the program sets (a static indentation); at most one of it and the probe.
+  std::unique_ptr<HeldTool>& held_tool() { return held_tool_; }
+  const HeldTool* held_tool() const { return held_tool_.get(); }
 
  private:
   friend class LevelsOfDetail;  // takes the object's model, state, diagnostics and probe over
@@ -90,6 +94,7 @@ class ModelSimulation {
   StepReport report_;
   StepDiagnostics diagnostics_;
   std::optional<ProbeAttachment> probe_;
+  std::unique_ptr<HeldTool> held_tool_;
 };
 
 }  // namespace pointhaptics

@@ -5,6 +5,7 @@
 #include <pointhaptics/haptics/devices/virtual_device.hpp>
 #include <pointhaptics/haptics/haptic_log.hpp>
 #include <pointhaptics/io/scene_toml.hpp>
+#include <pointhaptics/object_surface.hpp>
 #include <pointhaptics/scene_builder.hpp>
 
 #include <fmt/format.h>
@@ -18,7 +19,16 @@ SceneSession open_scene(Scene scene, const SessionOptions& options) {
   SceneSession s;
   s.simulation = std::make_unique<Simulation>(build_scene_model(scene, options.max_memory), scene.solver, options.threads);
   if (scene.lod.present) s.simulation->enable_lod(scene.lod.params, scene_lod_contact(scene, s.simulation->model()));
-  if (scene.probe.present) {
+  if (scene.probe.held()) {
+    // a tool held at a position, touching the object's surface
+    const ObjectSurface surface = build_object_surface(scene, s.simulation->model());
+    ToolShape shape;
+    shape.kind = scene.probe.capsule ? ToolKind::CAPSULE : ToolKind::SPHERE;
+    shape.radius = scene.probe.radius;
+    shape.length = scene.probe.length;
+    const auto& q = scene.probe.orientation;
+    s.simulation->hold_tool(shape, ToolPose{scene.probe.position, Eigen::Quaterniond(q[0], q[1], q[2], q[3])}, surface.mesh, surface.map);
+  } else if (scene.probe.present) {
     s.interactive = scene_interactive_options(scene, s.simulation->model());
     if (options.make_device) s.device = make_scene_device(scene);
   }

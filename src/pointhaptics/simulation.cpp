@@ -58,9 +58,26 @@ void Simulation::set_state(const State& state) {
 void Simulation::attach_probe(const ProbeParams& params, double coupling_stiffness, double max_force, bool asynchronous_lod) {
   ModelSimulation& sim = core();
   if (sim.solver().kind == SolverKind::STATIC) throw Error("probe: needs a dynamic solver (explicit or implicit)");
+  if (sim.held_tool()) throw Error("probe: the simulation already holds a tool (one tool at a time)");
   sim.probe().emplace(ProbeAttachment{ProbeTool(sim.model(), params, coupling_stiffness, max_force), asynchronous_lod});
   sim.inputs() = StepInputs{};
 }
+
+void Simulation::hold_tool(const ToolShape& shape, const ToolPose& pose, const TriangleMesh& mesh, SurfaceMap map,
+                           const SurfaceContactParams& params) {
+  if (lod_) throw Error("tool: a held tool with levels of detail is not available yet (its surface map is the object's)");
+  ModelSimulation& sim = core();
+  if (sim.probe()) throw Error("tool: the simulation already has a probe (one tool at a time)");
+  sim.held_tool() = std::make_unique<HeldTool>(SurfaceContact(sim.model(), mesh, std::move(map), shape, params));
+  sim.held_tool()->set_pose(pose);
+}
+
+void Simulation::set_tool_pose(const ToolPose& pose) {
+  if (!core().held_tool()) throw Error("tool: no held tool to move");
+  core().held_tool()->set_pose(pose);
+}
+
+HeldTool* Simulation::held_tool() { return core().held_tool().get(); }
 
 void Simulation::detach_probe() {
   core().probe().reset();
@@ -147,6 +164,9 @@ RunSummary Simulation::summary() {
   // a viscoelastic material's stress at the state: its history's, not the last step's in ws
   viscous_stress_at_state(model, state, ws, sim.solver().kind == SolverKind::STATIC);
   compute_internal_forces(model, state.u, ws);
+  // a held tool's contact is one of the forces in balance (the probe's, in dynamics, is reported below)
+  HeldTool* tool = sim.held_tool().get();
+  if (tool) tool->add(model, state, ws.f_int);
   s.reactions = support_reactions(model, ws.f_int);
   check_physical(model, ws, d, s);
   // dynamics is out of balance by the inertia; its Newton residual includes it
@@ -160,6 +180,14 @@ RunSummary Simulation::summary() {
   s.tools_s = d.tools_seconds;
   s.solve_s = d.solve_seconds;
   if (lod_) lod_->fill(s.lod);
+  if (tool) {
+    const ToolLoad load = tool->load(model, state.u);
+    s.tool = {true, tool->shape().kind == ToolKind::CAPSULE ? "capsule" : "sphere", tool->pose().position, load.force, load.torque,
+              load.contacts, load.penetration};
+  } else if (const ProbeTool* probe = this->probe()) {
+    const ContactModel& c = probe->contact_model();
+    s.tool = {true, "sphere", probe->probe(), c.f0, Vec3::Zero(), c.contacts, 0.0};
+  }
   return s;
 }
 

@@ -61,6 +61,14 @@ class Simulation {
   /// The probe (nullptr without one): its position and last local contact model. Its contact's point
   /// indices are the simulated model's; grabbed_points() gives the object's.
   const ProbeTool* probe() const;
+  /// A tool held at `pose` against the object's surface (`mesh`, carried by `map` over the object's points),
+  /// for any solver: the static solver finds the equilibrium with it there; set_tool_pose() moves it between
+  /// steps. Throws Error with levels of detail or a probe (one tool at a time).
+  void hold_tool(const ToolShape& shape, const ToolPose& pose, const TriangleMesh& mesh, SurfaceMap map,
+                 const SurfaceContactParams& params = {});
+  void set_tool_pose(const ToolPose& pose);
+  /// The held tool (nullptr without one).
+  HeldTool* held_tool();
   /// The object's points the probe holds (cleared first; allocates only to grow).
   void grabbed_points(std::vector<index_t>& out) const;
 

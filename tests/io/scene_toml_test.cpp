@@ -358,6 +358,41 @@ TEST(SceneToml, ReadsProbeAndDevice) {
   EXPECT_EQ(parse_scene(text, "dir/p.toml", "dir").probe.trajectory, "dir/probe.csv");
 }
 
+// a tool held at a position (issue 16): a static indentation, its shape and pose
+const char* held_tool_section = R"(
+[probe]
+radius = 0.01
+position = [0.0, 0.06, 0.0]
+shape = "capsule"
+length = 0.02
+orientation = [0.0, 1.0, 0.0, 0.0]
+)";
+
+TEST(SceneToml, ReadsAHeldTool) {
+  std::string text = std::string(full_scene) + held_tool_section;
+  text.replace(text.find("kind = \"explicit\""), 17, "kind = \"static\"");
+  const Scene s = parse_scene(text, "t.toml", ".");
+  EXPECT_TRUE(s.probe.held());
+  EXPECT_TRUE(s.probe.capsule);
+  EXPECT_DOUBLE_EQ(s.probe.length, 0.02);
+  EXPECT_DOUBLE_EQ(s.probe.position.y(), 0.06);
+  EXPECT_DOUBLE_EQ(s.probe.orientation[1], 1.0);
+}
+
+TEST(SceneToml, BadHeldToolIsANamedError) {
+  const std::string text = std::string(full_scene) + held_tool_section;
+  const auto error = [&](const std::string& find, const std::string& replace) { return error_of(find, replace, text); };
+  EXPECT_NE(error("length = 0.02", "").find("probe.length: a capsule needs length > 0"), std::string::npos);
+  EXPECT_NE(error("shape = \"capsule\"", "").find("only a capsule has a length"), std::string::npos);
+  EXPECT_NE(error("shape = \"capsule\"", "shape = \"cone\"").find("probe.shape: unknown value \"cone\""), std::string::npos);
+  EXPECT_NE(error("[0.0, 1.0, 0.0, 0.0]", "[1.0, 1.0, 0.0, 0.0]").find("norm is 1.41421, not 1"), std::string::npos);
+  EXPECT_NE(error("[0.0, 1.0, 0.0, 0.0]", "[1.0, 0.0]").find("unit quaternion [w, x, y, z]"), std::string::npos);
+  EXPECT_NE(error("length = 0.02", "length = 0.02\nkeyframes = [[0.0, 0.0, 0.0, 0.0]]").find("no trajectory or keyframes"),
+            std::string::npos);
+  EXPECT_NE(error("[0.0, 1.0, 0.0, 0.0]", "[0.0, 1.0, 0.0, 0.0]\n[device]\nkind = \"virtual\"").find("not driven by a [device]"),
+            std::string::npos);
+}
+
 std::string probe_error(const std::string& find, const std::string& replace) {
   return error_of(find, replace, std::string(full_scene) + probe_section);
 }
@@ -373,7 +408,7 @@ TEST(SceneToml, BadProbeOrDeviceIsANamedError) {
   EXPECT_NE(probe_error("kind = \"virtual\"", "kind = \"replay\"").find("needs log"), std::string::npos);
   EXPECT_NE(probe_error("kind = \"virtual\"", "kind = \"openhaptics\"\nlibary = \"x.so\"").find("device.libary: unknown key"),
             std::string::npos);
-  EXPECT_NE(probe_error("kind = \"explicit\"", "kind = \"static\"").find("needs a dynamic solver"), std::string::npos);
+  EXPECT_NE(probe_error("kind = \"explicit\"", "kind = \"static\"").find("give position = [x, y, z]"), std::string::npos);
   EXPECT_NE(probe_error("scale = 2.0", "scael = 2.0").find("probe.scael: unknown key"), std::string::npos);
 }
 

@@ -54,6 +54,11 @@ std::string result_json(const Model& model, const State& state, const RunSummary
   // zero without a probe
   doc["haptic"] = {{"ticks", s.haptic_ticks}, {"rate_hz", s.haptic_rate_hz}, {"period_p99_us", s.haptic_period_p99_us},
                    {"max_force_n", s.haptic_max_force_n}};
+  if (s.tool.present) {
+    const ToolSummary& t = s.tool;
+    doc["tool"] = {{"kind", t.kind},         {"position", vec(t.position)}, {"force", vec(t.force)},
+                   {"torque", vec(t.torque)}, {"contacts", t.contacts},       {"penetration", t.penetration}};
+  }
   // without levels of detail every point is simulated
   const LodSummary& l = s.lod;
   doc["lod"] = {{"enabled", l.enabled},

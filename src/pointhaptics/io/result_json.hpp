@@ -24,6 +24,17 @@ struct LodSummary {
 };
 
 /// What a run reports besides the points: solver outcome, energies, timing, support reactions.
+/// A run's tool (issue 16): what the object does to it at the end.
+struct ToolSummary {
+  bool present = false;
+  std::string kind;                          ///< "sphere" or "capsule"
+  Vec3 position = Vec3::Zero();              ///< m, scene axes
+  Vec3 force = Vec3::Zero();                 ///< N, the force the object exerts on the tool
+  Vec3 torque = Vec3::Zero();                ///< N m, about its position
+  int contacts = 0;                          ///< surface vertices (probe on points: points) pressing on it
+  double penetration = 0;                    ///< deepest surface vertex inside the tool, m (held tools)
+};
+
 struct RunSummary {
   std::string solver_kind;
   bool converged = false;
@@ -51,6 +62,7 @@ struct RunSummary {
   long long haptic_ticks = 0;
   double haptic_rate_hz = 0, haptic_period_p99_us = 0, haptic_max_force_n = 0;
   LodSummary lod;
+  ToolSummary tool;
 };
 
 /// The result document as a string (indented JSON).

@@ -112,7 +112,14 @@ struct ProbeSpec {
   Vec3 origin = Vec3::Constant(NAN);       ///< scene position of the device origin, m (NaN: above the object's centre)
   double scale = 1.0;                      ///< scene metres per device metre
   double stiffness = 0;                    ///< contact spring per point, N/m (0: E x spacing)
+  /// A tool held there, m (scene axes; NaN: driven by the device). With solver.kind = "static" the
+  /// equilibrium with the tool there; its contact is on the object's surface (issue 16).
+  Vec3 position = Vec3::Constant(NAN);
+  std::array<double, 4> orientation{1, 0, 0, 0};  ///< unit quaternion w, x, y, z: tool to scene axes
+  bool capsule = false;                    ///< shape = "capsule" (else "sphere")
+  double length = 0;                       ///< capsule: its axis segment, m, along the tool's local z
   int line = 0;
+  bool held() const { return present && position.allFinite(); }
 };
 
 /// [device]: which device drives the probe.

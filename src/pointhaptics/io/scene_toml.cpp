@@ -433,6 +433,22 @@ void read_probe(TableReader& r, ProbeSpec& p, const Context& ctx) {
   if (r.find("origin")) p.origin = r.vec3("origin", p.origin);
   p.scale = r.number("scale", p.scale, positive, "must be > 0 (scene metres per device metre)");
   p.stiffness = r.number("stiffness", p.stiffness, non_negative, "must be >= 0 (N/m)");
+  p.capsule = r.choice("shape", "sphere", {"sphere", "capsule"}) == "capsule";
+  p.length = r.number("length", p.length, non_negative, "must be >= 0 (m)");
+  if (p.capsule && !(p.length > 0)) r.fail_table("length", "a capsule needs length > 0 (m): its axis segment");
+  if (!p.capsule && r.find("length")) r.fail_at(*r.find("length"), "length", "only a capsule has a length (shape = \"capsule\")");
+  if (r.find("position")) {
+    p.position = r.vec3("position", p.position);
+    if (r.find("trajectory") || r.find("keyframes"))
+      r.fail_at(*r.find("position"), "position", "a tool held at a position has no trajectory or keyframes: give one or the other");
+  }
+  if (const toml::node* node = r.find("orientation")) {
+    const toml::array* a = node->as_array();
+    if (!a || a->size() != 4) r.fail_at(*node, "orientation", "expected a unit quaternion [w, x, y, z]");
+    double norm = 0;
+    for (std::size_t c = 0; c < 4; ++c) norm += std::pow(p.orientation[c] = r.as_number(*a->get(c), "orientation"), 2);
+    if (!(std::abs(std::sqrt(norm) - 1) < 1e-6)) r.fail_at(*node, "orientation", fmt::format("the quaternion's norm is {:.6g}, not 1", std::sqrt(norm)));
+  }
 }
 
 void read_device(TableReader& r, DeviceSpec& d, const Context& ctx) {
@@ -544,13 +560,18 @@ Scene parse_scene(std::string_view text, const std::string& name, const std::str
   section("probe", [&](TableReader& r) { read_probe(r, scene.probe, ctx); });
   section("device", [&](TableReader& r) { read_device(r, scene.device, ctx); });
   section("lod", [&](TableReader& r) { read_lod(r, scene.lod); });
-  if (scene.probe.present && scene.device.kind == "virtual" && scene.probe.trajectory.empty() && scene.probe.keyframes.empty())
-    throw Error(fmt::format("{}:{}: probe: a virtual device needs trajectory = \"probe.csv\" or keyframes = [[t, x, y, z], ...]",
+  if (scene.probe.present && !scene.probe.held() && scene.device.kind == "virtual" && scene.probe.trajectory.empty() &&
+      scene.probe.keyframes.empty())
+    throw Error(fmt::format("{}:{}: probe: a virtual device needs trajectory = \"probe.csv\" or keyframes = [[t, x, y, z], ...] "
+                            "(or position = [x, y, z] for a tool held there)",
                             name, scene.probe.line));
+  if (scene.probe.held() && root.get("device"))
+    throw Error(fmt::format("{}:{}: probe: a tool held at a position is not driven by a [device]", name, scene.probe.line));
   if (root.get("device") && !scene.probe.present)
     throw Error(fmt::format("{}: device: a [device] needs a [probe] to drive", name));
-  if (scene.probe.present && scene.solver.kind == SolverKind::STATIC)
-    throw Error(fmt::format("{}:{}: probe: a probe needs a dynamic solver (solver.kind = \"explicit\" or \"implicit\")",
+  if (scene.probe.present && !scene.probe.held() && scene.solver.kind == SolverKind::STATIC)
+    throw Error(fmt::format("{}:{}: probe: a static solve holds the tool at a position: give position = [x, y, z] (a probe "
+                            "driven by a device needs solver.kind = \"explicit\" or \"implicit\")",
                             name, scene.probe.line));
   read_array_of_tables(top, "fixed", [&](TableReader& r) { scene.fixed.push_back(read_fixed(r)); });
   read_array_of_tables(top, "region", [&](TableReader& r) { scene.regions.push_back(read_region(r)); });

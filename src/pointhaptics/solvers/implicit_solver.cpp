@@ -26,7 +26,9 @@ StepReport ImplicitSolver::step(const Model& model, State& state, Workspace& ws,
   problem.load = &model.f_ext;
   problem.inertia = k;
   problem.anchor = &anchor;
-  if (forces) {
+  if (forces && forces->energy_term()) {
+    problem.term = forces->energy_term();  // a contact minimised with the rest: its stiffness fully implicit
+  } else if (forces) {
     tool_forces.setZero();
     forces->add(model, state, tool_forces);
     load = model.f_ext + tool_forces;

@@ -39,6 +39,7 @@ double NewtonSolver::energy(const Model& model, const NewtonProblem& problem, co
       pi += 0.5 * e.dot(Eigen::Map<const Mat3>(problem.springs->col(i).data()) * e);
     }
   }
+  if (problem.term) pi += problem.term->energy(model, u);
   return pi;
 }
 
@@ -57,6 +58,7 @@ double NewtonSolver::residual(const Model& model, const NewtonProblem& problem, 
   if (problem.springs)
     for (index_t i = 0; i < model.n_points; ++i)
       r.col(i) -= Eigen::Map<const Mat3>(problem.springs->col(i).data()) * (u.col(i) - problem.spring_anchor->col(i));
+  if (problem.term) problem.term->add_forces(model, u, r);
   mask_held(model, r);
   const double scale = std::max({problem.load->norm(), ws.f_int.norm(), std::sqrt(inertial), 1e-300});
   return r.norm() / scale;
@@ -66,6 +68,7 @@ void NewtonSolver::build_preconditioner(const Model& model, const NewtonProblem&
   const double inertia = problem.inertia;
   Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks = ws.solver_scratch().blocks;
   tangent_.diagonal_blocks(model, blocks, &ws);
+  if (problem.term) problem.term->add_diagonal_blocks(blocks);
   for (index_t i = 0; i < model.n_points; ++i) {
     Eigen::Map<Mat3> B(blocks.col(i).data());
     if (model.fixed[i]) {
@@ -103,6 +106,7 @@ bool NewtonSolver::conjugate_gradients(const Model& model, const NewtonProblem& 
     if (problem.springs)
       for (index_t i = 0; i < model.n_points; ++i)
         cg_q.col(i) += Eigen::Map<const Mat3>(problem.springs->col(i).data()) * cg_p.col(i);
+    if (problem.term) problem.term->add_tangent_product(cg_p, cg_q);
     mask_held(model, cg_q);
     const double curvature = dot(cg_p, cg_q);
     ++iterations;
@@ -153,6 +157,7 @@ NewtonStats NewtonSolver::solve(const Model& model, const NewtonProblem& problem
     bool descent = false;
     for (TangentMode mode : {TangentMode::EXACT, TangentMode::PROJECTED}) {
       tangent_.linearise(model, u, mode, &ws);
+      if (problem.term) problem.term->linearise(model, u, mode);
       // the block-Jacobi preconditioner is rebuilt at the first iteration of a solve and when the tangent's
       // mode changes; in between it lags (it changes slowly, and costs a few tangent products)
       if (stats.iterations == 1 || mode != preconditioner_mode_) build_preconditioner(model, problem, ws);

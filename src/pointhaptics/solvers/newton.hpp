@@ -18,6 +18,27 @@ struct NewtonSettings {
   bool accept_at_budget = false;
 };
 
+/// A term of the energy beyond the material, the loads, the inertia and the per-point springs: a tool's
+/// contact, whose stiffness couples the points a surface vertex is carried by. Newton minimises it with
+/// the rest: its value and forces at any iterate, its tangent at the iterate it was linearised at.
+class EnergyTerm {
+ public:
+  virtual ~EnergyTerm() = default;
+  /// The term's energy at u, J.
+  virtual double energy(const Model& model, const Points& u) = 0;
+  /// f += -dE/du at u (N, 3 x n).
+  virtual void add_forces(const Model& model, const Points& u, Points& f) = 0;
+  /// Fix the tangent at u: exact, or (TangentMode::PROJECTED) its positive semi-definite part.
+  virtual void linearise(const Model& model, const Points& u, TangentMode mode) = 0;
+  /// out += H dx, with H the tangent fixed by the last linearise().
+  virtual void add_tangent_product(const Points& dx, Points& out) const = 0;
+  /// The tangent's 3x3 diagonal blocks added into `blocks` (9 x n, column-major), for the preconditioner.
+  virtual void add_diagonal_blocks(Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks) const = 0;
+  /// A constrained term (augmented Lagrangian) checks its constraint at the minimiser u: true when it is met,
+  /// else it updates its multipliers and the solver minimises again. Unconstrained terms: true.
+  virtual bool update_multipliers(const Model&, const Points&) { return true; }
+};
+
 /// The energy Pi(u) = W(u) - b . u + 0.5 k sum_free m_i |u_i - a_i|^2 minimised over the free points
 /// (held points keep the values they have in u). Static: k = 0; backward Euler: k = 1/dt^2 + c/dt.
 struct NewtonProblem {
@@ -29,6 +50,8 @@ struct NewtonProblem {
   /// linearly implicitly (S_i symmetric positive semi-definite).
   const Eigen::Matrix<double, 9, Eigen::Dynamic>* springs = nullptr;
   const Points* spring_anchor = nullptr;
+  /// Optional: a further term of the energy (a tool's contact on the surface).
+  EnergyTerm* term = nullptr;
 };
 
 struct NewtonStats {

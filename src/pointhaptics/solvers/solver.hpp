@@ -26,6 +26,12 @@ class DynamicForces {
   /// The largest stiffness (N/m) these forces can put on one point (an upper bound of the largest
   /// eigenvalue of its 3x3 block), for the explicit stable step; 0 if they have no springs.
   virtual double max_point_stiffness() const { return 0; }
+  /// The forces as a term of the energy, which the Newton solvers (static, implicit) minimise with the
+  /// material's instead of calling add() and add_stiffness(); nullptr if they have none.
+  virtual EnergyTerm* energy_term() { return nullptr; }
+  /// Once per step, before it: what the forces need to follow (an augmented Lagrangian's multipliers in
+  /// dynamics, updated once a step).
+  virtual void before_step(const Model&, const State&) {}
 };
 
 enum class StepStatus {

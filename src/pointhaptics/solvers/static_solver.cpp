@@ -12,12 +12,12 @@ namespace pointhaptics {
 namespace {
 
 StaticStats load_stepping(const Model& model, State& state, Workspace& ws, NewtonSolver& newton, const NewtonSettings& settings,
-                          Points& load, Points& trial) {
-  StaticStats stats;
+                          Points& load, Points& trial, EnergyTerm* term, StaticStats stats) {
   double reached = 0.0, increment = 1.0;
   const double min_increment = 1e-4;
   NewtonProblem problem;
   problem.load = &load;
+  problem.term = term;
   while (reached < 1.0) {
     const double factor = std::min(1.0, reached + increment);
     load = factor * model.f_ext;
@@ -53,17 +53,30 @@ StaticStats load_stepping(const Model& model, State& state, Workspace& ws, Newto
 }  // namespace
 
 StaticStats solve_static(const Model& model, State& state, Workspace& ws, NewtonSolver& newton,
-                         const NewtonSettings& settings) {
+                         const NewtonSettings& settings, EnergyTerm* term) {
   SolverScratch& scratch = ws.solver_scratch();
   // a viscoelastic material at equilibrium has relaxed fully: its long-term shear modulus
   if (!model.material.prony.empty()) relaxed_material(model, ws);
-  return load_stepping(model, state, ws, newton, settings, scratch.load, scratch.next);
+  StaticStats stats = load_stepping(model, state, ws, newton, settings, scratch.load, scratch.next, term, {});
+  // a constrained term (augmented Lagrangian): minimise again with its updated multipliers until it is met
+  constexpr int max_updates = 50;
+  while (term && stats.converged && !term->update_multipliers(model, state.u)) {
+    if (++stats.multiplier_updates > max_updates) {
+      stats.converged = false;
+      stats.failure = fmt::format("static solver: the tool's contact constraint is still not met after {} updates of its "
+                                  "multipliers", max_updates);
+      break;
+    }
+    stats.load_steps = 0;
+    stats = load_stepping(model, state, ws, newton, settings, scratch.load, scratch.next, term, stats);
+  }
+  return stats;
 }
 
 StaticSolver::StaticSolver(const Model& model, const NewtonSettings& settings) : settings_(settings), newton_(model) {}
 
-StepReport StaticSolver::step(const Model& model, State& state, Workspace& ws, DynamicForces*) {
-  const StaticStats stats = solve_static(model, state, ws, newton_, settings_);
+StepReport StaticSolver::step(const Model& model, State& state, Workspace& ws, DynamicForces* forces) {
+  const StaticStats stats = solve_static(model, state, ws, newton_, settings_, forces ? forces->energy_term() : nullptr);
   StepReport report;
   report.status = stats.converged ? StepStatus::CONVERGED : StepStatus::FAILED;
   report.substeps = stats.load_steps;

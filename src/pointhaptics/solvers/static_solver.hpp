@@ -13,6 +13,7 @@ struct StaticStats {
   int load_steps = 0;            ///< converged load increments
   int cutbacks = 0;              ///< failed increments that were retried with a smaller one
   double residual = 0;           ///< relative residual at the end
+  int multiplier_updates = 0;    ///< with a constrained term (a tool's contact): its augmented Lagrangian's updates
   std::string failure;           ///< why it did not converge
 };
 
@@ -20,9 +21,11 @@ struct StaticStats {
 /// Starts from state.u (e.g. the rest state) and takes the whole load at once; when Newton fails it
 /// halves the load increment (down to 1e-4 of the load) and grows it again after successes. The load
 /// factor scales f_ext and the prescribed displacements together. state.u holds the last converged
-/// equilibrium (the full load when converged); velocity is set to zero.
+/// equilibrium (the full load when converged); velocity is set to zero. `term`: a further energy (a tool's
+/// contact) minimised with the rest; a constrained one is solved again after each update of its multipliers
+/// until its constraint is met (at most 50 updates, else the solve fails saying so).
 StaticStats solve_static(const Model& model, State& state, Workspace& ws, NewtonSolver& newton,
-                         const NewtonSettings& settings);
+                         const NewtonSettings& settings, EnergyTerm* term = nullptr);
 
 /// solve_static() as a Solver; its buffers are the workspace's, sized once for the model, so that a solve
 /// allocates nothing. A solve that does not reach the full load is FAILED (the state holds

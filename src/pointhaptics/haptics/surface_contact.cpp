@@ -1,0 +1,144 @@
+#include <pointhaptics/haptics/surface_contact.hpp>
+
+#include <pointhaptics/core/error.hpp>
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace pointhaptics {
+
+SurfaceContact::SurfaceContact(const Model& model, const TriangleMesh& mesh, SurfaceMap map, const ToolShape& shape,
+                               const SurfaceContactParams& params)
+    : Y_(mesh.V), y_(mesh.V), map_(std::move(map)), shape_(shape) {
+  if (!(shape.radius > 0) || !std::isfinite(shape.radius)) throw Error("tool: radius must be positive (m)");
+  if (!(shape.length >= 0) || !std::isfinite(shape.length)) throw Error("tool: length must be >= 0 (m)");
+  if (map_.n_vertices() != Y_.cols()) throw Error("tool: the surface map is for another surface");
+  const index_t m = static_cast<index_t>(Y_.cols());
+  // a vertex stands for a third of its triangles' area: the penalty is a pressure per unit penetration
+  std::vector<double> area(static_cast<std::size_t>(m), 0.0);
+  for (const auto& t : mesh.F) {
+    const double a = 0.5 * (Y_.col(t[1]) - Y_.col(t[0])).cross(Y_.col(t[2]) - Y_.col(t[0])).norm();
+    for (const index_t v : t) area[static_cast<std::size_t>(v)] += a / 3.0;
+  }
+  const double per_area = params.penalty > 0 ? params.penalty : 1000.0 * model.material.young / model.spacing;
+  penalty_.resize(area.size());
+  for (std::size_t v = 0; v < area.size(); ++v) penalty_[v] = per_area * std::max(area[v], 1e-30);
+  lambda_.assign(area.size(), 0.0);
+  tolerance_ = params.tolerance > 0 ? params.tolerance : 1e-4 * shape.radius;
+  // the explicit stable step's bound: a point's contact stiffness is at most sum_v k_v w_vj^2
+  std::vector<double> stiffness(static_cast<std::size_t>(model.n_points), 0.0);
+  for (index_t v = 0; v < m; ++v)
+    for (index_t e = map_.points.begin(v); e < map_.points.end(v); ++e)
+      stiffness[static_cast<std::size_t>(map_.points.index[e])] += penalty_[static_cast<std::size_t>(v)] * map_.weight[e] * map_.weight[e];
+  max_point_stiffness_ = stiffness.empty() ? 0.0 : *std::max_element(stiffness.begin(), stiffness.end());
+}
+
+void SurfaceContact::evaluate(const Points& u) { carry_surface(map_, Y_, u, y_); }
+
+namespace {
+
+// a vertex further from the tool's position than this cannot touch it
+double reach(const ToolShape& shape) { return shape.radius + 0.5 * shape.length; }
+
+}  // namespace
+
+double SurfaceContact::energy(const Model&, const Points& u) {
+  evaluate(u);
+  double e = 0;
+  const double far = reach(shape_);
+  for (index_t v = 0; v < y_.cols(); ++v) {
+    const double lambda = lambda_[static_cast<std::size_t>(v)], k = penalty_[static_cast<std::size_t>(v)];
+    if (lambda == 0 && (y_.col(v) - pose_.position).squaredNorm() > far * far) continue;
+    const double t = std::max(lambda + k * tool_distance(shape_, pose_, y_.col(v)).penetration(shape_), 0.0);
+    e += (t * t - lambda * lambda) / (2 * k);
+  }
+  return e;
+}
+
+void SurfaceContact::add_forces(const Model&, const Points& u, Points& f) {
+  evaluate(u);
+  const double far = reach(shape_);
+  for (index_t v = 0; v < y_.cols(); ++v) {
+    const double lambda = lambda_[static_cast<std::size_t>(v)], k = penalty_[static_cast<std::size_t>(v)];
+    if (lambda == 0 && (y_.col(v) - pose_.position).squaredNorm() > far * far) continue;
+    const ToolDistance d = tool_distance(shape_, pose_, y_.col(v));
+    const double pressure = lambda + k * d.penetration(shape_);
+    if (!(pressure > 0)) continue;
+    const Vec3 force = pressure * d.normal;  // on the vertex, out of the tool
+    for (index_t e = map_.points.begin(v); e < map_.points.end(v); ++e) f.col(map_.points.index[e]) += map_.weight[e] * force;
+  }
+}
+
+void SurfaceContact::linearise(const Model&, const Points& u, TangentMode mode) {
+  evaluate(u);
+  active_.clear();
+  const double far = reach(shape_);
+  for (index_t v = 0; v < y_.cols(); ++v) {
+    const double lambda = lambda_[static_cast<std::size_t>(v)], k = penalty_[static_cast<std::size_t>(v)];
+    if (lambda == 0 && (y_.col(v) - pose_.position).squaredNorm() > far * far) continue;
+    const ToolDistance d = tool_distance(shape_, pose_, y_.col(v));
+    const double pressure = lambda + k * d.penetration(shape_);
+    if (!(pressure > 0)) continue;
+    // d2E/dy2 = k n n^T - p dn/dy: the second part (the tool's curvature, negative) only in the exact tangent
+    Mat3 hessian = k * d.normal * d.normal.transpose();
+    if (mode == TangentMode::EXACT && d.from_core > 0) {
+      const Mat3 off_normal = Mat3::Identity() - d.normal * d.normal.transpose();
+      const Mat3 along = Mat3::Identity() - d.axis * d.axis.transpose();
+      hessian -= (pressure / d.from_core) * off_normal * along;
+    }
+    active_.push_back({v, d.normal, pressure, hessian});
+  }
+}
+
+void SurfaceContact::add_tangent_product(const Points& dx, Points& out) const {
+  for (const Active& a : active_) {
+    Vec3 dy = Vec3::Zero();
+    for (index_t e = map_.points.begin(a.vertex); e < map_.points.end(a.vertex); ++e) dy += map_.weight[e] * dx.col(map_.points.index[e]);
+    const Vec3 h = a.hessian * dy;
+    for (index_t e = map_.points.begin(a.vertex); e < map_.points.end(a.vertex); ++e) out.col(map_.points.index[e]) += map_.weight[e] * h;
+  }
+}
+
+void SurfaceContact::add_diagonal_blocks(Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks) const {
+  // the normal stiffness only: the preconditioner wants positive blocks
+  for (const Active& a : active_) {
+    const Mat3 normal = penalty_[static_cast<std::size_t>(a.vertex)] * a.normal * a.normal.transpose();
+    for (index_t e = map_.points.begin(a.vertex); e < map_.points.end(a.vertex); ++e)
+      Eigen::Map<Mat3>(blocks.col(map_.points.index[e]).data()) += map_.weight[e] * map_.weight[e] * normal;
+  }
+}
+
+bool SurfaceContact::update_multipliers(const Model& model, const Points& u) {
+  if (load(model, u).penetration <= tolerance_) return true;
+  for (index_t v = 0; v < y_.cols(); ++v) {
+    double& lambda = lambda_[static_cast<std::size_t>(v)];
+    const double k = penalty_[static_cast<std::size_t>(v)];
+    lambda = std::max(lambda + k * tool_distance(shape_, pose_, y_.col(v)).penetration(shape_), 0.0);
+  }
+  return false;
+}
+
+ToolLoad SurfaceContact::load(const Model&, const Points& u) {
+  evaluate(u);
+  ToolLoad out;
+  const double far = reach(shape_);
+  for (index_t v = 0; v < y_.cols(); ++v) {
+    const double lambda = lambda_[static_cast<std::size_t>(v)], k = penalty_[static_cast<std::size_t>(v)];
+    if (lambda == 0 && (y_.col(v) - pose_.position).squaredNorm() > far * far) continue;
+    const ToolDistance d = tool_distance(shape_, pose_, y_.col(v));
+    out.penetration = std::max(out.penetration, d.penetration(shape_));
+    const double pressure = lambda + k * d.penetration(shape_);
+    if (!(pressure > 0)) continue;
+    const Vec3 on_tool = -pressure * d.normal;
+    out.force += on_tool;
+    out.torque += (d.core - pose_.position).cross(on_tool);  // the force acts along the normal through the core
+    ++out.contacts;
+  }
+  return out;
+}
+
+void SurfaceContact::reset_multipliers() { std::fill(lambda_.begin(), lambda_.end(), 0.0); }
+
+}  // namespace pointhaptics
