@@ -1,0 +1,161 @@
+// Tests for haptics/surface_contact: the contact energy's forces are its gradient and its tangent the
+// forces' derivative (finite differences, sphere and capsule, with and without multipliers); the load on the
+// tool balances what the points get; a capsule's off-centre contact has the torque of its forces; a tool
+// held at a position in a static solve leaves no vertex inside it beyond the tolerance and pushes the
+// object with the force the supports resist.
+#include <pointhaptics/geometry/sampling.hpp>
+#include <pointhaptics/geometry/shape_surfaces.hpp>
+#include <pointhaptics/haptics/surface_contact.hpp>
+#include <pointhaptics/mechanics/model_builder.hpp>
+#include <pointhaptics/simulation.hpp>
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+namespace pointhaptics {
+namespace {
+
+const double spacing = 0.005;
+const Vec3 size(0.04, 0.02, 0.04);
+
+struct Block {
+  Model model;
+  TriangleMesh surface;
+};
+
+Block block(bool hold_bottom = false) {
+  PointCloud cloud = sample_box(Vec3::Zero(), size, spacing);
+  Block b{build_model(cloud, MaterialParams{}, KernelParams{}), box_surface(Vec3::Zero(), size, spacing / 2)};
+  if (hold_bottom) {
+    FixedGroup bottom;
+    bottom.name = "bottom";
+    for (index_t i = 0; i < b.model.n_points; ++i)
+      if (b.model.X(1, i) < 1e-9) {
+        b.model.fixed[i] = 1;
+        bottom.points.push_back(i);
+      }
+    b.model.fixed_groups.push_back(bottom);
+  }
+  return b;
+}
+
+Points random_field(index_t n, double scale, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, scale);
+  Points u(3, n);
+  for (Eigen::Index k = 0; k < u.size(); ++k) u.data()[k] = noise(rng);
+  return u;
+}
+
+double dot(const Points& a, const Points& b) { return (a.array() * b.array()).sum(); }
+
+struct ToolCase {
+  const char* name;
+  ToolShape shape;
+  ToolPose pose;
+};
+
+std::vector<ToolCase> tools() {
+  ToolShape sphere{ToolKind::SPHERE, 0.01, 0};
+  ToolShape capsule{ToolKind::CAPSULE, 0.006, 0.02};
+  // the capsule lies across the top face, tilted, its axis off the block's centre
+  const Eigen::Quaterniond tilted(Eigen::AngleAxisd(1.3, Vec3(0.2, 0.1, 1).normalized()));
+  return {{"sphere", sphere, {Vec3(0.02, 0.02 + 0.01 - 0.0015, 0.02), Eigen::Quaterniond::Identity()}},
+          {"capsule", capsule, {Vec3(0.018, 0.02 + 0.006 - 0.001, 0.021), tilted}}};
+}
+
+TEST(SurfaceContact, ForcesAreTheEnergyGradientAndTheTangentTheirDerivative) {
+  const Block b = block();
+  for (const ToolCase& t : tools()) {
+    for (const bool with_multipliers : {false, true}) {
+      SCOPED_TRACE(std::string(t.name) + (with_multipliers ? " with multipliers" : ""));
+      SurfaceContact contact(b.model, b.surface, build_surface_map(b.model, b.surface.V), t.shape);
+      contact.set_pose(t.pose);
+      const Points u = random_field(b.model.n_points, 1e-4, 3);
+      if (with_multipliers) ASSERT_FALSE(contact.update_multipliers(b.model, u));  // the tool is inside: multipliers grow
+      Points f = Points::Zero(3, b.model.n_points);
+      contact.add_forces(b.model, u, f);
+      ASSERT_GT(f.norm(), 0);
+      const Points du = random_field(b.model.n_points, 1e-4, 5);
+      // energy: dE = -f . du, central differences
+      const double eps = 1e-4;
+      const double dE = (contact.energy(b.model, u + eps * du) - contact.energy(b.model, u - eps * du)) / (2 * eps);
+      EXPECT_NEAR(dE, -dot(f, du), 1e-6 * std::abs(dot(f, du)));
+      // tangent: H du = -(f(u + eps du) - f(u - eps du)) / (2 eps)
+      contact.linearise(b.model, u, TangentMode::EXACT);
+      Points Hdu = Points::Zero(3, b.model.n_points);
+      contact.add_tangent_product(du, Hdu);
+      Points f_plus = Points::Zero(3, b.model.n_points), f_minus = Points::Zero(3, b.model.n_points);
+      contact.add_forces(b.model, u + eps * du, f_plus);
+      contact.add_forces(b.model, u - eps * du, f_minus);
+      const Points fd = -(f_plus - f_minus) / (2 * eps);
+      EXPECT_LT((Hdu - fd).norm(), 1e-5 * fd.norm());
+      // the projected tangent keeps the normal stiffness only: positive semi-definite
+      contact.linearise(b.model, u, TangentMode::PROJECTED);
+      Points Pdu = Points::Zero(3, b.model.n_points);
+      contact.add_tangent_product(du, Pdu);
+      EXPECT_GE(dot(du, Pdu), 0);
+      // the tool feels the opposite of what the points get
+      const ToolLoad load = contact.load(b.model, u);
+      EXPECT_LT((load.force + f.rowwise().sum()).norm(), 1e-9 * load.force.norm());
+      EXPECT_GT(load.contacts, 0);
+    }
+  }
+}
+
+TEST(SurfaceContact, CapsuleTorqueIsTheMomentOfItsForces) {
+  const Block b = block();
+  const ToolCase t = tools()[1];
+  SurfaceContact contact(b.model, b.surface, build_surface_map(b.model, b.surface.V), t.shape);
+  contact.set_pose(t.pose);
+  const Points u = Points::Zero(3, b.model.n_points);
+  Points f = Points::Zero(3, b.model.n_points);
+  contact.add_forces(b.model, u, f);
+  const ToolLoad load = contact.load(b.model, u);
+  // the forces on the points, moved to the vertices' lines of action: recomputed independently from the
+  // deformed vertices, each vertex's force acting through its nearest axis point
+  Vec3 torque = Vec3::Zero();
+  const Points& y = contact.vertices();
+  for (index_t v = 0; v < y.cols(); ++v) {
+    const ToolDistance d = tool_distance(t.shape, t.pose, y.col(v));
+    const double g = d.penetration(t.shape);
+    if (g <= 0) continue;
+    torque += (d.core - t.pose.position).cross(-g * d.normal);
+  }
+  // the penalty is per vertex area, equal on the flat top: the torque's direction is that of sum g (q - c) x -n
+  ASSERT_GT(load.torque.norm(), 1e-6 * load.force.norm() * t.shape.length);
+  EXPECT_GT(load.torque.normalized().dot(torque.normalized()), 0.99);
+}
+
+TEST(SurfaceContact, StaticIndentationMeetsTheConstraintAndBalancesTheSupports) {
+  Block b = block(true);
+  const TriangleMesh surface = b.surface;
+  SolverSpec spec;
+  spec.kind = SolverKind::STATIC;
+  Simulation sim(std::move(b.model), spec, 2);
+  const double radius = 0.01, depth = 0.001;
+  sim.hold_tool(ToolShape{ToolKind::SPHERE, radius, 0}, ToolPose{Vec3(0.02, 0.02 + radius - depth, 0.02), Eigen::Quaterniond::Identity()},
+                surface, build_surface_map(sim.model(), surface.V));
+  ASSERT_EQ(sim.step().status, StepStatus::CONVERGED);
+  const RunSummary s = sim.summary();
+  ASSERT_TRUE(s.tool.present);
+  ASSERT_EQ(s.reactions.size(), 1u);
+  EXPECT_TRUE(s.converged);
+  EXPECT_LT(s.residual, 1e-6);
+  // pressed down, the object pushes the tool up; the supports hold the same force
+  EXPECT_GT(s.tool.force.y(), 0);
+  EXPECT_LT(std::hypot(s.tool.force.x(), s.tool.force.z()), 1e-6 * s.tool.force.y());
+  EXPECT_NEAR(s.reactions[0].y(), s.tool.force.y(), 1e-4 * s.tool.force.y());
+  // no vertex inside beyond 1% of the depth (the default tolerance is 1e-4 of the radius)
+  EXPECT_LT(s.tool.penetration, 0.01 * depth);
+  // the top face under the tool went down by about the depth
+  const Points y = sim.held_tool()->contact().vertices();
+  double lowest_top = 1;
+  for (index_t v = 0; v < y.cols(); ++v)
+    if (surface.V(1, v) > 0.02 - 1e-9 && (surface.V.col(v) - Vec3(0.02, 0.02, 0.02)).norm() < 1e-9) lowest_top = y(1, v);
+  EXPECT_NEAR(lowest_top, 0.02 - depth, 0.01 * depth);
+}
+
+}  // namespace
+}  // namespace pointhaptics
