@@ -1,6 +1,7 @@
 // pointhaptics: the command line. `pointhaptics <command> [scene.toml] [options]`, --help on every command.
 #include "experiment_beam.hpp"
 #include "experiment_cantilever.hpp"
+#include "experiment_contact.hpp"
 #include "experiment_force_profile.hpp"
 #include "experiment_lod.hpp"
 #include "experiment_materials.hpp"
@@ -361,6 +362,16 @@ int main(int argc, char** argv) {
   beam_cmd->add_option("--duration", beam.duration, "Simulated seconds of the dynamic runs")->check(CLI::PositiveNumber);
   beam_cmd->add_flag("!--no-implicit", beam.implicit, "Skip the (slow) implicit runs");
 
+  ph::experiments::ContactOptions contact;
+  CLI::App* contact_cmd = experiment_cmd->add_subcommand(
+      "contact", "A rigid sphere pressed into a block through the object's surface: force against depth beside Hertz, first "
+                 "contact, sliding");
+  contact_cmd->add_option("--out", contact.out, "Output folder")->required();
+  contact_cmd->add_flag("--quick", contact.quick, "The first spacing only, three depths (seconds)");
+  contact_cmd->add_option("--spacings", contact.per_radius, "Spacings as R / n: the n (default 4,8)")->delimiter(',')->check(CLI::Range(2, 64));
+  contact_cmd->add_option("--threads", contact.threads, "Threads (0: all)")->check(CLI::NonNegativeNumber);
+  contact_cmd->add_option("--plot-script", contact.plot_script, "plot_contact.py to use");
+
   ph::experiments::ForceProfileOptions profile;
   CLI::App* profile_cmd = experiment_cmd->add_subcommand(
       "force-profile", "Seed Fig. 2c: the force felt while dragging a point of the beam and letting it go");
@@ -404,6 +415,7 @@ int main(int argc, char** argv) {
     if (*cantilever_cmd) return ph::experiments::run_cantilever_experiment(cantilever);
     if (*materials_cmd) return ph::experiments::run_materials_experiment(materials);
     if (*beam_cmd) return ph::experiments::run_beam_experiment(beam);
+    if (*contact_cmd) return ph::experiments::run_contact_experiment(contact);
     if (*profile_cmd) return ph::experiments::run_force_profile_experiment(profile);
     if (*lod_table_cmd) return ph::experiments::run_lod_table_experiment(lod_table);
     if (*propagation_cmd) return ph::experiments::run_propagation_experiment(propagation);

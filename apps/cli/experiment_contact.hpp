@@ -1,0 +1,22 @@
+#pragma once
+/// @file `pointhaptics experiment contact` (issue 16): a rigid sphere pressed into a block through the
+/// object's surface, its force against depth beside Hertz's, at two spacings; where the surface is first
+/// felt; and the tool sliding at constant depth over the face.
+#include <string>
+#include <vector>
+
+namespace pointhaptics::experiments {
+
+struct ContactOptions {
+  std::string out = "contact-out";
+  bool quick = false;                ///< the coarser spacing only, fewer depths (seconds)
+  std::vector<int> per_radius{4, 8};  ///< spacings R / n
+  int threads = 0;                   ///< 0: all
+  std::string plot_script;           ///< plot_contact.py to use (default: the installed one)
+};
+
+/// Writes contact-force.csv, contact-sliding.csv, summary.md and contact.png into options.out; returns the
+/// exit code.
+int run_contact_experiment(const ContactOptions& options);
+
+}  // namespace pointhaptics::experiments

@@ -1,0 +1,51 @@
+#!/usr/bin/env python3
+"""Plots of `pointhaptics experiment contact`: force against depth beside Hertz, and the sliding forces.
+
+usage: plot_contact.py OUT
+"""
+import csv
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def read(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def main(out):
+    force = read(os.path.join(out, "contact-force.csv"))
+    sliding = read(os.path.join(out, "contact-sliding.csv"))
+    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4))
+    spacings = sorted({int(r["spacing_over_r"]) for r in force})
+    for n in spacings:
+        rows = [r for r in force if int(r["spacing_over_r"]) == n]
+        left.plot([float(r["depth_over_r"]) for r in rows], [float(r["force_n"]) for r in rows], "o-", label=f"points, spacing R/{n}")
+    rows = [r for r in force if int(r["spacing_over_r"]) == spacings[-1]]
+    left.plot([float(r["depth_over_r"]) for r in rows], [float(r["hertz_n"]) for r in rows], "k--", label="Hertz (half-space)")
+    left.set_xlabel("depth / R")
+    left.set_ylabel("force on the sphere (N)")
+    left.set_title("Sphere pressed into the block")
+    left.legend()
+    for n in sorted({int(r["spacing_over_r"]) for r in sliding}):
+        rows = [r for r in sliding if int(r["spacing_over_r"]) == n]
+        x = [float(r["x_over_spacing"]) for r in rows]
+        right.plot(x, [float(r["normal_n"]) for r in rows], "o-", label=f"normal, R/{n}")
+        right.plot(x, [float(r["tangential_n"]) for r in rows], "s--", label=f"tangential, R/{n}")
+    right.set_xlabel("tool position along x / spacing")
+    right.set_ylabel("force (N)")
+    right.set_title("Sliding at 0.1 R deep, frictionless")
+    right.legend()
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "contact.png"), dpi=120)
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 2:
+        sys.exit(__doc__)
+    main(sys.argv[1])
