@@ -30,6 +30,9 @@ struct DisplayFrame {
 
 struct InteractiveOptions {
   ProbeParams probe;
+  /// The object's surface: the probe pushes on it (issue 16) instead of on the point spheres (null: the
+  /// point spheres; with levels of detail the probe keeps them).
+  std::shared_ptr<const ObjectSurface> surface;
   WorkspaceMapping mapping;
   double duration = 1.0;         ///< s
   double haptic_rate = 1000.0;   ///< Hz

@@ -43,6 +43,7 @@ const StepReport& ModelSimulation::step() {
   // the solver: internal, external and tool forces, time integration or equilibrium, held points
   DynamicForces* tools = probe_ ? static_cast<DynamicForces*>(&probe_->tool) : held_tool_.get();
   report_ = solver_impl_->step(model_, state_, ws_, tools);
+  if (tools && report_.status != StepStatus::FAILED) tools->after_step(model_, state_);
   const auto solved = clock::now();
   // a state that is not finite is not a result, whatever the solver said; nor is an inverted one (counted)
   check_finite(report_);
@@ -56,7 +57,6 @@ const StepReport& ModelSimulation::step() {
 
 void ModelSimulation::place_tools() {
   if (probe_) probe_->tool.place(model_, state_, inputs_.device, inputs_.button);
-  if (held_tool_ && solver_.kind != SolverKind::STATIC) held_tool_->before_step(model_, state_);
 }
 
 void ModelSimulation::check_finite(StepReport& report) const {

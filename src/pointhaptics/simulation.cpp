@@ -55,11 +55,24 @@ void Simulation::set_state(const State& state) {
   else object_->set_state(state);
 }
 
-void Simulation::attach_probe(const ProbeParams& params, double coupling_stiffness, double max_force, bool asynchronous_lod) {
+void Simulation::attach_probe(const ProbeParams& params, double coupling_stiffness, double max_force, bool asynchronous_lod,
+                              const ObjectSurface* surface) {
   ModelSimulation& sim = core();
   if (sim.solver().kind == SolverKind::STATIC) throw Error("probe: needs a dynamic solver (explicit or implicit)");
   if (sim.held_tool()) throw Error("probe: the simulation already holds a tool (one tool at a time)");
-  sim.probe().emplace(ProbeAttachment{ProbeTool(sim.model(), params, coupling_stiffness, max_force), asynchronous_lod});
+  std::optional<SurfaceContact> on_surface;
+  if (surface && !lod_) {
+    SurfaceContactParams contact;
+    // the contact no stiffer on a point than the point spheres' springs were (E x spacing): explicit steps keep
+    // their stable sub-step, implicit ones their linearly implicit springs. In dynamics it is a penalty: the
+    // multipliers updated once a step (an integral of the penetration) made a deep, fast push diverge
+    // (tests/deep_compression_test.cpp), so the probe sinks by the penalty's give; the static solver meets
+    // the constraint exactly
+    contact.max_point_stiffness = sim.model().material.young * sim.model().spacing;
+    on_surface.emplace(sim.model(), surface->mesh, surface->map, ToolShape{ToolKind::SPHERE, params.radius, 0}, contact);
+  }
+  sim.probe().emplace(
+      ProbeAttachment{ProbeTool(sim.model(), params, coupling_stiffness, max_force, std::move(on_surface)), asynchronous_lod});
   sim.inputs() = StepInputs{};
 }
 
@@ -68,7 +81,11 @@ void Simulation::hold_tool(const ToolShape& shape, const ToolPose& pose, const T
   if (lod_) throw Error("tool: a held tool with levels of detail is not available yet (its surface map is the object's)");
   ModelSimulation& sim = core();
   if (sim.probe()) throw Error("tool: the simulation already has a probe (one tool at a time)");
-  sim.held_tool() = std::make_unique<HeldTool>(SurfaceContact(sim.model(), mesh, std::move(map), shape, params));
+  SurfaceContactParams contact = params;
+  // explicit steps: no stiffer on a point than E x spacing, or the stable sub-step would shrink with it
+  if (sim.solver().kind == SolverKind::EXPLICIT && contact.max_point_stiffness <= 0)
+    contact.max_point_stiffness = sim.model().material.young * sim.model().spacing;
+  sim.held_tool() = std::make_unique<HeldTool>(SurfaceContact(sim.model(), mesh, std::move(map), shape, contact));
   sim.held_tool()->set_pose(pose);
 }
 

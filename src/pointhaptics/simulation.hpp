@@ -6,6 +6,7 @@
 #include <pointhaptics/io/scene.hpp>
 #include <pointhaptics/levels_of_detail.hpp>
 #include <pointhaptics/model_simulation.hpp>
+#include <pointhaptics/object_surface.hpp>
 
 #include <functional>
 #include <memory>
@@ -56,7 +57,10 @@ class Simulation {
   /// (N/m) toward inputs().device, its force capped at `max_force` (N), pushing or grabbing the points.
   /// With levels of detail the active set follows its contact point, re-selected on a worker thread when
   /// `asynchronous_lod` (real time) and in place otherwise (reproducible runs). Throws Error for a static solver.
-  void attach_probe(const ProbeParams& params, double coupling_stiffness, double max_force, bool asynchronous_lod);
+  /// `surface`: the object's surface, which the probe then pushes on (issue 16) instead of the point
+  /// spheres; without levels of detail only (with them the probe keeps the point spheres).
+  void attach_probe(const ProbeParams& params, double coupling_stiffness, double max_force, bool asynchronous_lod,
+                    const ObjectSurface* surface = nullptr);
   void detach_probe();
   /// The probe (nullptr without one): its position and last local contact model. Its contact's point
   /// indices are the simulated model's; grabbed_points() gives the object's.

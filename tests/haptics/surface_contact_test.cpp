@@ -73,7 +73,9 @@ TEST(SurfaceContact, ForcesAreTheEnergyGradientAndTheTangentTheirDerivative) {
       SurfaceContact contact(b.model, b.surface, build_surface_map(b.model, b.surface.V), t.shape);
       contact.set_pose(t.pose);
       const Points u = random_field(b.model.n_points, 1e-4, 3);
-      if (with_multipliers) ASSERT_FALSE(contact.update_multipliers(b.model, u));  // the tool is inside: multipliers grow
+      if (with_multipliers) {
+        ASSERT_FALSE(contact.update_multipliers(b.model, u));  // the tool is inside: multipliers grow
+      }
       Points f = Points::Zero(3, b.model.n_points);
       contact.add_forces(b.model, u, f);
       ASSERT_GT(f.norm(), 0);

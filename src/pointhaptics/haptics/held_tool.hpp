@@ -1,7 +1,8 @@
 #pragma once
 /// @file A tool held at a prescribed pose against the object's surface: a static indentation (`[probe]
 /// position` with solver.kind = "static"), or a tool posed by the program in dynamics. Its contact is a
-/// term of the energy for the Newton solvers (static, implicit) and forces at every explicit sub-step.
+/// term of the energy for the Newton solvers (static, implicit) and forces at every explicit sub-step; the
+/// static solver meets its constraint (augmented Lagrangian), dynamics leaves the penalty's give.
 #include <pointhaptics/haptics/surface_contact.hpp>
 #include <pointhaptics/solvers/solver.hpp>
 
@@ -18,9 +19,6 @@ class HeldTool final : public DynamicForces {
   void add(const Model& model, const State& state, Points& f) override { contact_.add_forces(model, state.u, f); }
   double max_point_stiffness() const override { return contact_.max_point_stiffness(); }
   EnergyTerm* energy_term() override { return &contact_; }
-  /// Dynamics: one update of the contact's multipliers a step (the constraint is met as the motion settles;
-  /// the static solver iterates them to the tolerance within its solve instead).
-  void before_step(const Model& model, const State& state) override { contact_.update_multipliers(model, state.u); }
 
   /// What the object does to the tool at u.
   ToolLoad load(const Model& model, const Points& u) { return contact_.load(model, u); }

@@ -2,8 +2,10 @@
 /// @file The probe as a tool of the simulation: placed on its coupling spring once per step, then its
 /// contact forces act on the points at every (sub-)step the solver takes.
 #include <pointhaptics/haptics/contact.hpp>
+#include <pointhaptics/haptics/surface_contact.hpp>
 #include <pointhaptics/solvers/solver.hpp>
 
+#include <optional>
 #include <vector>
 
 namespace pointhaptics {
@@ -12,7 +14,10 @@ class ProbeTool final : public DynamicForces {
  public:
   /// coupling_stiffness: the spring between the device point and the probe, N/m; max_force: the device's
   /// largest force, N (the hand cannot push harder than it can feel).
-  ProbeTool(const Model& model, const ProbeParams& params, double coupling_stiffness, double max_force);
+  /// `surface`: the probe pushes on the object's surface (issue 16) instead of the point spheres; grabbing
+  /// still holds the points under it.
+  ProbeTool(const Model& model, const ProbeParams& params, double coupling_stiffness, double max_force,
+            std::optional<SurfaceContact> surface = std::nullopt);
 
   /// Once per step: the probe is where the coupling spring toward `device` (its force capped at max_force)
   /// balances the contact forces at the step's start; a few Newton steps on the local model from the last
@@ -21,7 +26,13 @@ class ProbeTool final : public DynamicForces {
   void place(const Model& model, const State& state, const Vec3& device, bool button);
   void add(const Model& model, const State& state, Points& f) override;
   bool add_stiffness(const Model&, const State&, Eigen::Matrix<double, 9, Eigen::Dynamic>& springs) override;
-  double max_point_stiffness() const override { return contact_.params().stiffness; }
+  double max_point_stiffness() const override;
+  /// Pushing on the surface: the local contact model at the step's end state, for the haptic side.
+  void after_step(const Model& model, const State& state) override;
+
+  /// Whether the probe touches the object's surface (else the point spheres).
+  bool on_surface() const { return surface_.has_value(); }
+  const SurfaceContact* surface_contact() const { return surface_ ? &*surface_ : nullptr; }
   /// The model's points were renumbered (a level-of-detail re-selection): new_index[old], -1 if dropped.
   void remap(const Model& model, const std::vector<index_t>& new_index);
 
@@ -33,7 +44,12 @@ class ProbeTool final : public DynamicForces {
   const ProbeContact& contact() const { return contact_; }
 
  private:
+  bool pushing_surface() const;
+  /// The local model of the surface contact at the probe position p (u as in the last evaluation when same_u).
+  ContactModel surface_model(const Model& model, const State& state, const Vec3& p, bool same_u);
+
   ProbeContact contact_;
+  std::optional<SurfaceContact> surface_;
   double k_, max_force_;
   Vec3 device_ = Vec3::Constant(NAN);
   Vec3 probe_ = Vec3::Constant(NAN);

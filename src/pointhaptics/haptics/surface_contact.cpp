@@ -33,6 +33,11 @@ SurfaceContact::SurfaceContact(const Model& model, const TriangleMesh& mesh, Sur
     for (index_t e = map_.points.begin(v); e < map_.points.end(v); ++e)
       stiffness[static_cast<std::size_t>(map_.points.index[e])] += penalty_[static_cast<std::size_t>(v)] * map_.weight[e] * map_.weight[e];
   max_point_stiffness_ = stiffness.empty() ? 0.0 : *std::max_element(stiffness.begin(), stiffness.end());
+  if (params.max_point_stiffness > 0 && max_point_stiffness_ > params.max_point_stiffness) {
+    const double scale = params.max_point_stiffness / max_point_stiffness_;
+    for (double& k : penalty_) k *= scale;
+    max_point_stiffness_ = params.max_point_stiffness;
+  }
 }
 
 void SurfaceContact::evaluate(const Points& u) { carry_surface(map_, Y_, u, y_); }
@@ -57,39 +62,48 @@ double SurfaceContact::energy(const Model&, const Points& u) {
   return e;
 }
 
-void SurfaceContact::add_forces(const Model&, const Points& u, Points& f) {
-  evaluate(u);
+template <class Pressing>
+ToolLoad SurfaceContact::for_each_pressing(const Pressing& pressing) const {
+  ToolLoad out;
   const double far = reach(shape_);
   for (index_t v = 0; v < y_.cols(); ++v) {
     const double lambda = lambda_[static_cast<std::size_t>(v)], k = penalty_[static_cast<std::size_t>(v)];
     if (lambda == 0 && (y_.col(v) - pose_.position).squaredNorm() > far * far) continue;
     const ToolDistance d = tool_distance(shape_, pose_, y_.col(v));
+    out.penetration = std::max(out.penetration, d.penetration(shape_));
     const double pressure = lambda + k * d.penetration(shape_);
     if (!(pressure > 0)) continue;
+    const Vec3 on_tool = -pressure * d.normal;
+    out.force += on_tool;
+    out.torque += (d.core - pose_.position).cross(on_tool);  // the force acts along the normal through the core
+    out.stiffness -= k * d.normal * d.normal.transpose();
+    ++out.contacts;
+    pressing(v, d, pressure);
+  }
+  return out;
+}
+
+void SurfaceContact::add_forces(const Model&, const Points& u, Points& f) {
+  evaluate(u);
+  last_load_ = for_each_pressing([&](index_t v, const ToolDistance& d, double pressure) {
     const Vec3 force = pressure * d.normal;  // on the vertex, out of the tool
     for (index_t e = map_.points.begin(v); e < map_.points.end(v); ++e) f.col(map_.points.index[e]) += map_.weight[e] * force;
-  }
+  });
 }
 
 void SurfaceContact::linearise(const Model&, const Points& u, TangentMode mode) {
   evaluate(u);
   active_.clear();
-  const double far = reach(shape_);
-  for (index_t v = 0; v < y_.cols(); ++v) {
-    const double lambda = lambda_[static_cast<std::size_t>(v)], k = penalty_[static_cast<std::size_t>(v)];
-    if (lambda == 0 && (y_.col(v) - pose_.position).squaredNorm() > far * far) continue;
-    const ToolDistance d = tool_distance(shape_, pose_, y_.col(v));
-    const double pressure = lambda + k * d.penetration(shape_);
-    if (!(pressure > 0)) continue;
+  for_each_pressing([&](index_t v, const ToolDistance& d, double pressure) {
     // d2E/dy2 = k n n^T - p dn/dy: the second part (the tool's curvature, negative) only in the exact tangent
-    Mat3 hessian = k * d.normal * d.normal.transpose();
+    Mat3 hessian = penalty_[static_cast<std::size_t>(v)] * d.normal * d.normal.transpose();
     if (mode == TangentMode::EXACT && d.from_core > 0) {
       const Mat3 off_normal = Mat3::Identity() - d.normal * d.normal.transpose();
       const Mat3 along = Mat3::Identity() - d.axis * d.axis.transpose();
       hessian -= (pressure / d.from_core) * off_normal * along;
     }
     active_.push_back({v, d.normal, pressure, hessian});
-  }
+  });
 }
 
 void SurfaceContact::add_tangent_product(const Points& dx, Points& out) const {
@@ -120,23 +134,9 @@ bool SurfaceContact::update_multipliers(const Model& model, const Points& u) {
   return false;
 }
 
-ToolLoad SurfaceContact::load(const Model&, const Points& u) {
-  evaluate(u);
-  ToolLoad out;
-  const double far = reach(shape_);
-  for (index_t v = 0; v < y_.cols(); ++v) {
-    const double lambda = lambda_[static_cast<std::size_t>(v)], k = penalty_[static_cast<std::size_t>(v)];
-    if (lambda == 0 && (y_.col(v) - pose_.position).squaredNorm() > far * far) continue;
-    const ToolDistance d = tool_distance(shape_, pose_, y_.col(v));
-    out.penetration = std::max(out.penetration, d.penetration(shape_));
-    const double pressure = lambda + k * d.penetration(shape_);
-    if (!(pressure > 0)) continue;
-    const Vec3 on_tool = -pressure * d.normal;
-    out.force += on_tool;
-    out.torque += (d.core - pose_.position).cross(on_tool);  // the force acts along the normal through the core
-    ++out.contacts;
-  }
-  return out;
+ToolLoad SurfaceContact::load(const Model&, const Points& u, bool same_u) {
+  if (!same_u) evaluate(u);
+  return for_each_pressing([](index_t, const ToolDistance&, double) {});
 }
 
 void SurfaceContact::reset_multipliers() { std::fill(lambda_.begin(), lambda_.end(), 0.0); }

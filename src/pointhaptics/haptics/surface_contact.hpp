@@ -19,12 +19,16 @@
 namespace pointhaptics {
 
 struct SurfaceContactParams {
-  /// Penalty per unit of the vertex's area, N/m^3 (0: 10 E / spacing, ten times the object's own
-  /// stiffness under a pressure on its surface at the scale of a spacing).
+  /// Penalty per unit of the vertex's area, N/m^3 (0: 1000 E / spacing). The multipliers meet the constraint
+  /// whatever it is; a stiffer one needs fewer updates (measured on the contact experiment's block: 10 E /
+  /// spacing took 51+ updates, 100 E / spacing 13, 1000 E / spacing 5) and CG's iterations did not grow.
   double penalty = 0;
   /// Largest penetration of a vertex into the tool at which the constraint counts as met, m (0: 1e-4 of
   /// the tool's radius).
   double tolerance = 0;
+  /// If > 0, N/m: the penalty is lowered so that no point's contact stiffness (sum_v k_v w_vj^2) exceeds it
+  /// (explicit dynamics, whose stable sub-step it would otherwise shorten).
+  double max_point_stiffness = 0;
 };
 
 /// What the object does to the tool.
@@ -33,6 +37,9 @@ struct ToolLoad {
   Vec3 torque = Vec3::Zero();  ///< N m, about the tool's position
   int contacts = 0;            ///< vertices pressing on it
   double penetration = 0;      ///< deepest vertex inside the tool, m (0: none)
+  /// d force / d tool position with the object held still, N/m: -sum_v k_v n_v n_v^T over the pressing
+  /// vertices (negative semi-definite; the tool's curvature term, which would make it indefinite, left out)
+  Mat3 stiffness = Mat3::Zero();
 };
 
 class SurfaceContact final : public EnergyTerm {
@@ -54,8 +61,11 @@ class SurfaceContact final : public EnergyTerm {
   /// Uzawa's update at u: true (multipliers kept) when no vertex is deeper in the tool than the tolerance.
   bool update_multipliers(const Model& model, const Points& u) override;
 
-  /// The load on the tool at u (its multipliers and penalty as they are).
-  ToolLoad load(const Model& model, const Points& u);
+  /// The load on the tool at u (its multipliers and penalty as they are); same_u: u is the last evaluation's,
+  /// whose carried surface is reused (the probe's placement tries several positions on one state).
+  ToolLoad load(const Model& model, const Points& u, bool same_u = false);
+  /// The load of the last add_forces(), which computes it on the way.
+  const ToolLoad& last_load() const { return last_load_; }
   /// Forget the multipliers (the tool lifted off, or moved far).
   void reset_multipliers();
   /// Upper bound of the contact's stiffness on one point, N/m (explicit stable step): max_j sum_v k_v w_vj^2.
@@ -73,6 +83,9 @@ class SurfaceContact final : public EnergyTerm {
   };
   /// y = Y + W u, the vertices that can touch the tool, and their contact values.
   void evaluate(const Points& u);
+  /// The load of the vertices pressing on the tool at y_, calling pressing(v, distance, pressure) for each.
+  template <class Pressing>
+  ToolLoad for_each_pressing(const Pressing& pressing) const;
 
   Points Y_, y_;
   SurfaceMap map_;
@@ -80,6 +93,7 @@ class SurfaceContact final : public EnergyTerm {
   ToolPose pose_;
   std::vector<double> penalty_, lambda_;  // per vertex
   std::vector<Active> active_;            // at the last linearise()
+  ToolLoad last_load_;
   double tolerance_ = 0, max_point_stiffness_ = 0;
 };
 

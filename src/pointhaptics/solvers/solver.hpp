@@ -29,9 +29,8 @@ class DynamicForces {
   /// The forces as a term of the energy, which the Newton solvers (static, implicit) minimise with the
   /// material's instead of calling add() and add_stiffness(); nullptr if they have none.
   virtual EnergyTerm* energy_term() { return nullptr; }
-  /// Once per step, before it: what the forces need to follow (an augmented Lagrangian's multipliers in
-  /// dynamics, updated once a step).
-  virtual void before_step(const Model&, const State&) {}
+  /// Once per step, after it, at the state it reached (a probe's local contact model for the haptic side).
+  virtual void after_step(const Model&, const State&) {}
 };
 
 enum class StepStatus {
