@@ -21,6 +21,7 @@ struct SolverScratch {
   Points anchor, next, load, start, tool_forces;     ///< implicit: the inertia's anchor, the iterate, the load, u_n,
                                                      ///< the tools' forces; static: the increment's load and iterate
   Eigen::Matrix<double, 9, Eigen::Dynamic> springs;  ///< implicit: the tools' springs (9 x n)
+  Points term_forces;                                ///< Newton: the forces of its problem's further term
 };
 
 /// Scratch buffers and the thread pool of the force evaluation and the solvers: the one owner of every

@@ -58,9 +58,18 @@ double NewtonSolver::residual(const Model& model, const NewtonProblem& problem, 
   if (problem.springs)
     for (index_t i = 0; i < model.n_points; ++i)
       r.col(i) -= Eigen::Map<const Mat3>(problem.springs->col(i).data()) * (u.col(i) - problem.spring_anchor->col(i));
-  if (problem.term) problem.term->add_forces(model, u, r);
+  // a term's forces (a tool's contact) are part of the force scale: pressing on a body at rest, they are all
+  // there is at the first iterate
+  double term_forces = 0;
+  if (problem.term) {
+    Points& f = ws.solver_scratch().term_forces;
+    f.setZero(3, model.n_points);
+    problem.term->add_forces(model, u, f);
+    r += f;
+    term_forces = f.norm();
+  }
   mask_held(model, r);
-  const double scale = std::max({problem.load->norm(), ws.f_int.norm(), std::sqrt(inertial), 1e-300});
+  const double scale = std::max({problem.load->norm(), ws.f_int.norm(), std::sqrt(inertial), term_forces, 1e-300});
   return r.norm() / scale;
 }
 
