@@ -71,7 +71,7 @@ int run_contact_experiment(const ContactOptions& options) {
   const std::vector<double> depths = options.quick ? std::vector<double>{0.1, 0.2, 0.3}
                                                    : std::vector<double>{0.05, 0.1, 0.15, 0.2, 0.25, 0.3};
   auto force_csv = fmt::output_file((out / "contact-force.csv").string());
-  force_csv.print("spacing_over_r,points,depth_over_r,depth_m,force_n,hertz_n,ratio_to_hertz,contacts,penetration_m,newton,seconds\n");
+  force_csv.print("spacing_over_r,points,depth_over_r,depth_m,force_n,hertz_n,ratio_to_hertz,contacts,penetration_m,newton,seconds,physical\n");
   auto sliding_csv = fmt::output_file((out / "contact-sliding.csv").string());
   sliding_csv.print("spacing_over_r,x_over_spacing,normal_n,tangential_n,contacts\n");
   std::string table, sliding_table, offsets;
@@ -100,11 +100,14 @@ int run_contact_experiment(const ContactOptions& options) {
       if (report.status == StepStatus::FAILED) throw Error(fmt::format("contact: R/{} at depth {} R: {}", n, d, report.failure));
       const ToolLoad load = tool.load(sim.model(), sim.state().u);
       const double f = load.force.y(), f_hertz = hertz(d * R);
-      force_csv.print("{},{},{},{:.6g},{:.6g},{:.6g},{:.5f},{},{:.3g},{},{:.3f}\n", n, sim.model().n_points, d, d * R, f, f_hertz,
-                      f / f_hertz, load.contacts, load.penetration, report.iterations, took);
-      table += fmt::format("| R/{} | {} | {:.2f} | {:.4f} | {:.4f} | {:.3f} | {} | {:.2g} ({:.2g}% of the depth) | {:.1f} |\n", n,
+      // an equilibrium with inverted neighbourhoods (a material collapsing under the sphere) is no result
+      const RunSummary summary = sim.summary();
+      const std::string physical = summary.converged ? "yes" : fmt::format("no: {}", summary.failure);
+      force_csv.print("{},{},{},{:.6g},{:.6g},{:.6g},{:.5f},{},{:.3g},{},{:.3f},{}\n", n, sim.model().n_points, d, d * R, f, f_hertz,
+                      f / f_hertz, load.contacts, load.penetration, report.iterations, took, summary.converged ? 1 : 0);
+      table += fmt::format("| R/{} | {} | {:.2f} | {:.4f} | {:.4f} | {:.3f} | {} | {:.2g} ({:.2g}% of the depth) | {:.1f} | {} |\n", n,
                            sim.model().n_points, d, f, f_hertz, f / f_hertz, load.contacts, load.penetration,
-                           100 * load.penetration / (d * R), took);
+                           100 * load.penetration / (d * R), took, physical);
       fmt::print("contact: R/{} depth {:.2f} R: {:.4f} N (Hertz {:.4f} N, ratio {:.3f}), {} contacts, {:.1f} s\n", n, d, f, f_hertz,
                  f / f_hertz, load.contacts, took);
     }
@@ -139,8 +142,8 @@ int run_contact_experiment(const ContactOptions& options) {
            "## Force against depth (depth from the undeformed surface)\n\n"
            "Hertz is the small-depth limit for a half-space; the block's finite thickness (4 R) stiffens it, and the "
            "strains at 0.3 R are no longer small.\n\n"
-           "| spacing | points | depth / R | force (N) | Hertz (N) | ratio | vertices in contact | deepest vertex inside (m) | solve (s) |\n"
-           "|---|---|---|---|---|---|---|---|---|\n{}\n"
+           "| spacing | points | depth / R | force (N) | Hertz (N) | ratio | vertices in contact | deepest vertex inside (m) | solve (s) | a result |\n"
+           "|---|---|---|---|---|---|---|---|---|---|\n{}\n"
            "## Where the surface is first felt\n\n"
            "The sphere's lowest point at first contact, above the true top face (the point-sphere contact felt it half a "
            "spacing above):\n\n| spacing | offset |\n|---|---|\n{}\n"

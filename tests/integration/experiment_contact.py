@@ -1,0 +1,65 @@
+#!/usr/bin/env python3
+"""End to end: `pointhaptics experiment contact --quick` writes its CSVs, summary and plot; the force rises
+with depth, within 20% of Hertz's from 0.1 R to 0.3 R at spacing R/4; no surface vertex ends deeper in the
+sphere than 1% of the depth; first contact is within 0.05 R of the true surface; frictionless sliding keeps
+the normal force's ripple under 5% and the tangential force under 2% of it. Then a scene with a tool held
+at a position, solved statically, writes the result JSON's tool block."""
+import csv
+import json
+import os
+import re
+import subprocess
+import sys
+
+exe, out = sys.argv[1], sys.argv[2]
+subprocess.run([exe, "experiment", "contact", "--quick", "--out", out], check=True)
+for name in ("contact-force.csv", "contact-sliding.csv", "summary.md", "contact.png"):
+    assert os.path.getsize(os.path.join(out, name)) > 100, f"{name} missing or empty"
+with open(os.path.join(out, "contact-force.csv"), newline="") as f:
+    rows = [{k: float(v) for k, v in r.items()} for r in csv.DictReader(f)]
+assert [r["depth_over_r"] for r in rows] == [0.1, 0.2, 0.3], rows
+forces = [r["force_n"] for r in rows]
+assert forces == sorted(forces) and forces[0] > 0, forces
+for r in rows:
+    assert 0.8 < r["ratio_to_hertz"] < 1.2, r
+    assert r["penetration_m"] < 0.01 * r["depth_m"], r
+    assert r["physical"] == 1, r
+summary = open(os.path.join(out, "summary.md")).read()
+offset = float(re.search(r"\| R/4 \| (-?[0-9.]+) R \(", summary).group(1))
+assert abs(offset) < 0.05, offset
+with open(os.path.join(out, "contact-sliding.csv"), newline="") as f:
+    sliding = [{k: float(v) for k, v in r.items()} for r in csv.DictReader(f)]
+normal = [r["normal_n"] for r in sliding]
+mean = sum(normal) / len(normal)
+ripple = (sum((n - mean) ** 2 for n in normal) / len(normal)) ** 0.5 / mean
+assert ripple < 0.05, ripple
+assert max(r["tangential_n"] for r in sliding) < 0.02 * mean, sliding
+
+# a static indentation from a scene file: the tool block
+scene = os.path.join(out, "indent.toml")
+with open(scene, "w") as f:
+    f.write("""[object]
+shape = "box"
+size = [0.04, 0.02, 0.04]
+origin = [-0.02, 0.0, -0.02]
+spacing = 0.005
+[material]
+young = 1e5
+poisson = 0.3
+[[fixed]]
+box = { min = [-1.0, -1.0, -1.0], max = [1.0, 0.0, 1.0] }
+[probe]
+radius = 0.01
+position = [0.0, 0.029, 0.0]
+[solver]
+kind = "static"
+""")
+result = os.path.join(out, "indent.json")
+subprocess.run([exe, "run", scene, "--json", result, "--quiet"], check=True)
+doc = json.load(open(result))
+tool = doc["tool"]
+assert tool["kind"] == "sphere" and tool["position"] == [0.0, 0.029, 0.0], tool
+assert tool["force"][1] > 0 and abs(tool["force"][0]) < 1e-6 * tool["force"][1], tool
+assert tool["contacts"] > 0 and tool["penetration"] < 1e-5, tool
+assert abs(doc["constraints"][0]["reaction"][1] - tool["force"][1]) < 1e-3 * tool["force"][1], (doc["constraints"], tool)
+print("contact: ok", forces, f"offset {offset} R, ripple {ripple:.4f}")
