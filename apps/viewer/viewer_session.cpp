@@ -77,7 +77,13 @@ std::unique_ptr<Prepared> prepare(const Scene& scene_in, ProbeSource source, int
     p->note = "static solver shown with implicit dynamics (dt = 2 ms)";
   }
   // the viewer always has a probe (the scene's [probe] values, else the defaults): levels of detail start
-  // under it
+  // under it. A tool held at a position becomes the mouse's probe (a sphere of its radius).
+  if (scene.probe.held()) {
+    scene.probe.position = Vec3::Constant(NAN);
+    scene.probe.capsule = false;
+    scene.probe.length = 0;
+    p->note += std::string(p->note.empty() ? "" : "; ") + "the held tool is the mouse's probe here";
+  }
   scene.probe.present = true;
   SessionOptions session_options;
   session_options.threads = threads;

@@ -109,6 +109,17 @@ TEST(ViewerSession, HeadlessFramesAreDeterministicAndFollowTheScript) {
   EXPECT_LT(fa.u.row(1).minCoeff(), -1e-3);         // and pressed the beam
 }
 
+TEST(ViewerSession, AToolHeldAtAPositionBecomesTheMousesProbe) {
+  Scene scene = beam_scene();
+  scene.probe.keyframes.clear();
+  scene.probe.position = Vec3(0.0675, 0.035, 0.015);
+  scene.solver.kind = SolverKind::STATIC;
+  auto p = prepare(scene, ProbeSource::MOUSE, 1);
+  EXPECT_NE(p->note.find("the held tool is the mouse's probe"), std::string::npos) << p->note;
+  EXPECT_EQ(p->simulation->held_tool(), nullptr);
+  EXPECT_NEAR(simulate_frame(*p, 0.05).time, 0.05, 1e-9);
+}
+
 TEST(ViewerSession, TheMouseDrivesARealTimeRunAndEditsRebuildIt) {
   const Scene scene = beam_scene();
   ViewerSession session(prepare(scene, ProbeSource::MOUSE, 1), ProbeSource::MOUSE, 1);
