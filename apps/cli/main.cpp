@@ -219,6 +219,7 @@ int run_command(const RunOptions& opt) {
   ph::RunSummary summary = sim.summary();
   summary.interrupted = interrupted.load();
   if (haptic) {
+    summary.tool = interactive.tool;
     summary.haptic_ticks = interactive.haptic.ticks;
     summary.haptic_rate_hz = interactive.haptic.rate_hz;
     summary.haptic_period_p99_us = interactive.haptic.period_p99_us;

@@ -128,6 +128,7 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
   result.haptic = loop.stats();
   take_log();
   result.log_dropped = loop.log_dropped();
+  result.tool = sim.tool_summary();  // before the probe is detached
   return result;
 }
 

@@ -65,6 +65,7 @@ struct InteractiveResult {
   long long simulation_steps = 0;
   double simulation_wall_s = 0;
   int max_contacts = 0;
+  ToolSummary tool;               ///< the probe at the end (the result JSON's tool block)
 };
 
 /// Run the simulation with a probe driven by `device` for options.duration. Real time: the haptic loop

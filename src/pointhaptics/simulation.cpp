@@ -162,6 +162,21 @@ void check_physical(const Model& model, Workspace& ws, const StepDiagnostics& d,
 
 }  // namespace
 
+ToolSummary Simulation::tool_summary() {
+  ModelSimulation& sim = core();
+  if (HeldTool* tool = sim.held_tool().get()) {
+    const ToolLoad load = tool->load(sim.model(), sim.state().u);
+    return {true, tool->shape().kind == ToolKind::CAPSULE ? "capsule" : "sphere", tool->pose().position, load.force, load.torque,
+            load.contacts, load.penetration};
+  }
+  if (const ProbeTool* probe = this->probe()) {
+    // the probe's local model at the last step's end: the force the object exerts on it there
+    const ContactModel& c = probe->contact_model();
+    return {true, "sphere", probe->probe(), c.f0, Vec3::Zero(), c.contacts, 0.0};
+  }
+  return {};
+}
+
 RunSummary Simulation::summary() {
   ModelSimulation& sim = core();
   const Model& model = sim.model();
@@ -197,14 +212,7 @@ RunSummary Simulation::summary() {
   s.tools_s = d.tools_seconds;
   s.solve_s = d.solve_seconds;
   if (lod_) lod_->fill(s.lod);
-  if (tool) {
-    const ToolLoad load = tool->load(model, state.u);
-    s.tool = {true, tool->shape().kind == ToolKind::CAPSULE ? "capsule" : "sphere", tool->pose().position, load.force, load.torque,
-              load.contacts, load.penetration};
-  } else if (const ProbeTool* probe = this->probe()) {
-    const ContactModel& c = probe->contact_model();
-    s.tool = {true, "sphere", probe->probe(), c.f0, Vec3::Zero(), c.contacts, 0.0};
-  }
+  s.tool = tool_summary();
   return s;
 }
 

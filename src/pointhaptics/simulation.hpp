@@ -94,6 +94,8 @@ class Simulation {
   /// Selections made so far (0 without levels of detail): a new one means a new active set.
   long long lod_selections() const;
 
+  /// The tool (held, or the probe) at the current state: what the object does to it. Not present without one.
+  ToolSummary tool_summary();
   /// Results at the current state: energies (of what is simulated), reactions, residual, timing, and the
   /// levels of detail.
   RunSummary summary();

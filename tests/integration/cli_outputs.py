@@ -113,8 +113,11 @@ print("ok: " + err.splitlines()[0])
 
 # 12b: --vtk-every animates an interactive run (only its first and last frames were written)
 frames = os.path.join(work, "probe_frames")
-p, _ = run(probe, "--deterministic", "--vtk", frames, "--vtk-every", "100")
+probe_json = os.path.join(work, "probe.json")
+p, _ = run(probe, "--deterministic", "--vtk", frames, "--vtk-every", "100", "--json", probe_json)
 assert p.returncode == 0, p.stderr
+tool = json.load(open(probe_json))["tool"]  # issue 16: every run with a tool has its block
+assert tool["kind"] == "sphere" and len(tool["position"]) == 3 and len(tool["force"]) == 3, tool
 vtp = [f for f in os.listdir(frames) if f.endswith(".vtp") and "_surface_" not in f]
 assert len(vtp) == 3000 // 100 + 2, len(vtp)  # every 100 of 3000 steps, the first and the last state
 surfaces = [f for f in os.listdir(frames) if f.endswith(".vtp") and "_surface_" in f]

@@ -46,7 +46,12 @@ void ProbeTool::place(const Model& model, const State& state, const Vec3& device
     // the state is the same at every iteration: the positions (and their grid) are made once
     const ContactModel local = pushing_surface() ? surface_model(model, state, p, it > 0)
                                                  : contact_.apply(model, state.u, p, button, state.time, scratch_, it > 0);
-    const Vec3 next = coupled_probe(local, device, k_, max_force_);
+    Vec3 next = coupled_probe(local, device, k_, max_force_);
+    // on the surface the probe moves at most a quarter radius per iteration (2 radii a step, far above a
+    // hand's speed): its local model knows only the vertices it touches where it is, and a longer jump could
+    // pass the surface and push it out from within
+    const double longest = 0.25 * contact_.params().radius;
+    if (pushing_surface() && (next - p).norm() > longest) next = p + (next - p) * (longest / (next - p).norm());
     const bool settled = (next - p).norm() < 1e-9 + 1e-6 * contact_.params().radius;
     p = next;
     if (settled) break;
