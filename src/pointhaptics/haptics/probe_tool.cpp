@@ -20,16 +20,18 @@ double ProbeTool::max_point_stiffness() const {
   return std::max(contact_.params().stiffness, surface_ ? surface_->max_point_stiffness() : 0.0);
 }
 
+namespace {
+
+// the haptic side's local model of a surface contact's load on the probe at p
+ContactModel contact_model_of(const ToolLoad& load, double time, const Vec3& p) {
+  return ContactModel{time, p, load.force, load.stiffness, load.contacts, false};
+}
+
+}  // namespace
+
 ContactModel ProbeTool::surface_model(const Model& model, const State& state, const Vec3& p, bool same_u) {
   surface_->set_pose(ToolPose{p, surface_->pose().orientation});
-  const ToolLoad load = surface_->load(model, state.u, same_u);
-  ContactModel m;
-  m.time = state.time;
-  m.p0 = p;
-  m.f0 = load.force;
-  m.K = load.stiffness;
-  m.contacts = load.contacts;
-  return m;
+  return contact_model_of(surface_->load(model, state.u, same_u), state.time, p);
 }
 
 void ProbeTool::place(const Model& model, const State& state, const Vec3& device, bool button) {
@@ -66,8 +68,7 @@ void ProbeTool::add(const Model& model, const State& state, Points& f) {
     return;
   }
   surface_->add_forces(model, state.u, f);
-  const ToolLoad& load = surface_->last_load();
-  last_ = ContactModel{state.time, probe_, load.force, load.stiffness, load.contacts, false};
+  last_ = contact_model_of(surface_->last_load(), state.time, probe_);
 }
 
 void ProbeTool::after_step(const Model& model, const State& state) {
