@@ -127,8 +127,7 @@ Points mesh_nodes(const BoxProblem& problem) {
   return nodes;
 }
 
-// *MATERIAL with its constitutive card and density (13 significant digits fit ccx's 20-character fields)
-static std::string material_card(const std::string& name, const BoxProblem& p) {
+std::string material_card(const std::string& name, const BoxProblem& p) {
   std::string out = fmt::format("*MATERIAL, NAME={}\n", name);
   switch (p.material) {
     case FemMaterial::ELASTIC: out += fmt::format("*ELASTIC\n{:.13g}, {:.13g}\n", p.young, p.poisson); break;
@@ -389,57 +388,69 @@ std::string find_ccx() {
               "(apt-get install calculix-ccx) or set PH_CCX to its path");
 }
 
-Solution solve(const BoxProblem& problem, int threads, bool partial) {
+CcxRun run_ccx(const std::string& deck, int threads) {
   const std::string ccx = find_ccx();
-  const std::string deck = write_inp(problem);
   std::string dir_template = (std::filesystem::temp_directory_path() / "pointhaptics-ccx-XXXXXX").string();
   if (!::mkdtemp(dir_template.data())) throw Error("CalculiX: cannot create a temporary folder");
-  const std::filesystem::path dir = dir_template;
+  CcxRun run;
+  run.dir = dir_template;
   {
-    std::ofstream inp(dir / "job.inp");
+    std::ofstream inp(run.dir / "job.inp");
     inp << deck;
-    if (!inp) throw Error(fmt::format("CalculiX: cannot write {}", (dir / "job.inp").string()));
+    if (!inp) throw Error(fmt::format("CalculiX: cannot write {}", (run.dir / "job.inp").string()));
   }
   const std::string command =
       fmt::format("cd '{}' && OMP_NUM_THREADS={} CCX_NPROC_EQUATION_SOLVER={} '{}' -i job > ccx.log 2>&1",
-                  dir.string(), std::max(1, threads), std::max(1, threads), ccx);
+                  run.dir.string(), std::max(1, threads), std::max(1, threads), ccx);
   const auto start = std::chrono::steady_clock::now();
-  const int status = std::system(command.c_str());
+  run.status = std::system(command.c_str());
+  run.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return run;
+}
+
+Error CcxRun::failure(const std::string& what) const {
+  std::ifstream log(dir / "ccx.log");
+  std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+  if (text.size() > 600) text = "..." + text.substr(text.size() - 600);
+  return Error(fmt::format("CalculiX run in {} failed: {}; end of ccx.log:\n{}", dir.string(), what, text));
+}
+
+void CcxRun::remove() const {
+  std::error_code ignored;
+  std::filesystem::remove_all(dir, ignored);
+}
+
+Solution solve(const BoxProblem& problem, int threads, bool partial) {
+  const CcxRun run = run_ccx(write_inp(problem), threads);
+  const std::filesystem::path dat_path = run.dir / "job.dat";
   Solution solution;
-  solution.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  auto failure = [&](const std::string& what) {
-    std::ifstream log(dir / "ccx.log");
-    std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
-    if (text.size() > 600) text = "..." + text.substr(text.size() - 600);
-    return Error(fmt::format("CalculiX run in {} failed: {}; end of ccx.log:\n{}", dir.string(), what, text));
-  };
-  std::ifstream dat(dir / "job.dat");
+  solution.wall_s = run.wall_s;
+  std::ifstream dat(dat_path);
   solution.nodes = mesh_nodes(problem);
-  if (status != 0 && partial && dat) {
+  if (run.status != 0 && partial && dat) {
     // the increments ccx finished before it stopped: their reaction totals are in the .dat file (kept)
-    solution.failure = failure(fmt::format("ccx exited with status {}", status)).what();
+    solution.failure = run.failure(fmt::format("ccx exited with status {}", run.status)).what();
     for (size_t s = 0; s < problem.prescribed.size(); ++s) {
-      std::ifstream again(dir / "job.dat");
+      std::ifstream again(dat_path);
       try {
-        solution.reactions.push_back(read_dat_totals(again, fmt::format("NMOVE{}", s + 1), (dir / "job.dat").string()));
+        solution.reactions.push_back(read_dat_totals(again, fmt::format("NMOVE{}", s + 1), dat_path.string()));
       } catch (const Error&) {
         solution.reactions.emplace_back();
       }
     }
     return solution;
   }
-  if (status != 0 || !dat) throw failure(fmt::format("ccx exited with status {}", status));
+  if (run.status != 0 || !dat) throw run.failure(fmt::format("ccx exited with status {}", run.status));
   try {
-    solution.displacement = read_dat_displacements(dat, solution.nodes.cols(), (dir / "job.dat").string());
+    solution.displacement = read_dat_displacements(dat, solution.nodes.cols(), dat_path.string());
     for (size_t s = 0; s < problem.prescribed.size(); ++s) {
-      std::ifstream again(dir / "job.dat");
-      solution.reactions.push_back(read_dat_totals(again, fmt::format("NMOVE{}", s + 1), (dir / "job.dat").string()));
+      std::ifstream again(dat_path);
+      solution.reactions.push_back(read_dat_totals(again, fmt::format("NMOVE{}", s + 1), dat_path.string()));
     }
   } catch (const Error& e) {
-    throw failure(e.what());
+    throw run.failure(e.what());
   }
-  std::error_code ignored;
-  std::filesystem::remove_all(dir, ignored);
+  run.remove();
   return solution;
 }
 

@@ -4,6 +4,9 @@
 #include <pointhaptics/core/parameters.hpp>
 #include <pointhaptics/core/types.hpp>
 
+#include <pointhaptics/core/error.hpp>
+
+#include <filesystem>
 #include <iosfwd>
 #include <string>
 #include <vector>
@@ -116,8 +119,22 @@ Points read_dat_displacements(std::istream& dat, index_t n_nodes, const std::str
 /// The "total force" blocks of *NODE PRINT, TOTALS=ONLY for the set named `set` (upper case), in file order.
 /// Throws Error naming `source` on a malformed block.
 std::vector<Reaction> read_dat_totals(std::istream& dat, const std::string& set, const std::string& source);
+/// *MATERIAL, NAME=name with the problem's constitutive card and density (13 significant digits: they fit ccx's
+/// 20-character fields).
+std::string material_card(const std::string& name, const BoxProblem& problem);
 /// The `ccx` program: $PH_CCX if set, else `ccx` on PATH; throws Error saying how to install it if absent.
 std::string find_ccx();
+/// A deck run by ccx in a fresh temporary folder (job.inp, job.dat, ccx.log).
+struct CcxRun {
+  std::filesystem::path dir;
+  int status = 0;  ///< ccx's exit status
+  double wall_s = 0;
+  /// An error naming the folder (kept for a look), `what` went wrong and the end of ccx.log.
+  Error failure(const std::string& what) const;
+  void remove() const;
+};
+/// Write `deck` into a fresh temporary folder and run ccx there with `threads` threads.
+CcxRun run_ccx(const std::string& deck, int threads);
 /// Write the deck into a fresh temporary folder, run ccx there (threads = OMP_NUM_THREADS), read the
 /// displacements, remove the folder (kept, and named in the error, when ccx fails). `partial`: a run ccx
 /// stopped returns the reactions of the increments it finished, with Solution::failure, instead of throwing.
