@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Plots of `pointhaptics experiment contact`: force against depth beside Hertz, and the sliding forces.
+"""Plots of `pointhaptics experiment contact`: force against depth beside CalculiX and Hertz, and the sliding forces.
 
 usage: plot_contact.py OUT
 """
@@ -27,6 +27,7 @@ def main(out):
         rows = [r for r in force if int(r["spacing_over_r"]) == n]
         left.plot([float(r["depth_over_r"]) for r in rows], [float(r["force_n"]) for r in rows], "o-", label=f"points, spacing R/{n}")
     rows = [r for r in force if int(r["spacing_over_r"]) == spacings[-1]]
+    left.plot([float(r["depth_over_r"]) for r in rows], [float(r["calculix_n"]) for r in rows], "k-", lw=2, label="CalculiX (converged)")
     left.plot([float(r["depth_over_r"]) for r in rows], [float(r["hertz_n"]) for r in rows], "k--", label="Hertz (half-space)")
     left.set_xlabel("depth / R")
     left.set_ylabel("force on the sphere (N)")

@@ -1,6 +1,7 @@
 #pragma once
 /// @file `pointhaptics experiment contact` (issue 16): a rigid sphere pressed into a block through the
-/// object's surface, its force against depth beside Hertz's, at two spacings; where the surface is first
+/// object's surface, its force against depth beside Hertz's and a mesh-converged CalculiX model's
+/// (fem/calculix_indentation), at two spacings; where the surface is first
 /// felt; and the tool sliding at constant depth over the face.
 #include <string>
 #include <vector>
@@ -11,11 +12,17 @@ struct ContactOptions {
   std::string out = "contact-out";
   bool quick = false;                ///< the coarser spacing only, fewer depths (seconds)
   std::vector<int> per_radius{4, 8};  ///< spacings R / n
+  /// the block's material: neo-Hookean by default (St. Venant-Kirchhoff collapses under the sphere past
+  /// about 0.2 R in CalculiX and in the point model alike)
+  std::string material = "neo_hookean";
+  /// CalculiX's element sizes at the contact, R / n: the last one is the reference, the others show its
+  /// convergence (quick: 10 only)
+  std::vector<int> fem_per_radius{10, 20, 40};
   int threads = 0;                   ///< 0: all
   std::string plot_script;           ///< plot_contact.py to use (default: the installed one)
 };
 
-/// Writes contact-force.csv, contact-sliding.csv, summary.md and contact.png into options.out; returns the
+/// Writes contact-force.csv, contact-calculix.csv, contact-sliding.csv, summary.md and contact.png into options.out; returns the
 /// exit code.
 int run_contact_experiment(const ContactOptions& options);
 
