@@ -1,6 +1,7 @@
 #include <pointhaptics/scene_builder.hpp>
 
 #include <pointhaptics/core/error.hpp>
+#include <pointhaptics/geometry/refine_sampling.hpp>
 #include <pointhaptics/geometry/sampling.hpp>
 #include <pointhaptics/io/input_file.hpp>
 #include <pointhaptics/io/mesh_file.hpp>
@@ -73,7 +74,59 @@ bool is_point_cloud_file(const std::string& path) {
   return ext == ".xyz" || ext == ".csv" || ext == ".txt" || (ext == ".ply" && !ply_has_faces(path));
 }
 
-PointCloud sample_object(const Scene& scene) {
+namespace {
+
+// An analytic object's inside test, faces included.
+std::function<bool(const Vec3&)> object_inside(const ObjectSpec& o) {
+  const double tol = 1e-9 * o.spacing;
+  switch (o.shape) {
+    case ShapeKind::BOX:
+      return [=](const Vec3& p) {
+        return ((p - o.origin).array() >= -tol).all() && ((p - o.origin - o.size).array() <= tol).all();
+      };
+    case ShapeKind::SPHERE: return [=](const Vec3& p) { return (p - o.origin).norm() <= o.radius + tol; };
+    case ShapeKind::HALF_SPHERE:
+      return [=](const Vec3& p) { return p.y() >= o.origin.y() - tol && (p - o.origin).norm() <= o.radius + tol; };
+    case ShapeKind::FILE: break;
+  }
+  throw Error("object: a file has no analytic inside test");
+}
+
+// The object's points at a finer spacing within a region's bounds: the box's lattice keeps points on its faces
+// (whole intervals per axis, as sample_box), the balls' is centred as theirs. Volumes are left to refine_region.
+PointCloud fine_lattice(const ObjectSpec& o, double spacing, const Aabb& bounds) {
+  const auto inside = object_inside(o);
+  Vec3 step = Vec3::Constant(spacing), origin = o.origin;
+  if (o.shape == ShapeKind::BOX)
+    for (int a = 0; a < 3; ++a) step[a] = o.size[a] / std::max(1.0, std::round(o.size[a] / spacing));
+  std::array<long, 3> first{}, last{};
+  for (int a = 0; a < 3; ++a) {
+    first[a] = static_cast<long>(std::floor((bounds.min[a] - origin[a]) / step[a] - 1e-9));
+    last[a] = static_cast<long>(std::ceil((bounds.max[a] - origin[a]) / step[a] + 1e-9));
+  }
+  const double near_face = 0.5 * spacing;
+  std::vector<Vec3> points;
+  std::vector<unsigned char> surface;
+  for (long k = first[2]; k <= last[2]; ++k)
+    for (long j = first[1]; j <= last[1]; ++j)
+      for (long i = first[0]; i <= last[0]; ++i) {
+        const Vec3 p = origin + Vec3(static_cast<double>(i), static_cast<double>(j), static_cast<double>(k)).cwiseProduct(step);
+        if (!inside(p)) continue;
+        points.push_back(p);
+        bool on_face = false;
+        for (int a = 0; a < 3; ++a)
+          on_face = on_face || !inside(p + near_face * Vec3::Unit(a)) || !inside(p - near_face * Vec3::Unit(a));
+        surface.push_back(on_face ? 1 : 0);
+      }
+  PointCloud cloud;
+  cloud.spacing = spacing;
+  cloud.X.resize(3, static_cast<index_t>(points.size()));
+  for (std::size_t i = 0; i < points.size(); ++i) cloud.X.col(static_cast<index_t>(i)) = points[i];
+  cloud.surface = std::move(surface);
+  return cloud;
+}
+
+PointCloud sample_shape(const Scene& scene) {
   const ObjectSpec& o = scene.object;
   switch (o.shape) {
     case ShapeKind::BOX: return sample_box(o.origin, o.size, o.spacing);
@@ -92,6 +145,28 @@ PointCloud sample_object(const Scene& scene) {
     }
   }
   throw Error("object: unknown shape");
+}
+
+}  // namespace
+
+PointCloud sample_object(const Scene& scene) {
+  const ObjectSpec& o = scene.object;
+  PointCloud cloud = sample_shape(scene);
+  // [[refine]]: finer points where a tool presses, each with its own support
+  const double support = scene.kernel.support > 0 ? scene.kernel.support : scene.kernel.support_factor * o.spacing;
+  for (const RefineSpec& r : scene.refine) {
+    const double tol = 1e-9 * o.spacing;
+    Aabb bounds = r.bounds();
+    bounds.min.array() -= tol;
+    bounds.max.array() += tol;
+    try {
+      refine_region(cloud, Refinement{[&r](const Vec3& x, double grow) { return r.contains(x, grow); }, fine_lattice(o, r.spacing, bounds)},
+                    object_inside(o), support);
+    } catch (const Error& e) {
+      throw Error(fmt::format("{}:{}: {}", scene.path, r.line, e.what()));
+    }
+  }
+  return cloud;
 }
 
 namespace {

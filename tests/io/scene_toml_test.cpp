@@ -393,6 +393,22 @@ TEST(SceneToml, BadHeldToolIsANamedError) {
             std::string::npos);
 }
 
+TEST(SceneToml, ReadsRefineRegionsAndNamesTheirErrors) {
+  const std::string refine = "\n[[refine]]\nsphere = { centre = [0.0, 0.03, 0.0], radius = 0.01 }\nspacing = 0.003\n";
+  const Scene s = parse_scene(std::string(full_scene) + refine, "t.toml", ".");
+  ASSERT_EQ(s.refine.size(), 1u);
+  EXPECT_DOUBLE_EQ(s.refine[0].spacing, 0.003);
+  ASSERT_TRUE(s.refine[0].sphere.has_value());
+  EXPECT_DOUBLE_EQ(s.refine[0].bounds().max.y(), 0.04);
+  const std::string text = std::string(full_scene) + refine;
+  EXPECT_NE(error_of("spacing = 0.003", "", text).find("needs spacing"), std::string::npos);
+  EXPECT_NE(error_of("spacing = 0.003", "spacing = 0.0075", text).find("refine[0].spacing: 0.0075 is out of range: must be finer"), std::string::npos);
+  EXPECT_NE(error_of("spacing = 0.003", "spacing = 0.0001", text).find("at least a twentieth"), std::string::npos);
+  EXPECT_NE(error_of("sphere = {", "box = { min = [0.0, 0.0, 0.0], max = [0.01, 0.01, 0.01] }\nsphere = {", text)
+                .find("exactly one of box"),
+            std::string::npos);
+}
+
 std::string probe_error(const std::string& find, const std::string& replace) {
   return error_of(find, replace, std::string(full_scene) + probe_section);
 }

@@ -69,6 +69,15 @@ struct PointSelector {
     }
     return (x.array() >= box.min.array() - tol).all() && (x.array() <= box.max.array() + tol).all();
   }
+  /// The region's bounding box.
+  Aabb bounds() const {
+    if (sphere) return {sphere->centre.array() - sphere->radius, sphere->centre.array() + sphere->radius};
+    if (cylinder) {
+      const Vec3 reach = (cylinder->half_length * cylinder->axis).cwiseAbs().array() + cylinder->radius;
+      return {cylinder->centre - reach, cylinder->centre + reach};
+    }
+    return box;
+  }
 };
 
 struct FixedSpec : PointSelector {
@@ -82,6 +91,13 @@ struct FixedSpec : PointSelector {
 struct RegionSpec : PointSelector {
   std::optional<MaterialModel> model;
   std::optional<double> young, poisson, density;  ///< Pa, -, kg/m^3
+  int line = 0;
+};
+
+/// A [[refine]] table: the object's points in the region resampled at a finer spacing (resolution where a tool
+/// presses; geometry/refine_sampling.hpp).
+struct RefineSpec : PointSelector {
+  double spacing = 0;  ///< m, finer than the object's
   int line = 0;
 };
 
@@ -146,6 +162,7 @@ struct Scene {
   KernelParams kernel;
   std::vector<FixedSpec> fixed;
   std::vector<RegionSpec> regions;
+  std::vector<RefineSpec> refine;
   std::vector<LoadSpec> loads;
   SolverSpec solver;
   ProbeSpec probe;

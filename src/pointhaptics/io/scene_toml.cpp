@@ -382,6 +382,16 @@ RegionSpec read_region(TableReader& r) {
   return g;
 }
 
+RefineSpec read_refine(TableReader& r, const ObjectSpec& object) {
+  RefineSpec f;
+  f.line = r.line();
+  read_selector(r, f);
+  if (!r.find("spacing")) r.fail_table("spacing", "a [[refine]] table needs spacing = s (m), finer than the object's");
+  f.spacing = r.number("spacing", 0.0, [&](double s) { return s > 0 && s < object.spacing && s >= 0.05 * object.spacing; },
+                       "must be finer than the object's spacing, and at least a twentieth of it (m)");
+  if (object.shape == ShapeKind::FILE) r.fail_table("spacing", "[[refine]] is for box, sphere and half_sphere objects (not files)");
+  return f;
+}
 
 LoadSpec read_load(TableReader& r) {
   LoadSpec l;
@@ -576,6 +586,9 @@ Scene parse_scene(std::string_view text, const std::string& name, const std::str
   read_array_of_tables(top, "fixed", [&](TableReader& r) { scene.fixed.push_back(read_fixed(r)); });
   read_array_of_tables(top, "region", [&](TableReader& r) { scene.regions.push_back(read_region(r)); });
   read_array_of_tables(top, "load", [&](TableReader& r) { scene.loads.push_back(read_load(r)); });
+  read_array_of_tables(top, "refine", [&](TableReader& r) { scene.refine.push_back(read_refine(r, scene.object)); });
+  if (!scene.refine.empty() && scene.lod.present)
+    throw Error(fmt::format("{}:{}: refine: not yet with levels of detail ([lod] thins a uniform sampling)", name, scene.refine.front().line));
   top.finish();
   if (scene.lod.present && !scene.probe.present && !scene.lod.contact.allFinite()) {
     int point_loads = 0;
