@@ -20,7 +20,7 @@ namespace {
 // the block: 80 x 40 x 80 mm, E = 1e5 Pa, nu = 0.3, bottom held; a rigid sphere of radius 10 mm
 constexpr double R = 0.01, width = 0.08, height = 0.04, young = 1e5, poisson = 0.3;
 
-Scene block_scene(double spacing, MaterialModel model) {
+Scene block_scene(double spacing, MaterialModel model, int refine) {
   Scene s;
   s.path = "contact-block";
   s.object.size = Vec3(width, height, width);
@@ -34,6 +34,13 @@ Scene block_scene(double spacing, MaterialModel model) {
   bottom.box = {Vec3(-1, -1, -1), Vec3(1, 1e-9, 1)};
   s.fixed.push_back(bottom);
   s.solver.kind = SolverKind::STATIC;
+  if (refine > 0) {
+    RefineSpec r;
+    r.box = {Vec3(-1.2 * R, height - 1.2 * R, -1.2 * R), Vec3(1.2 * R, height + R, 1.2 * R)};
+    r.spacing = R / refine;
+    s.refine.push_back(r);
+    s.object.surface_edge = 0.5 * r.spacing;
+  }
   return s;
 }
 
@@ -51,9 +58,9 @@ struct Setup {
   double top = 0;  // the top face's height, m
 };
 
-Setup setup(int per_radius, MaterialModel model, int threads) {
+Setup setup(int per_radius, MaterialModel model, int refine, int threads) {
   Setup s;
-  s.scene = block_scene(R / per_radius, model);
+  s.scene = block_scene(R / per_radius, model, refine);
   s.sim = std::make_unique<Simulation>(build_scene_model(s.scene), s.scene.solver, threads);
   s.surface = build_object_surface(s.scene, s.sim->model());
   s.top = s.surface.mesh.V.row(1).maxCoeff();
@@ -97,7 +104,14 @@ int run_contact_experiment(const ContactOptions& options) {
   namespace fs = std::filesystem;
   fs::create_directories(options.out);
   const fs::path out = options.out;
-  const std::vector<int> spacings = options.quick ? std::vector<int>{options.per_radius.front()} : options.per_radius;
+  // the uniform samplings, then the first one refined near the contact
+  std::vector<std::pair<int, int>> samplings;  // (spacing R / n, refined to R / m near the contact; 0: not)
+  for (const int n : options.quick ? std::vector<int>{options.per_radius.front()} : options.per_radius) samplings.emplace_back(n, 0);
+  if (options.refine > 0) {
+    if (options.refine <= options.per_radius.front())
+      throw Error(fmt::format("experiment contact: --refine {} must be finer than the spacing R/{}", options.refine, options.per_radius.front()));
+    samplings.emplace_back(options.per_radius.front(), options.refine);
+  }
   const std::vector<double> depths = options.quick ? std::vector<double>{0.1, 0.2, 0.3}
                                                    : std::vector<double>{0.05, 0.1, 0.15, 0.2, 0.25, 0.3};
   const std::optional<MaterialModel> model = parse_enum<MaterialModel>(options.material);
@@ -105,7 +119,7 @@ int run_contact_experiment(const ContactOptions& options) {
     throw Error(fmt::format("experiment contact: --material \"{}\" is not one CalculiX has (svk | neo_hookean | mooney_rivlin)",
                             options.material));
   if (options.fem_per_radius.empty()) throw Error("experiment contact: --fem-meshes needs at least one element size");
-  const Scene reference_scene = block_scene(R, *model);
+  const Scene reference_scene = block_scene(R, *model, 0);
   const int fem_threads = options.threads > 0 ? options.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
 
   // CalculiX: the meshes, then at the finest two checks of the model itself (a tenfold contact penalty, and a
@@ -141,13 +155,14 @@ int run_contact_experiment(const ContactOptions& options) {
     depth_rule += "---|";
   }
   auto force_csv = fmt::output_file((out / "contact-force.csv").string());
-  force_csv.print("spacing_over_r,points,depth_over_r,depth_m,force_n,hertz_n,ratio_to_hertz,calculix_n,ratio_to_calculix,contacts,"
+  force_csv.print("spacing_over_r,refine_over_r,points,depth_over_r,depth_m,force_n,hertz_n,ratio_to_hertz,calculix_n,ratio_to_calculix,contacts,"
                   "penetration_m,newton,seconds,physical\n");
   auto sliding_csv = fmt::output_file((out / "contact-sliding.csv").string());
-  sliding_csv.print("spacing_over_r,x_over_spacing,normal_n,tangential_n,contacts\n");
+  sliding_csv.print("spacing_over_r,refine_over_r,x_over_spacing,normal_n,tangential_n,contacts\n");
   std::string table, sliding_table, offsets, goal;
-  for (const int n : spacings) {
-    Setup s = setup(n, *model, options.threads);
+  for (const auto& [n, refine] : samplings) {
+    const std::string label = refine > 0 ? fmt::format("R/{} (R/{} near the contact)", n, refine) : fmt::format("R/{}", n);
+    Setup s = setup(n, *model, refine, options.threads);
     double worst = 0;  // the largest |force / CalculiX - 1| from 0.1 R to 0.3 R
     Simulation& sim = *s.sim;
     HeldTool& tool = *sim.held_tool();
@@ -162,30 +177,30 @@ int run_contact_experiment(const ContactOptions& options) {
         break;
       }
     }
-    offsets += fmt::format("| R/{} | {:.4f} R ({:.3f} mm) |\n", n, (first - s.top) / R, 1e3 * (first - s.top));
+    offsets += fmt::format("| {} | {:.4f} R ({:.3f} mm) |\n", label, (first - s.top) / R, 1e3 * (first - s.top));
     // pressed in, depth by depth, each solve starting from the last
     for (const double d : depths) {
       sim.set_tool_pose(at(0, s.top + R - d * R));
       const auto start = std::chrono::steady_clock::now();
       const StepReport report = sim.step();
       const double took = seconds_since(start);
-      if (report.status == StepStatus::FAILED) throw Error(fmt::format("contact: R/{} at depth {} R: {}", n, d, report.failure));
+      if (report.status == StepStatus::FAILED) throw Error(fmt::format("contact: {} at depth {} R: {}", label, d, report.failure));
       const ToolLoad load = tool.load(sim.model(), sim.state().u);
       const double f = load.force.y(), f_hertz = hertz(d * R), f_fem = reference.solution.force_at(d * R);
       // an equilibrium with inverted neighbourhoods (a material collapsing under the sphere) is no result
       const RunSummary summary = sim.summary();
       const std::string physical = summary.converged ? "yes" : fmt::format("no: {}", summary.failure);
-      force_csv.print("{},{},{},{:.6g},{:.6g},{:.6g},{:.5f},{:.6g},{:.5f},{},{:.3g},{},{:.3f},{}\n", n, sim.model().n_points, d, d * R, f,
+      force_csv.print("{},{},{},{},{:.6g},{:.6g},{:.6g},{:.5f},{:.6g},{:.5f},{},{:.3g},{},{:.3f},{}\n", n, refine, sim.model().n_points, d, d * R, f,
                       f_hertz, f / f_hertz, f_fem, f / f_fem, load.contacts, load.penetration, report.iterations, took,
                       summary.converged ? 1 : 0);
-      table += fmt::format("| R/{} | {} | {:.2f} | {:.4f} | {:.4f} | {:.3f} | {:.4f} | **{:.3f}** | {} | {:.2g} ({:.2g}% of the depth) | {:.1f} | {} |\n",
-                           n, sim.model().n_points, d, f, f_hertz, f / f_hertz, f_fem, f / f_fem, load.contacts, load.penetration,
+      table += fmt::format("| {} | {} | {:.2f} | {:.4f} | {:.4f} | {:.3f} | {:.4f} | **{:.3f}** | {} | {:.2g} ({:.2g}% of the depth) | {:.1f} | {} |\n",
+                           label, sim.model().n_points, d, f, f_hertz, f / f_hertz, f_fem, f / f_fem, load.contacts, load.penetration,
                            100 * load.penetration / (d * R), took, physical);
-      fmt::print("contact: R/{} depth {:.2f} R: {:.4f} N (CalculiX {:.4f} N, ratio {:.3f}; Hertz {:.4f} N), {} contacts, {:.1f} s\n", n, d,
+      fmt::print("contact: {} depth {:.2f} R: {:.4f} N (CalculiX {:.4f} N, ratio {:.3f}; Hertz {:.4f} N), {} contacts, {:.1f} s\n", label, d,
                  f, f_fem, f / f_fem, f_hertz, load.contacts, took);
       if (d >= 0.1 - 1e-9) worst = std::max(worst, std::abs(f / f_fem - 1));
     }
-    goal += fmt::format("| R/{} | {:.1f}% |\n", n, 100 * worst);
+    goal += fmt::format("| {} | {:.1f}% |\n", label, 100 * worst);
     // sliding, frictionless, at 0.1 R deep over two spacings of the lattice (quasi-static: each an equilibrium)
     sim.set_tool_pose(at(0, s.top + R - 0.1 * R));
     sim.step();
@@ -194,17 +209,17 @@ int run_contact_experiment(const ContactOptions& options) {
       const double x = k * spacing / 8;
       sim.set_tool_pose(at(x, s.top + R - 0.1 * R));
       const StepReport report = sim.step();
-      if (report.status == StepStatus::FAILED) throw Error(fmt::format("contact: sliding at R/{}: {}", n, report.failure));
+      if (report.status == StepStatus::FAILED) throw Error(fmt::format("contact: sliding at {}: {}", label, report.failure));
       const ToolLoad load = tool.load(sim.model(), sim.state().u);
       normal.push_back(load.force.y());
       tangential.push_back(std::hypot(load.force.x(), load.force.z()));
-      sliding_csv.print("{},{:.4f},{:.6g},{:.6g},{}\n", n, x / spacing, load.force.y(), tangential.back(), load.contacts);
+      sliding_csv.print("{},{},{:.4f},{:.6g},{:.6g},{}\n", n, refine, x / spacing, load.force.y(), tangential.back(), load.contacts);
     }
     double mean = 0, var = 0, worst_tangential = 0;
     for (double v : normal) mean += v / static_cast<double>(normal.size());
     for (double v : normal) var += (v - mean) * (v - mean) / static_cast<double>(normal.size());
     for (double t : tangential) worst_tangential = std::max(worst_tangential, t);
-    sliding_table += fmt::format("| R/{} | {:.4f} | {:.2f}% | {:.2f}% |\n", n, mean, 100 * std::sqrt(var) / mean, 100 * worst_tangential / mean);
+    sliding_table += fmt::format("| {} | {:.4f} | {:.2f}% | {:.2f}% |\n", label, mean, 100 * std::sqrt(var) / mean, 100 * worst_tangential / mean);
   }
   force_csv.close();
   sliding_csv.close();

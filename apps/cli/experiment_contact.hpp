@@ -18,6 +18,9 @@ struct ContactOptions {
   /// CalculiX's element sizes at the contact, R / n: the last one is the reference, the others show its
   /// convergence (quick: 10 only)
   std::vector<int> fem_per_radius{10, 20, 40};
+  /// > 0: the first spacing once more with the points near the contact (a box 1.2 R around it, down to 1.2 R
+  /// deep) at spacing R / refine and the surface's edge half that ([[refine]]); 0: uniform samplings only
+  int refine = 8;
   int threads = 0;                   ///< 0: all
   std::string plot_script;           ///< plot_contact.py to use (default: the installed one)
 };
