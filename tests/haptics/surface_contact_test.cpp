@@ -2,7 +2,9 @@
 // forces' derivative (finite differences, sphere and capsule, with and without multipliers); the load on the
 // tool balances what the points get; a capsule's off-centre contact has the torque of its forces; a tool
 // held at a position in a static solve leaves no vertex inside it beyond the tolerance and pushes the
-// object with the force the supports resist.
+// object with the force the supports resist; with Coulomb friction the forces stay the energy's gradient, a
+// small move of the pressed tool sticks (a tangential force inside the cone) and a longer one slides with mu
+// times the normal force.
 #include <pointhaptics/geometry/sampling.hpp>
 #include <pointhaptics/geometry/shape_surfaces.hpp>
 #include <pointhaptics/haptics/surface_contact.hpp>
@@ -157,6 +159,80 @@ TEST(SurfaceContact, StaticIndentationMeetsTheConstraintAndBalancesTheSupports) 
   for (index_t v = 0; v < y.cols(); ++v)
     if (surface.V(1, v) > 0.02 - 1e-9 && (surface.V.col(v) - Vec3(0.02, 0.02, 0.02)).norm() < 1e-9) lowest_top = y(1, v);
   EXPECT_NEAR(lowest_top, 0.02 - depth, 0.01 * depth);
+}
+
+TEST(SurfaceContact, FrictionForcesAreTheEnergyGradientAndTheTangentTheirDerivative) {
+  const Block b = block();
+  for (const ToolCase& t : tools()) {
+    SCOPED_TRACE(t.name);
+    SurfaceContactParams params;
+    params.friction = 0.3;
+    SurfaceContact contact(b.model, b.surface, build_surface_map(b.model, b.surface.V), t.shape, params);
+    contact.set_pose(t.pose);
+    const Points u = random_field(b.model.n_points, 1e-4, 3);
+    ASSERT_FALSE(contact.update_multipliers(b.model, u));  // multipliers, and anchors where the vertices are
+    ToolPose moved = t.pose;
+    moved.position += Vec3(3e-4, 0, -2e-4);  // the anchors move with the tool: the vertices are dragged
+    contact.set_pose(moved);
+    Points f = Points::Zero(3, b.model.n_points);
+    contact.add_forces(b.model, u, f);
+    const ToolLoad load = contact.load(b.model, u);
+    ASSERT_GT(std::hypot(load.force.x(), load.force.z()), 0.0);
+    EXPECT_LT((load.force + f.rowwise().sum()).norm(), 1e-9 * load.force.norm());
+    const Points du = random_field(b.model.n_points, 1e-4, 5);
+    const double eps = 1e-4;
+    const double dE = (contact.energy(b.model, u + eps * du) - contact.energy(b.model, u - eps * du)) / (2 * eps);
+    EXPECT_NEAR(dE, -dot(f, du), 1e-6 * std::abs(dot(f, du)));
+    contact.linearise(b.model, u, TangentMode::EXACT);
+    Points Hdu = Points::Zero(3, b.model.n_points);
+    contact.add_tangent_product(du, Hdu);
+    Points f_plus = Points::Zero(3, b.model.n_points), f_minus = Points::Zero(3, b.model.n_points);
+    contact.add_forces(b.model, u + eps * du, f_plus);
+    contact.add_forces(b.model, u - eps * du, f_minus);
+    const Points fd = -(f_plus - f_minus) / (2 * eps);
+    EXPECT_LT((Hdu - fd).norm(), 1e-5 * fd.norm());
+  }
+}
+
+TEST(SurfaceContact, FrictionSticksForASmallMoveAndSlidesWithMuTimesTheNormalForce) {
+  Block b = block(true);
+  const TriangleMesh surface = b.surface;
+  SolverSpec spec;
+  spec.kind = SolverKind::STATIC;
+  Simulation sim(std::move(b.model), spec, 2);
+  const double radius = 0.01, depth = 0.001, mu = 0.3;
+  SurfaceContactParams params;
+  params.friction = mu;
+  const auto at = [&](double x) { return ToolPose{Vec3(0.02 + x, 0.02 + radius - depth, 0.02), Eigen::Quaterniond::Identity()}; };
+  sim.hold_tool(ToolShape{ToolKind::SPHERE, radius, 0}, at(0), surface, build_surface_map(sim.model(), surface.V), params);
+  const StepReport first = sim.step();
+  ASSERT_EQ(first.status, StepStatus::CONVERGED) << first.failure;
+  const double pressed = sim.summary().tool.force.y();
+  EXPECT_LT(std::abs(sim.summary().tool.force.x()), 1e-6 * pressed);  // straight down: no drag
+  // a small move sticks: the tool drags the surface along, resisted by less than mu N
+  sim.set_tool_pose(at(1e-5));
+  const StepReport small = sim.step();
+  ASSERT_EQ(small.status, StepStatus::CONVERGED) << small.failure;
+  RunSummary s = sim.summary();
+  EXPECT_LT(s.tool.force.x(), -0.01 * mu * s.tool.force.y());  // the object holds the tool back
+  EXPECT_GT(s.tool.force.x(), -mu * s.tool.force.y());
+  // a longer one slides: mu times the normal force, against the motion
+  for (int k = 1; k <= 8; ++k) {
+    sim.set_tool_pose(at(k * 5e-4));
+    const StepReport slid = sim.step();
+    ASSERT_EQ(slid.status, StepStatus::CONVERGED) << k << ": " << slid.failure;
+  }
+  s = sim.summary();
+  // the friction's part of the force is mu times the pressure's, against the motion; the whole force on the
+  // tool also has the tilted normals' share (this coarse surface holds one or two vertices under the tool)
+  const ToolLoad load = sim.held_tool()->load(sim.model(), sim.state().u);
+  const Vec3 pressure = load.force - load.friction;
+  EXPECT_NEAR(load.friction.norm() / pressure.norm(), mu, 0.05 * mu);
+  EXPECT_LT(load.friction.x(), -0.95 * load.friction.norm());
+  EXPECT_LT(s.tool.force.x(), -0.5 * mu * s.tool.force.y());
+  EXPECT_LT(s.tool.penetration, 0.01 * depth);
+  // the supports hold what the tool does to the object, along x too
+  EXPECT_NEAR(s.reactions[0].x(), s.tool.force.x(), 1e-3 * s.tool.force.y());
 }
 
 }  // namespace

@@ -26,6 +26,9 @@ SurfaceContact::SurfaceContact(const Model& model, const TriangleMesh& mesh, Sur
   penalty_.resize(area.size());
   for (std::size_t v = 0; v < area.size(); ++v) penalty_[v] = per_area * std::max(area[v], 1e-30);
   lambda_.assign(area.size(), 0.0);
+  if (!(params.friction >= 0) || !std::isfinite(params.friction)) throw Error("tool: friction must be >= 0");
+  friction_ = params.friction;
+  if (friction_ > 0) anchors_.assign(area.size(), Anchor{});
   tolerance_ = params.tolerance > 0 ? params.tolerance : 1e-4 * shape.radius;
   // the explicit stable step's bound: a point's contact stiffness is at most sum_v k_v w_vj^2
   std::vector<double> stiffness(static_cast<std::size_t>(model.n_points), 0.0);
@@ -59,7 +62,29 @@ double SurfaceContact::energy(const Model&, const Points& u) {
     const double t = std::max(lambda + k * tool_distance(shape_, pose_, y_.col(v)).penetration(shape_), 0.0);
     e += (t * t - lambda * lambda) / (2 * k);
   }
+  // friction: quadratic in the trial force inside the cone, linear beyond it (so a slide is one minimisation,
+  // not one multiplier update per penalty's worth of slip)
+  for (index_t v = 0; v < static_cast<index_t>(anchors_.size()); ++v) {
+    const Anchor& a = anchors_[static_cast<std::size_t>(v)];
+    if (!a.held) continue;
+    const double k = penalty_[static_cast<std::size_t>(v)], cone = friction_cone(v), t = friction_trial(v).norm();
+    e += (t <= cone ? t * t : 2 * cone * t - cone * cone) / (2 * k) - a.tau.squaredNorm() / (2 * k);
+  }
   return e;
+}
+
+Vec3 SurfaceContact::friction_trial(index_t v) const {
+  const Anchor& a = anchors_[static_cast<std::size_t>(v)];
+  const Vec3 slip = a.tangent * (y_.col(v) - (pose_.position + pose_.orientation * a.local));
+  return a.tau + penalty_[static_cast<std::size_t>(v)] * slip;
+}
+
+double SurfaceContact::friction_cone(index_t v) const { return friction_ * lambda_[static_cast<std::size_t>(v)]; }
+
+Vec3 SurfaceContact::friction_force(index_t v) const {
+  const Vec3 t = friction_trial(v);
+  const double cone = friction_cone(v), norm = t.norm();
+  return norm > cone ? Vec3(cone / norm * t) : t;
 }
 
 template <class Pressing>
@@ -80,6 +105,14 @@ ToolLoad SurfaceContact::for_each_pressing(const Pressing& pressing) const {
     ++out.contacts;
     pressing(v, d, pressure);
   }
+  // friction: the anchored vertices drag the tool (acting where they are)
+  for (index_t v = 0; v < static_cast<index_t>(anchors_.size()); ++v) {
+    if (!anchors_[static_cast<std::size_t>(v)].held) continue;
+    const Vec3 on_tool = friction_force(v);
+    out.force += on_tool;
+    out.friction += on_tool;
+    out.torque += (y_.col(v) - pose_.position).cross(on_tool);
+  }
   return out;
 }
 
@@ -89,6 +122,11 @@ void SurfaceContact::add_forces(const Model&, const Points& u, Points& f) {
     const Vec3 force = pressure * d.normal;  // on the vertex, out of the tool
     for (index_t e = map_.points.begin(v); e < map_.points.end(v); ++e) f.col(map_.points.index[e]) += map_.weight[e] * force;
   });
+  for (index_t v = 0; v < static_cast<index_t>(anchors_.size()); ++v) {
+    if (!anchors_[static_cast<std::size_t>(v)].held) continue;
+    const Vec3 force = -friction_force(v);  // on the vertex, toward its anchor
+    for (index_t e = map_.points.begin(v); e < map_.points.end(v); ++e) f.col(map_.points.index[e]) += map_.weight[e] * force;
+  }
 }
 
 void SurfaceContact::linearise(const Model&, const Points& u, TangentMode mode) {
@@ -102,8 +140,17 @@ void SurfaceContact::linearise(const Model&, const Points& u, TangentMode mode) 
       const Mat3 along = Mat3::Identity() - d.axis * d.axis.transpose();
       hessian -= (pressure / d.from_core) * off_normal * along;
     }
-    active_.push_back({v, d.normal, pressure, hessian});
+    active_.push_back({v, d.normal, pressure, hessian, penalty_[static_cast<std::size_t>(v)] * d.normal * d.normal.transpose()});
   });
+  for (index_t v = 0; v < static_cast<index_t>(anchors_.size()); ++v) {
+    const Anchor& a = anchors_[static_cast<std::size_t>(v)];
+    if (!a.held) continue;
+    const Vec3 t = friction_trial(v);
+    const double k = penalty_[static_cast<std::size_t>(v)], cone = friction_cone(v), norm = t.norm();
+    // inside the cone k P; beyond it the clamped force's derivative, (cone k / |t|) (P - t^ t^T)
+    const Mat3 hessian = norm <= cone ? Mat3(k * a.tangent) : Mat3(cone * k / norm * (a.tangent - t * t.transpose() / (norm * norm)));
+    active_.push_back({v, Vec3::Zero(), 0.0, hessian, hessian});
+  }
 }
 
 void SurfaceContact::add_tangent_product(const Points& dx, Points& out) const {
@@ -116,20 +163,53 @@ void SurfaceContact::add_tangent_product(const Points& dx, Points& out) const {
 }
 
 void SurfaceContact::add_diagonal_blocks(Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks) const {
-  // the normal stiffness only: the preconditioner wants positive blocks
-  for (const Active& a : active_) {
-    const Mat3 normal = penalty_[static_cast<std::size_t>(a.vertex)] * a.normal * a.normal.transpose();
+  // the positive parts only (the normal and the friction's stiffness): the preconditioner wants positive blocks
+  for (const Active& a : active_)
     for (index_t e = map_.points.begin(a.vertex); e < map_.points.end(a.vertex); ++e)
-      Eigen::Map<Mat3>(blocks.col(map_.points.index[e]).data()) += map_.weight[e] * map_.weight[e] * normal;
-  }
+      Eigen::Map<Mat3>(blocks.col(map_.points.index[e]).data()) += map_.weight[e] * map_.weight[e] * a.preconditioner;
 }
 
 bool SurfaceContact::update_multipliers(const Model& model, const Points& u) {
-  if (load(model, u).penetration <= tolerance_) return true;
+  bool met = load(model, u).penetration <= tolerance_;
+  for (index_t v = 0; v < static_cast<index_t>(anchors_.size()); ++v) {
+    Anchor& a = anchors_[static_cast<std::size_t>(v)];
+    if (!a.held) {
+      met = met && lambda_[static_cast<std::size_t>(v)] == 0;  // pressing without an anchor: anchor it first
+      continue;
+    }
+    const double k = penalty_[static_cast<std::size_t>(v)];
+    const Vec3 t = friction_trial(v), clamped = friction_force(v);
+    // a sticking vertex is done on its anchor, a sliding one when its force stopped changing
+    met = met && (clamped - a.tau).norm() <= k * tolerance_;
+    // beyond the cone the anchor follows the vertex (the slide so far), the force unchanged
+    if ((t - clamped).squaredNorm() > 0) a.local += pose_.orientation.conjugate() * Vec3((t - clamped) / k);
+  }
+  if (met) return true;
   for (index_t v = 0; v < y_.cols(); ++v) {
     double& lambda = lambda_[static_cast<std::size_t>(v)];
     const double k = penalty_[static_cast<std::size_t>(v)];
-    lambda = std::max(lambda + k * tool_distance(shape_, pose_, y_.col(v)).penetration(shape_), 0.0);
+    const ToolDistance d = tool_distance(shape_, pose_, y_.col(v));
+    lambda = std::max(lambda + k * d.penetration(shape_), 0.0);
+    if (anchors_.empty()) continue;
+    Anchor& a = anchors_[static_cast<std::size_t>(v)];
+    if (lambda == 0) {
+      a = Anchor{};  // lifted off: free again
+      continue;
+    }
+    const Mat3 tangent = Mat3::Identity() - d.normal * d.normal.transpose();
+    if (!a.held) {
+      // touches: anchored where it is as seen by the tool before its last move (so in a quasi-static step
+      // it slides at once, as it would have under the moving tool)
+      a.local = previous_pose_.orientation.conjugate() * (y_.col(v) - previous_pose_.position);
+      a.tangent = tangent;
+      a.held = true;
+    }
+    // the trial force on the new tangent plane, put on the new cone if beyond it (the anchor then follows)
+    const Vec3 t = tangent * friction_trial(v);
+    const double cone = friction_ * lambda;
+    a.tau = t.norm() > cone ? Vec3(cone / t.norm() * t) : t;
+    if (t.norm() > cone) a.local = pose_.orientation.conjugate() * (y_.col(v) - pose_.position);
+    a.tangent = tangent;
   }
   return false;
 }
@@ -139,6 +219,9 @@ ToolLoad SurfaceContact::load(const Model&, const Points& u, bool same_u) {
   return for_each_pressing([](index_t, const ToolDistance&, double) {});
 }
 
-void SurfaceContact::reset_multipliers() { std::fill(lambda_.begin(), lambda_.end(), 0.0); }
+void SurfaceContact::reset_multipliers() {
+  std::fill(lambda_.begin(), lambda_.end(), 0.0);
+  std::fill(anchors_.begin(), anchors_.end(), Anchor{});
+}
 
 }  // namespace pointhaptics

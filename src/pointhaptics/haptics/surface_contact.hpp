@@ -8,6 +8,15 @@
 /// stiffness that makes the tangent ill conditioned to reach the 1% of the depth; the multipliers
 /// reach any tolerance with a penalty of the object's own stiffness. Forces on the vertices reach the points
 /// by W^T (virtual work), and the tool feels their opposite.
+///
+/// Coulomb friction (friction > 0) is met the same way (Simo and Laursen's augmented Lagrangian): a pressing
+/// vertex sticks to an anchor on the tool (kept in the tool's frame, so it follows the tool), and adds
+///   E_t = sum_v (|tau_v + k_v s_v|^2 - |tau_v|^2) / (2 k_v),  s_v = P_v (y_v - anchor_v),
+/// with P_v the projection off the normal frozen at the last update, while the trial force t = tau_v + k_v s_v
+/// lies in the cone |t| <= friction x lambda_v (stick), and linear in |t| beyond it (slip: the force stays on
+/// the cone, so a slide is one minimisation). Between minimisations tau_v takes the trial force (put on the
+/// cone, the anchor then moving to the vertex); the solve is done when no sticking vertex strays from its
+/// anchor, and no sliding one's force changes, by more than the tolerance's worth of penalty.
 #include <pointhaptics/core/model.hpp>
 #include <pointhaptics/geometry/triangle_mesh.hpp>
 #include <pointhaptics/haptics/tool_shape.hpp>
@@ -29,11 +38,14 @@ struct SurfaceContactParams {
   /// If > 0, N/m: the penalty is lowered so that no point's contact stiffness (sum_v k_v w_vj^2) exceeds it
   /// (explicit dynamics, whose stable sub-step it would otherwise shorten).
   double max_point_stiffness = 0;
+  /// Coulomb's coefficient (0: frictionless). The static solver meets it; dynamics ignores it so far.
+  double friction = 0;
 };
 
 /// What the object does to the tool.
 struct ToolLoad {
   Vec3 force = Vec3::Zero();   ///< N, on the tool, scene axes
+  Vec3 friction = Vec3::Zero();  ///< N: the part of `force` friction makes (the rest is the normal pressure's)
   Vec3 torque = Vec3::Zero();  ///< N m, about the tool's position
   int contacts = 0;            ///< vertices pressing on it
   double penetration = 0;      ///< deepest vertex inside the tool, m (0: none)
@@ -48,7 +60,13 @@ class SurfaceContact final : public EnergyTerm {
   SurfaceContact(const Model& model, const TriangleMesh& mesh, SurfaceMap map, const ToolShape& shape,
                  const SurfaceContactParams& params = {});
 
-  void set_pose(const ToolPose& pose) { pose_ = pose; }
+  /// Moves the tool; the pose it leaves is kept for friction (a vertex touching during the move is anchored
+  /// as if it had touched before it, so it slides at once as the tool moves on it).
+  void set_pose(const ToolPose& pose) {
+    previous_pose_ = posed_ ? pose_ : pose;
+    pose_ = pose;
+    posed_ = true;
+  }
   const ToolPose& pose() const { return pose_; }
   const ToolShape& shape() const { return shape_; }
   double tolerance() const { return tolerance_; }
@@ -66,8 +84,9 @@ class SurfaceContact final : public EnergyTerm {
   ToolLoad load(const Model& model, const Points& u, bool same_u = false);
   /// The load of the last add_forces(), which computes it on the way.
   const ToolLoad& last_load() const { return last_load_; }
-  /// Forget the multipliers (the tool lifted off, or moved far).
+  /// Forget the multipliers and the friction's anchors (the tool lifted off, or moved far).
   void reset_multipliers();
+  double friction() const { return friction_; }
   /// Upper bound of the contact's stiffness on one point, N/m (explicit stable step): max_j sum_v k_v w_vj^2.
   double max_point_stiffness() const { return max_point_stiffness_; }
   /// The deformed vertices of the last evaluation.
@@ -80,7 +99,22 @@ class SurfaceContact final : public EnergyTerm {
     Vec3 normal;
     double pressure;  // <lambda + k g>, N
     Mat3 hessian;     // d2E/dy2 at the vertex
+    Mat3 preconditioner;  // its positive part
   };
+  /// A vertex stuck to the tool (friction): where, in the tool's frame, the projection off the normal frozen
+  /// at the last update, and the tangential multiplier.
+  struct Anchor {
+    Vec3 local = Vec3::Zero();
+    Mat3 tangent = Mat3::Zero();
+    Vec3 tau = Vec3::Zero();
+    bool held = false;
+  };
+  /// The friction's trial force on the tool from an anchored vertex v at y_: tau + k s.
+  Vec3 friction_trial(index_t v) const;
+  /// Its cone's radius: friction x the vertex's normal multiplier.
+  double friction_cone(index_t v) const;
+  /// The force itself: the trial force put on the cone when beyond it.
+  Vec3 friction_force(index_t v) const;
   /// y = Y + W u, the vertices that can touch the tool, and their contact values.
   void evaluate(const Points& u);
   /// The load of the vertices pressing on the tool at y_, calling pressing(v, distance, pressure) for each.
@@ -90,11 +124,13 @@ class SurfaceContact final : public EnergyTerm {
   Points Y_, y_;
   SurfaceMap map_;
   ToolShape shape_;
-  ToolPose pose_;
+  ToolPose pose_, previous_pose_;
   std::vector<double> penalty_, lambda_;  // per vertex
+  std::vector<Anchor> anchors_;           // per vertex, with friction
   std::vector<Active> active_;            // at the last linearise()
   ToolLoad last_load_;
-  double tolerance_ = 0, max_point_stiffness_ = 0;
+  double tolerance_ = 0, max_point_stiffness_ = 0, friction_ = 0;
+  bool posed_ = false;
 };
 
 }  // namespace pointhaptics
