@@ -27,7 +27,10 @@ SceneSession open_scene(Scene scene, const SessionOptions& options) {
     shape.radius = scene.probe.radius;
     shape.length = scene.probe.length;
     const auto& q = scene.probe.orientation;
-    s.simulation->hold_tool(shape, ToolPose{scene.probe.position, Eigen::Quaterniond(q[0], q[1], q[2], q[3])}, surface.mesh, surface.map);
+    SurfaceContactParams contact;
+    contact.friction = scene.probe.friction;
+    s.simulation->hold_tool(shape, ToolPose{scene.probe.position, Eigen::Quaterniond(q[0], q[1], q[2], q[3])}, surface.mesh, surface.map,
+                            contact);
   } else if (scene.probe.present) {
     s.interactive = scene_interactive_options(scene, s.simulation->model());
     // the probe pushes on the object's surface; with levels of detail on the point spheres (the surface's map

@@ -167,12 +167,12 @@ ToolSummary Simulation::tool_summary() {
   if (HeldTool* tool = sim.held_tool().get()) {
     const ToolLoad load = tool->load(sim.model(), sim.state().u);
     return {true, tool->shape().kind == ToolKind::CAPSULE ? "capsule" : "sphere", tool->pose().position, load.force, load.torque,
-            load.contacts, load.penetration};
+            load.contacts, load.penetration, load.friction};
   }
   if (const ProbeTool* probe = this->probe()) {
     // the probe's local model at the last step's end: the force the object exerts on it there
     const ContactModel& c = probe->contact_model();
-    return {true, "sphere", probe->probe(), c.f0, Vec3::Zero(), c.contacts, 0.0};
+    return {true, "sphere", probe->probe(), c.f0, Vec3::Zero(), c.contacts, 0.0, Vec3::Zero()};
   }
   return {};
 }

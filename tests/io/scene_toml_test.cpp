@@ -366,6 +366,7 @@ position = [0.0, 0.06, 0.0]
 shape = "capsule"
 length = 0.02
 orientation = [0.0, 1.0, 0.0, 0.0]
+friction = 0.3
 )";
 
 TEST(SceneToml, ReadsAHeldTool) {
@@ -377,6 +378,7 @@ TEST(SceneToml, ReadsAHeldTool) {
   EXPECT_DOUBLE_EQ(s.probe.length, 0.02);
   EXPECT_DOUBLE_EQ(s.probe.position.y(), 0.06);
   EXPECT_DOUBLE_EQ(s.probe.orientation[1], 1.0);
+  EXPECT_DOUBLE_EQ(s.probe.friction, 0.3);
 }
 
 TEST(SceneToml, BadHeldToolIsANamedError) {
@@ -384,12 +386,13 @@ TEST(SceneToml, BadHeldToolIsANamedError) {
   const auto error = [&](const std::string& find, const std::string& replace) { return error_of(find, replace, text); };
   EXPECT_NE(error("length = 0.02", "").find("probe.length: a capsule needs length > 0"), std::string::npos);
   EXPECT_NE(error("shape = \"capsule\"", "").find("only a capsule has a length"), std::string::npos);
+  EXPECT_NE(error("friction = 0.3", "friction = -1").find("probe.friction"), std::string::npos);
   EXPECT_NE(error("shape = \"capsule\"", "shape = \"cone\"").find("probe.shape: unknown value \"cone\""), std::string::npos);
   EXPECT_NE(error("[0.0, 1.0, 0.0, 0.0]", "[1.0, 1.0, 0.0, 0.0]").find("norm is 1.41421, not 1"), std::string::npos);
   EXPECT_NE(error("[0.0, 1.0, 0.0, 0.0]", "[1.0, 0.0]").find("unit quaternion [w, x, y, z]"), std::string::npos);
   EXPECT_NE(error("length = 0.02", "length = 0.02\nkeyframes = [[0.0, 0.0, 0.0, 0.0]]").find("no trajectory or keyframes"),
             std::string::npos);
-  EXPECT_NE(error("[0.0, 1.0, 0.0, 0.0]", "[0.0, 1.0, 0.0, 0.0]\n[device]\nkind = \"virtual\"").find("not driven by a [device]"),
+  EXPECT_NE(error("friction = 0.3", "friction = 0.3\n[device]\nkind = \"virtual\"").find("not driven by a [device]"),
             std::string::npos);
 }
 
@@ -411,6 +414,11 @@ TEST(SceneToml, ReadsRefineRegionsAndNamesTheirErrors) {
 
 std::string probe_error(const std::string& find, const std::string& replace) {
   return error_of(find, replace, std::string(full_scene) + probe_section);
+}
+
+TEST(SceneToml, FrictionIsForAHeldToolSoFar) {
+  EXPECT_NE(probe_error("radius = 0.01", "radius = 0.01\nfriction = 0.3").find("probe.friction: only a tool held at a position"),
+            std::string::npos);
 }
 
 TEST(SceneToml, BadProbeOrDeviceIsANamedError) {

@@ -57,7 +57,8 @@ std::string result_json(const Model& model, const State& state, const RunSummary
   if (s.tool.present) {
     const ToolSummary& t = s.tool;
     doc["tool"] = {{"kind", t.kind},         {"position", vec(t.position)}, {"force", vec(t.force)},
-                   {"torque", vec(t.torque)}, {"contacts", t.contacts},       {"penetration", t.penetration}};
+                   {"torque", vec(t.torque)}, {"contacts", t.contacts},       {"penetration", t.penetration},
+                   {"friction", vec(t.friction)}};
   }
   // without levels of detail every point is simulated
   const LodSummary& l = s.lod;

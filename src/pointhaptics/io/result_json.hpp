@@ -33,6 +33,7 @@ struct ToolSummary {
   Vec3 torque = Vec3::Zero();                ///< N m, about its position
   int contacts = 0;                          ///< surface vertices (probe on points: points) pressing on it
   double penetration = 0;                    ///< deepest surface vertex inside the tool, m (held tools)
+  Vec3 friction = Vec3::Zero();              ///< N, the part of `force` friction makes (held tools with friction)
 };
 
 struct RunSummary {

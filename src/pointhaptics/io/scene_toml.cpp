@@ -447,6 +447,7 @@ void read_probe(TableReader& r, ProbeSpec& p, const Context& ctx) {
   p.length = r.number("length", p.length, non_negative, "must be >= 0 (m)");
   if (p.capsule && !(p.length > 0)) r.fail_table("length", "a capsule needs length > 0 (m): its axis segment");
   if (!p.capsule && r.find("length")) r.fail_at(*r.find("length"), "length", "only a capsule has a length (shape = \"capsule\")");
+  p.friction = r.number("friction", p.friction, [](double m) { return m >= 0 && m <= 10; }, "must be in [0, 10]");
   if (r.find("position")) {
     p.position = r.vec3("position", p.position);
     if (r.find("trajectory") || r.find("keyframes"))
@@ -574,6 +575,10 @@ Scene parse_scene(std::string_view text, const std::string& name, const std::str
       scene.probe.keyframes.empty())
     throw Error(fmt::format("{}:{}: probe: a virtual device needs trajectory = \"probe.csv\" or keyframes = [[t, x, y, z], ...] "
                             "(or position = [x, y, z] for a tool held there)",
+                            name, scene.probe.line));
+  if (scene.probe.present && !scene.probe.held() && scene.probe.friction > 0)
+    throw Error(fmt::format("{}:{}: probe.friction: only a tool held at a position (position = [x, y, z]) has friction so far; "
+                            "a device's probe is frictionless",
                             name, scene.probe.line));
   if (scene.probe.held() && root.get("device"))
     throw Error(fmt::format("{}:{}: probe: a tool held at a position is not driven by a [device]", name, scene.probe.line));
