@@ -58,14 +58,16 @@ struct Setup {
   double top = 0;  // the top face's height, m
 };
 
-Setup setup(int per_radius, MaterialModel model, int refine, int threads) {
+Setup setup(int per_radius, MaterialModel model, int refine, int threads, double friction = 0) {
   Setup s;
   s.scene = block_scene(R / per_radius, model, refine);
   s.sim = std::make_unique<Simulation>(build_scene_model(s.scene), s.scene.solver, threads);
   s.surface = build_object_surface(s.scene, s.sim->model());
   s.top = s.surface.mesh.V.row(1).maxCoeff();
+  SurfaceContactParams contact;
+  contact.friction = friction;
   s.sim->hold_tool(ToolShape{ToolKind::SPHERE, R, 0}, ToolPose{Vec3(0, s.top + 2 * R, 0), Eigen::Quaterniond::Identity()},
-                   s.surface.mesh, s.surface.map);
+                   s.surface.mesh, s.surface.map, contact);
   return s;
 }
 
@@ -223,6 +225,58 @@ int run_contact_experiment(const ContactOptions& options) {
   }
   force_csv.close();
   sliding_csv.close();
+
+  // friction: the last sampling once more with Coulomb friction, pressed 0.1 R deep, nudged (it sticks), then
+  // dragged along x (a spacing to reach steady sliding, then 8 equilibria over the next)
+  auto friction_csv = fmt::output_file((out / "contact-friction.csv").string());
+  friction_csv.print("spacing_over_r,refine_over_r,x_over_spacing,pressure_n,friction_n,friction_over_pressure,drag_over_normal\n");
+  std::string friction_table;
+  {
+    const auto [n, refine] = samplings.back();
+    const std::string label = refine > 0 ? fmt::format("R/{} (R/{} near the contact)", n, refine) : fmt::format("R/{}", n);
+    Setup s = setup(n, *model, refine, options.threads, options.friction);
+    Simulation& sim = *s.sim;
+    HeldTool& tool = *sim.held_tool();
+    const double spacing = R / n, height = s.top + R - 0.1 * R;
+    struct Sample {
+      double pressure, friction, drag;
+    };
+    auto move_to = [&](double x) {
+      sim.set_tool_pose(at(x, height));
+      const StepReport report = sim.step();
+      if (report.status == StepStatus::FAILED)
+        throw Error(fmt::format("contact: friction at {}, x = {:.4f} spacing: {}", label, x / spacing, report.failure));
+      const ToolLoad load = tool.load(sim.model(), sim.state().u);
+      const Vec3 pressure = load.force - load.friction;
+      const Sample sample{pressure.norm(), load.friction.norm(), -load.force.x() / load.force.y()};
+      friction_csv.print("{},{},{:.4f},{:.6g},{:.6g},{:.5f},{:.5f}\n", n, refine, x / spacing, sample.pressure, sample.friction,
+                         sample.friction / sample.pressure, sample.drag);
+      return sample;
+    };
+    // pressed in steps from first touch (each step's new contacts anchor as seen before it)
+    for (const double d : {0.0, 0.025, 0.05, 0.075}) {
+      sim.set_tool_pose(at(0, s.top + R - d * R));
+      const StepReport report = sim.step();
+      if (report.status == StepStatus::FAILED)
+        throw Error(fmt::format("contact: friction at {}, pressed {} R: {}", label, d, report.failure));
+    }
+    move_to(0);
+    const Sample nudged = move_to(1e-3 * spacing);
+    for (int k = 1; k <= 4; ++k) move_to(k * spacing / 4);
+    double worst = 0, mean = 0, drag = 0;
+    for (int k = 1; k <= 8; ++k) {
+      const Sample sample = move_to(spacing + k * spacing / 8);
+      const double ratio = sample.friction / sample.pressure;
+      worst = std::max(worst, std::abs(ratio / options.friction - 1));
+      mean += ratio / 8;
+      drag += sample.drag / 8;
+    }
+    fmt::print("contact: friction {} at {}: sliding friction / pressure {:.4f} (worst {:.2f}% from mu), drag / normal {:.4f}; nudged "
+               "{:.4f}\n", options.friction, label, mean, 100 * worst, drag, nudged.friction / nudged.pressure);
+    friction_table = fmt::format("| {} | {} | {:.4f} | {:.4f} ({:.2f}% from mu at worst) | {:.4f} |\n", label, options.friction,
+                                 nudged.friction / nudged.pressure, mean, 100 * worst, drag);
+  }
+  friction_csv.close();
   auto md = fmt::output_file((out / "summary.md").string());
   md.print("# Contact: a rigid sphere pressed into a block\n\n"
            "Block {} x {} x {} mm (E = {:.0e} Pa, nu = {}, {}, bottom held), a rigid frictionless sphere of "
@@ -248,9 +302,15 @@ int run_contact_experiment(const ContactOptions& options) {
            "17 equilibria over two spacings along x:\n\n"
            "| spacing | mean normal force (N) | normal-force ripple (std / mean) | largest tangential / normal |\n"
            "|---|---|---|---|\n{}\n"
-           "Not yet in this experiment: friction.\n",
+           "## Sliding at 0.1 R deep with Coulomb friction\n\n"
+           "Pressed, nudged by a thousandth of a spacing (the contact sticks: its friction stays inside the cone), dragged "
+           "a spacing to slide, then 8 equilibria over the next spacing. The friction's part of the force against the "
+           "pressure's (the goal: within 5% of mu), and the whole force's drag against its normal part (the tilted "
+           "normals of the dragged surface add to it):\n\n"
+           "| sampling | mu | nudged: friction / pressure | sliding: friction / pressure | sliding: drag / normal |\n"
+           "|---|---|---|---|---|\n{}\n",
            1e3 * width, 1e3 * height, 1e3 * width, young, poisson, options.material, 1e3 * R, depth_header, depth_rule, fem_table,
-           table, goal, offsets, sliding_table);
+           table, goal, offsets, sliding_table, friction_table);
   md.close();
   if (run_plot_script("plot_contact.py", out.string(), options.plot_script) != 0) return 1;
   fmt::print("wrote {}\n", out.string());

@@ -67,7 +67,7 @@ double SurfaceContact::energy(const Model&, const Points& u) {
   for (index_t v = 0; v < static_cast<index_t>(anchors_.size()); ++v) {
     const Anchor& a = anchors_[static_cast<std::size_t>(v)];
     if (!a.held) continue;
-    const double k = penalty_[static_cast<std::size_t>(v)], cone = friction_cone(v), t = friction_trial(v).norm();
+    const double k = tangential_penalty(v), cone = friction_cone(v), t = friction_trial(v).norm();
     e += (t <= cone ? t * t : 2 * cone * t - cone * cone) / (2 * k) - a.tau.squaredNorm() / (2 * k);
   }
   return e;
@@ -76,8 +76,10 @@ double SurfaceContact::energy(const Model&, const Points& u) {
 Vec3 SurfaceContact::friction_trial(index_t v) const {
   const Anchor& a = anchors_[static_cast<std::size_t>(v)];
   const Vec3 slip = a.tangent * (y_.col(v) - (pose_.position + pose_.orientation * a.local));
-  return a.tau + penalty_[static_cast<std::size_t>(v)] * slip;
+  return a.tau + tangential_penalty(v) * slip;
 }
+
+double SurfaceContact::tangential_penalty(index_t v) const { return tangential_share * penalty_[static_cast<std::size_t>(v)]; }
 
 double SurfaceContact::friction_cone(index_t v) const { return friction_ * lambda_[static_cast<std::size_t>(v)]; }
 
@@ -146,7 +148,7 @@ void SurfaceContact::linearise(const Model&, const Points& u, TangentMode mode) 
     const Anchor& a = anchors_[static_cast<std::size_t>(v)];
     if (!a.held) continue;
     const Vec3 t = friction_trial(v);
-    const double k = penalty_[static_cast<std::size_t>(v)], cone = friction_cone(v), norm = t.norm();
+    const double k = tangential_penalty(v), cone = friction_cone(v), norm = t.norm();
     // inside the cone k P; beyond it the clamped force's derivative, (cone k / |t|) (P - t^ t^T)
     const Mat3 hessian = norm <= cone ? Mat3(k * a.tangent) : Mat3(cone * k / norm * (a.tangent - t * t.transpose() / (norm * norm)));
     active_.push_back({v, Vec3::Zero(), 0.0, hessian, hessian});
@@ -174,13 +176,20 @@ bool SurfaceContact::update_multipliers(const Model& model, const Points& u) {
   for (index_t v = 0; v < static_cast<index_t>(anchors_.size()); ++v) {
     Anchor& a = anchors_[static_cast<std::size_t>(v)];
     if (!a.held) {
-      met = met && lambda_[static_cast<std::size_t>(v)] == 0;  // pressing without an anchor: anchor it first
+      // pressing without an anchor (a multiplier, or only the penalty at the contact's rim): anchor it first
+      met = met && lambda_[static_cast<std::size_t>(v)] == 0 &&
+            !(lambda_[static_cast<std::size_t>(v)] == 0 && (y_.col(v) - pose_.position).squaredNorm() <= reach(shape_) * reach(shape_) &&
+              tool_distance(shape_, pose_, y_.col(v)).penetration(shape_) > 0);
       continue;
     }
-    const double k = penalty_[static_cast<std::size_t>(v)];
+    const double k = tangential_penalty(v);
     const Vec3 t = friction_trial(v), clamped = friction_force(v);
-    // a sticking vertex is done on its anchor, a sliding one when its force stopped changing
-    met = met && (clamped - a.tau).norm() <= k * tolerance_;
+    // a sticking vertex is done on its anchor, a sliding one when its force stopped changing; and its cone,
+    // friction x lambda, is its pressure to 1% (lambda + k g: a penetration within the tolerance still made
+    // the penalty's part of the pressure as large as lambda, and the friction 5% short of mu x pressure)
+    const double g = std::max(tool_distance(shape_, pose_, y_.col(v)).penetration(shape_), 0.0);
+    met = met && (clamped - a.tau).norm() <= k * tolerance_ &&
+          penalty_[static_cast<std::size_t>(v)] * g <= 0.01 * lambda_[static_cast<std::size_t>(v)];
     // beyond the cone the anchor follows the vertex (the slide so far), the force unchanged
     if ((t - clamped).squaredNorm() > 0) a.local += pose_.orientation.conjugate() * Vec3((t - clamped) / k);
   }

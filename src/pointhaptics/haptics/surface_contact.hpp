@@ -111,6 +111,11 @@ class SurfaceContact final : public EnergyTerm {
   };
   /// The friction's trial force on the tool from an anchored vertex v at y_: tau + k s.
   Vec3 friction_trial(index_t v) const;
+  /// The friction's penalty: a share of the normal one. The full penalty puts the stick-slip kink within
+  /// c / k of the anchor (1e-7 m on the contact experiment's block) and Newton's iterations ran out on the
+  /// first drag; the multipliers meet the stick exactly whatever it is.
+  static constexpr double tangential_share = 0.01;
+  double tangential_penalty(index_t v) const;
   /// Its cone's radius: friction x the vertex's normal multiplier.
   double friction_cone(index_t v) const;
   /// The force itself: the trial force put on the cone when beyond it.
