@@ -21,7 +21,7 @@ struct ContactOptions {
   /// > 0: the first spacing once more with the points near the contact (a box 1.2 R around it, down to 1.2 R
   /// deep) at spacing R / refine and the surface's edge half that ([[refine]]); 0: uniform samplings only
   int refine = 8;
-  double friction = 0.3;             ///< Coulomb's coefficient of the friction run (the last sampling)
+  double friction = 0.3;             ///< Coulomb's coefficient of the friction run (the first sampling)
   int threads = 0;                   ///< 0: all
   std::string plot_script;           ///< plot_contact.py to use (default: the installed one)
 };
