@@ -67,6 +67,24 @@ std::vector<ToolCase> tools() {
           {"capsule", capsule, {Vec3(0.018, 0.02 + 0.006 - 0.001, 0.021), tilted}}};
 }
 
+// Forces are the energy's gradient (central differences of the energy) and the exact tangent their
+// derivative (central differences of the forces), at u along a random direction.
+void expect_forces_are_the_gradient_and_the_tangent_their_derivative(SurfaceContact& contact, const Model& model, const Points& u,
+                                                                      const Points& f) {
+  const Points du = random_field(model.n_points, 1e-4, 5);
+  const double eps = 1e-4;
+  const double dE = (contact.energy(model, u + eps * du) - contact.energy(model, u - eps * du)) / (2 * eps);
+  EXPECT_NEAR(dE, -dot(f, du), 1e-6 * std::abs(dot(f, du)));
+  contact.linearise(model, u, TangentMode::EXACT);
+  Points Hdu = Points::Zero(3, model.n_points);
+  contact.add_tangent_product(du, Hdu);
+  Points f_plus = Points::Zero(3, model.n_points), f_minus = Points::Zero(3, model.n_points);
+  contact.add_forces(model, u + eps * du, f_plus);
+  contact.add_forces(model, u - eps * du, f_minus);
+  const Points fd = -(f_plus - f_minus) / (2 * eps);
+  EXPECT_LT((Hdu - fd).norm(), 1e-5 * fd.norm());
+}
+
 TEST(SurfaceContact, ForcesAreTheEnergyGradientAndTheTangentTheirDerivative) {
   const Block b = block();
   for (const ToolCase& t : tools()) {
@@ -81,20 +99,8 @@ TEST(SurfaceContact, ForcesAreTheEnergyGradientAndTheTangentTheirDerivative) {
       Points f = Points::Zero(3, b.model.n_points);
       contact.add_forces(b.model, u, f);
       ASSERT_GT(f.norm(), 0);
+      expect_forces_are_the_gradient_and_the_tangent_their_derivative(contact, b.model, u, f);
       const Points du = random_field(b.model.n_points, 1e-4, 5);
-      // energy: dE = -f . du, central differences
-      const double eps = 1e-4;
-      const double dE = (contact.energy(b.model, u + eps * du) - contact.energy(b.model, u - eps * du)) / (2 * eps);
-      EXPECT_NEAR(dE, -dot(f, du), 1e-6 * std::abs(dot(f, du)));
-      // tangent: H du = -(f(u + eps du) - f(u - eps du)) / (2 eps)
-      contact.linearise(b.model, u, TangentMode::EXACT);
-      Points Hdu = Points::Zero(3, b.model.n_points);
-      contact.add_tangent_product(du, Hdu);
-      Points f_plus = Points::Zero(3, b.model.n_points), f_minus = Points::Zero(3, b.model.n_points);
-      contact.add_forces(b.model, u + eps * du, f_plus);
-      contact.add_forces(b.model, u - eps * du, f_minus);
-      const Points fd = -(f_plus - f_minus) / (2 * eps);
-      EXPECT_LT((Hdu - fd).norm(), 1e-5 * fd.norm());
       // the projected tangent keeps the normal stiffness only: positive semi-definite
       contact.linearise(b.model, u, TangentMode::PROJECTED);
       Points Pdu = Points::Zero(3, b.model.n_points);
@@ -179,18 +185,7 @@ TEST(SurfaceContact, FrictionForcesAreTheEnergyGradientAndTheTangentTheirDerivat
     const ToolLoad load = contact.load(b.model, u);
     ASSERT_GT(std::hypot(load.force.x(), load.force.z()), 0.0);
     EXPECT_LT((load.force + f.rowwise().sum()).norm(), 1e-9 * load.force.norm());
-    const Points du = random_field(b.model.n_points, 1e-4, 5);
-    const double eps = 1e-4;
-    const double dE = (contact.energy(b.model, u + eps * du) - contact.energy(b.model, u - eps * du)) / (2 * eps);
-    EXPECT_NEAR(dE, -dot(f, du), 1e-6 * std::abs(dot(f, du)));
-    contact.linearise(b.model, u, TangentMode::EXACT);
-    Points Hdu = Points::Zero(3, b.model.n_points);
-    contact.add_tangent_product(du, Hdu);
-    Points f_plus = Points::Zero(3, b.model.n_points), f_minus = Points::Zero(3, b.model.n_points);
-    contact.add_forces(b.model, u + eps * du, f_plus);
-    contact.add_forces(b.model, u - eps * du, f_minus);
-    const Points fd = -(f_plus - f_minus) / (2 * eps);
-    EXPECT_LT((Hdu - fd).norm(), 1e-5 * fd.norm());
+    expect_forces_are_the_gradient_and_the_tangent_their_derivative(contact, b.model, u, f);
   }
 }
 
