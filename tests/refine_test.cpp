@@ -21,17 +21,15 @@ Scene block(bool refined) {
   s.material.young = 1e5;
   s.material.poisson = 0.3;
   s.material.model = MaterialModel::NEO_HOOKEAN;
-  FixedSpec bottom, top;
-  bottom.box = {Vec3(-1, -1, -1), Vec3(1, 0, 1)};
-  top.box = {Vec3(-1, 0.04, -1), Vec3(1, 1, 1)};
-  top.displacement = Vec3(0, -0.0004, 0);
-  s.fixed = {bottom, top};
+  s.fixed.resize(2);  // built in place (copies of the selectors' optionals made GCC warn under ASan)
+  s.fixed[0].box = {Vec3(-1, -1, -1), Vec3(1, 0, 1)};
+  s.fixed[1].box = {Vec3(-1, 0.04, -1), Vec3(1, 1, 1)};
+  s.fixed[1].displacement = Vec3(0, -0.0004, 0);
   s.solver.kind = SolverKind::STATIC;
   if (refined) {
-    RefineSpec r;
-    r.box = {Vec3(-0.012, 0.028, -0.012), Vec3(0.012, 0.05, 0.012)};
-    r.spacing = 0.00125;
-    s.refine.push_back(r);
+    s.refine.resize(1);
+    s.refine[0].box = {Vec3(-0.012, 0.028, -0.012), Vec3(0.012, 0.05, 0.012)};
+    s.refine[0].spacing = 0.00125;
   }
   return s;
 }
