@@ -14,8 +14,8 @@ struct Refinement {
   PointCloud fine;  ///< the body sampled at the finer spacing (its points outside the region are not used)
 };
 
-/// Replaces `cloud`'s points in the region by `refinement.fine`'s: the coarse points within half a coarse
-/// spacing of the region go, the fine points in it come. The volumes of the points whose cells changed (the
+/// Replaces `cloud`'s points in the region by `refinement.fine`'s: the fine points in it come, the coarse points
+/// in it or closer than 0.75 fine spacings to a fine one go. The volumes of the points whose cells changed (the
 /// new ones, and the coarse ones within three coarse spacings of the region) are recomputed as clipped
 /// Voronoi cells of the body (`inside`) and rescaled to the volume those points stood for before, so the
 /// body's volume is unchanged and the others keep theirs. Every point gets its own kernel support: `support`
