@@ -95,34 +95,9 @@ std::function<bool(const Vec3&)> object_inside(const ObjectSpec& o) {
 // The object's points at a finer spacing within a region's bounds: the box's lattice keeps points on its faces
 // (whole intervals per axis, as sample_box), the balls' is centred as theirs. Volumes are left to refine_region.
 PointCloud fine_lattice(const ObjectSpec& o, double spacing, const Aabb& bounds) {
-  const auto inside = object_inside(o);
-  Vec3 step = Vec3::Constant(spacing), origin = o.origin;
-  if (o.shape == ShapeKind::BOX)
-    for (int a = 0; a < 3; ++a) step[a] = o.size[a] / std::max(1.0, std::round(o.size[a] / spacing));
-  std::array<long, 3> first{}, last{};
-  for (int a = 0; a < 3; ++a) {
-    first[a] = static_cast<long>(std::floor((bounds.min[a] - origin[a]) / step[a] - 1e-9));
-    last[a] = static_cast<long>(std::ceil((bounds.max[a] - origin[a]) / step[a] + 1e-9));
-  }
-  const double near_face = 0.5 * spacing;
-  std::vector<Vec3> points;
-  std::vector<unsigned char> surface;
-  for (long k = first[2]; k <= last[2]; ++k)
-    for (long j = first[1]; j <= last[1]; ++j)
-      for (long i = first[0]; i <= last[0]; ++i) {
-        const Vec3 p = origin + Vec3(static_cast<double>(i), static_cast<double>(j), static_cast<double>(k)).cwiseProduct(step);
-        if (!inside(p)) continue;
-        points.push_back(p);
-        bool on_face = false;
-        for (int a = 0; a < 3; ++a)
-          on_face = on_face || !inside(p + near_face * Vec3::Unit(a)) || !inside(p - near_face * Vec3::Unit(a));
-        surface.push_back(on_face ? 1 : 0);
-      }
-  PointCloud cloud;
+  const Vec3 step = o.shape == ShapeKind::BOX ? box_lattice_step(o.size, spacing) : Vec3::Constant(spacing);
+  PointCloud cloud = lattice_inside(o.origin, step, bounds.min, bounds.max, object_inside(o));
   cloud.spacing = spacing;
-  cloud.X.resize(3, static_cast<index_t>(points.size()));
-  for (std::size_t i = 0; i < points.size(); ++i) cloud.X.col(static_cast<index_t>(i)) = points[i];
-  cloud.surface = std::move(surface);
   return cloud;
 }
 

@@ -27,43 +27,55 @@ void check_spacing(double spacing, double extent) {
 
 // grid points spacing apart, one at `centre`, for which inside() holds
 PointCloud grid_inside(const Vec3& centre, double radius, double spacing, const std::function<bool(const Vec3&)>& inside) {
-  const int k = static_cast<int>(std::floor(radius / spacing)) + 1;
+  const Vec3 reach = Vec3::Constant(radius);
+  return lattice_inside(centre, Vec3::Constant(spacing), centre - reach, centre + reach, inside);
+}
+
+}  // namespace
+
+PointCloud lattice_inside(const Vec3& origin, const Vec3& step, const Vec3& lo, const Vec3& hi,
+                          const std::function<bool(const Vec3&)>& inside) {
+  std::array<long, 3> first{}, last{};
+  for (int a = 0; a < 3; ++a) {
+    first[a] = static_cast<long>(std::floor((lo[a] - origin[a]) / step[a] - 1e-9));
+    last[a] = static_cast<long>(std::ceil((hi[a] - origin[a]) / step[a] + 1e-9));
+  }
   std::vector<Vec3> kept;
-  for (int a = -k; a <= k; ++a)
-    for (int b = -k; b <= k; ++b)
-      for (int c = -k; c <= k; ++c) {
-        const Vec3 p = centre + spacing * Vec3(a, b, c);
+  for (long a = first[0]; a <= last[0]; ++a)
+    for (long b = first[1]; b <= last[1]; ++b)
+      for (long c = first[2]; c <= last[2]; ++c) {
+        const Vec3 p = origin + Vec3(static_cast<double>(a), static_cast<double>(b), static_cast<double>(c)).cwiseProduct(step);
         if (inside(p)) kept.push_back(p);
       }
   PointCloud cloud;
-  cloud.spacing = spacing;
+  cloud.spacing = step.maxCoeff();
   cloud.X.resize(3, static_cast<Eigen::Index>(kept.size()));
   for (size_t i = 0; i < kept.size(); ++i) cloud.X.col(static_cast<Eigen::Index>(i)) = kept[i];
-  // a point is on the surface when one of its 6 grid neighbours is outside
+  // a point is on the surface when one of its 6 lattice neighbours is outside
   cloud.surface.assign(kept.size(), 0);
   for (size_t i = 0; i < kept.size(); ++i)
     for (int axis = 0; axis < 3; ++axis)
       for (int sign : {-1, 1}) {
         Vec3 q = kept[i];
-        q[axis] += sign * spacing;
+        q[axis] += sign * step[axis];
         if (!inside(q)) cloud.surface[i] = 1;
       }
   return cloud;
 }
 
-}  // namespace
+Vec3 box_lattice_step(const Vec3& size, double spacing) {
+  Vec3 step;
+  for (int a = 0; a < 3; ++a) step[a] = size[a] / std::max(1, static_cast<int>(std::lround(size[a] / spacing)));
+  return step;
+}
 
 PointCloud sample_box(const Vec3& origin, const Vec3& size, double spacing) {
   if (!(size.array() > 0).all() || !size.allFinite() || !origin.allFinite())
     throw Error("sampling: box size must be positive and finite");
   check_spacing(spacing, size.maxCoeff());
+  const Vec3 step = box_lattice_step(size, spacing);
   std::array<int, 3> n{};  // points per axis
-  Vec3 step;
-  for (int a = 0; a < 3; ++a) {
-    const int intervals = std::max(1, static_cast<int>(std::lround(size[a] / spacing)));
-    n[a] = intervals + 1;
-    step[a] = size[a] / intervals;
-  }
+  for (int a = 0; a < 3; ++a) n[a] = static_cast<int>(std::lround(size[a] / step[a])) + 1;
   PointCloud cloud;
   cloud.spacing = spacing;
   const Eigen::Index count = static_cast<Eigen::Index>(n[0]) * n[1] * n[2];

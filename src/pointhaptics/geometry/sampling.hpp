@@ -12,6 +12,14 @@ namespace pointhaptics {
 /// they sum to the box's volume exactly.
 PointCloud sample_box(const Vec3& origin, const Vec3& size, double spacing);
 
+/// The points of the lattice origin + (i, j, k) * step (per axis) in [lo, hi] for which inside() holds, with
+/// surface flags (a point whose lattice neighbour along an axis is outside); no volumes.
+PointCloud lattice_inside(const Vec3& origin, const Vec3& step, const Vec3& lo, const Vec3& hi,
+                          const std::function<bool(const Vec3&)>& inside);
+
+/// sample_box's lattice step per axis: the size over round(size / spacing) intervals (at least 1).
+Vec3 box_lattice_step(const Vec3& size, double spacing);
+
 /// Grid points (spacing apart, one at the centre) inside the ball; volumes are cells clipped to the
 /// ball (see clipped_cell_volumes) and sum to 4/3 pi r^3.
 PointCloud sample_sphere(const Vec3& centre, double radius, double spacing);

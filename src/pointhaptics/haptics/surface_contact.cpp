@@ -177,9 +177,7 @@ bool SurfaceContact::update_multipliers(const Model& model, const Points& u) {
     Anchor& a = anchors_[static_cast<std::size_t>(v)];
     if (!a.held) {
       // pressing without an anchor (a multiplier, or only the penalty at the contact's rim): anchor it first
-      met = met && lambda_[static_cast<std::size_t>(v)] == 0 &&
-            !(lambda_[static_cast<std::size_t>(v)] == 0 && (y_.col(v) - pose_.position).squaredNorm() <= reach(shape_) * reach(shape_) &&
-              tool_distance(shape_, pose_, y_.col(v)).penetration(shape_) > 0);
+      met = met && lambda_[static_cast<std::size_t>(v)] == 0 && !(tool_distance(shape_, pose_, y_.col(v)).penetration(shape_) > 0);
       continue;
     }
     const double k = tangential_penalty(v);
