@@ -43,6 +43,7 @@ struct RunOptions {
   bool quiet = false;
   int threads = 0;
   std::uint64_t max_memory = 0;  ///< bytes; 0: the memory available
+  std::vector<std::string> settings;  ///< --set key=value
 };
 
 void print_summary(ph::Simulation& sim, const ph::RunSummary& s, double setup_s) {
@@ -134,6 +135,7 @@ int run_command(const RunOptions& opt) {
   ph::SessionOptions session_options;
   session_options.threads = opt.threads;
   session_options.max_memory = static_cast<double>(opt.max_memory);
+  for (const std::string& setting : opt.settings) session_options.settings.push_back(ph::parse_scene_setting(setting));
   ph::SceneSession session = ph::open_scene_file(opt.scene, session_options);
   const ph::Scene& scene = session.scene;
   ph::Simulation& sim = *session.simulation;
@@ -293,6 +295,10 @@ int main(int argc, char** argv) {
   run_cmd->add_flag("--deterministic", run.deterministic,
                     "With a [probe]: interleave haptic ticks and simulation steps on one thread in simulated time");
   run_cmd->add_option("--threads", run.threads, "Threads for the force evaluation (0: all)")->check(CLI::NonNegativeNumber);
+  run_cmd->add_option("--set", run.settings,
+                      "Change a key of the scene: KEY=VALUE, a dotted path and a TOML value (material.young=2e5, "
+                      "load.0.total=[0,-0.02,0]); repeatable")
+      ->allow_extra_args(false);
 
 #ifdef PH_HAVE_VIEWER
   ph::viewer::ViewerOptions view;

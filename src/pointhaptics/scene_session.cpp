@@ -45,7 +45,7 @@ SceneSession open_scene(Scene scene, const SessionOptions& options) {
 
 SceneSession open_scene_file(const std::string& path, const SessionOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  Scene scene = read_scene_file(path);
+  Scene scene = read_scene_file(path, options.settings);
   const double reading = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   SceneSession s = open_scene(std::move(scene), options);
   s.setup_seconds += reading;

@@ -4,8 +4,10 @@
 /// Every default a run depends on is set here once.
 #include <pointhaptics/interactive.hpp>
 #include <pointhaptics/io/scene.hpp>
+#include <pointhaptics/io/scene_toml.hpp>
 
 #include <memory>
+#include <vector>
 
 namespace pointhaptics {
 
@@ -13,6 +15,7 @@ struct SessionOptions {
   int threads = 0;          ///< for the force evaluation (0: all hardware threads)
   double max_memory = 0;    ///< bytes a model may take (0: the memory available); a larger one is refused
   bool make_device = true;  ///< with a [probe]: open the scene's device (a viewer or Python brings its own)
+  std::vector<SceneSetting> settings;  ///< open_scene_file(): keys set over the file's (`--set`, a study's parameters)
 };
 
 struct SceneSession {

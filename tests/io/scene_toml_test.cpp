@@ -396,6 +396,47 @@ TEST(SceneToml, BadHeldToolIsANamedError) {
             std::string::npos);
 }
 
+TEST(SceneToml, AHeldToolPressesAlongItsDirection) {
+  std::string text = std::string(full_scene) + held_tool_section;
+  EXPECT_EQ(parse_scene(text, "t.toml", ".").probe.direction, Vec3(0, -1, 0));  // the default
+  text += "direction = [0.0, 0.0, -2.0]\n";
+  EXPECT_EQ(parse_scene(text, "t.toml", ".").probe.direction, Vec3(0, 0, -1));  // normalised
+  EXPECT_NE(error_of("direction = [0.0, 0.0, -2.0]", "direction = [0.0, 0.0, 0.0]", text).find("probe.direction: must not be zero"),
+            std::string::npos);
+  EXPECT_NE(error_of("position = [0.0, 0.06, 0.0]", "", text).find("probe.direction: only a tool held at a position"), std::string::npos);
+}
+
+// A setting (--set, a study's parameter) changes a key as if the file said it, makes missing tables, indexes
+// arrays of tables, and its errors name the setting.
+TEST(SceneToml, SettingsChangeKeysAndTheirErrorsNameThem) {
+  const std::vector<SceneSetting> settings = {parse_scene_setting("material.young=2e5"), parse_scene_setting("material.model=neo_hookean"),
+                                              parse_scene_setting("load.0.total=[0, -0.5, 0]"), parse_scene_setting("lod.k1=0.5")};
+  const Scene s = parse_scene(full_scene, "t.toml", ".", settings);
+  EXPECT_DOUBLE_EQ(s.material.young, 2e5);
+  EXPECT_EQ(s.material.model, MaterialModel::NEO_HOOKEAN);
+  EXPECT_DOUBLE_EQ(s.loads[0].total.y(), -0.5);
+  EXPECT_DOUBLE_EQ(s.material.poisson, 0.4);  // the rest as the file says
+  EXPECT_TRUE(s.lod.present);                 // a missing table is made
+  EXPECT_DOUBLE_EQ(s.lod.params.k1, 0.5);
+  const auto error = [](const std::string& setting) {
+    try {
+      parse_scene(full_scene, "t.toml", ".", {parse_scene_setting(setting)});
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(error("material.young=-1"), "t.toml: material.young (set to -1): -1 is out of range: must lie in (0, 1e13] (Pa)");
+  EXPECT_NE(error("material.young=abc").find("material.young (set to abc): expected a number, got a string"), std::string::npos);
+  EXPECT_NE(error("load.7.total=[0, 0, 0]").find("\"7\" is not an index of the array (it has 3 entries)"), std::string::npos);
+  EXPECT_NE(error("material.young.x=1").find("\"young\" is a value, not a table"), std::string::npos);
+  EXPECT_NE(error("materia.young=1").find("materia (made for the setting materia.young=1): unknown key"), std::string::npos);
+  EXPECT_NE(error("material.poisson=[1").find("not a TOML value"), std::string::npos);
+  EXPECT_NE(error("material..young=1").find("an empty key on the path"), std::string::npos);
+  EXPECT_THROW(parse_scene_setting("young"), Error);
+  EXPECT_THROW(parse_scene_setting("=1"), Error);
+}
+
 TEST(SceneToml, ReadsRefineRegionsAndNamesTheirErrors) {
   const std::string refine = "\n[[refine]]\nsphere = { centre = [0.0, 0.03, 0.0], radius = 0.01 }\nspacing = 0.003\n";
   const Scene s = parse_scene(std::string(full_scene) + refine, "t.toml", ".");

@@ -131,6 +131,9 @@ struct ProbeSpec {
   /// A tool held there, m (scene axes; NaN: driven by the device). With solver.kind = "static" the
   /// equilibrium with the tool there; its contact is on the object's surface (issue 16).
   Vec3 position = Vec3::Constant(NAN);
+  /// A held tool: the unit direction it presses in (`pointhaptics fit` moves it along it from `position`, the
+  /// tool at zero depth, and reads the force against it)
+  Vec3 direction = -Vec3::UnitY();
   std::array<double, 4> orientation{1, 0, 0, 0};  ///< unit quaternion w, x, y, z: tool to scene axes
   bool capsule = false;                    ///< shape = "capsule" (else "sphere")
   double length = 0;                       ///< capsule: its axis segment, m, along the tool's local z

@@ -6,7 +6,9 @@
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
+#include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -20,6 +22,7 @@ namespace {
 struct Context {
   std::string file;
   std::string base_dir;
+  const std::vector<SceneSetting>* settings = nullptr;
 };
 
 // toml++ recurses once per level of a dotted key or table header (a.b.c = 1, [a.b.c]), and some ten
@@ -66,8 +69,84 @@ void check_key_nesting(std::string_view text, const std::string& name) {
   }
 }
 
+// the source name of the values a SceneSetting puts into a scene (their line is the setting's own)
+constexpr std::string_view setting_source = "<scene setting>";
+
 [[noreturn]] void fail(const Context& ctx, const toml::source_region& where, std::string_view key, std::string_view what) {
+  // a key set from outside the file has no line in it: its message names the setting instead
+  const bool set = where.begin.line == 0 || (where.path && *where.path == setting_source);
+  if (set && ctx.settings) {
+    std::string dotted(key);  // load[0].total -> load.0.total, as the setting spells it
+    std::replace(dotted.begin(), dotted.end(), '[', '.');
+    std::erase(dotted, ']');
+    for (const SceneSetting& s : *ctx.settings)
+      if (s.key == dotted) throw Error(fmt::format("{}: {} (set to {}): {}", ctx.file, key, s.value, what));
+    for (const SceneSetting& s : *ctx.settings)
+      if (s.key.starts_with(dotted + "."))
+        throw Error(fmt::format("{}: {} (made for the setting {}={}): {}", ctx.file, key, s.key, s.value, what));
+  }
   throw Error(fmt::format("{}:{}: {}: {}", ctx.file, where.begin.line, key, what));
+}
+
+// The value of a setting as a TOML node (in a table of its own, under "value"); a bare word that TOML does
+// not read (neo_hookean) is a string.
+toml::table setting_value(const SceneSetting& s, const std::string& file) {
+  try {
+    return toml::parse("value = " + s.value, setting_source);
+  } catch (const toml::parse_error&) {
+  }
+  const bool word = !s.value.empty() && std::all_of(s.value.begin(), s.value.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.' || c == '/';
+  });
+  if (!word)
+    throw Error(fmt::format("{}: {} (set to {}): not a TOML value (a number, true or false, [x, y, z], or a \"string\")", file,
+                            s.key, s.value));
+  toml::table t;
+  t.insert("value", s.value);
+  return t;
+}
+
+// Puts one setting into the parsed scene: the tables on its path are made when missing, an array of tables
+// takes an index ("load.0.total").
+void apply_setting(toml::table& root, const SceneSetting& s, const std::string& file) {
+  std::vector<std::string> parts;
+  for (std::size_t begin = 0;;) {
+    const std::size_t dot = s.key.find('.', begin);
+    parts.push_back(s.key.substr(begin, dot == std::string::npos ? std::string::npos : dot - begin));
+    if (dot == std::string::npos) break;
+    begin = dot + 1;
+  }
+  const auto bad = [&](std::string_view what) -> Error {
+    return Error(fmt::format("{}: {} (set to {}): {}", file, s.key, s.value, what));
+  };
+  for (const std::string& part : parts)
+    if (part.empty()) throw bad("an empty key on the path (expected section.key, e.g. material.young)");
+  toml::table value = setting_value(s, file);
+  toml::node* at = &root;
+  for (std::size_t k = 0; k < parts.size(); ++k) {
+    const std::string& part = parts[k];
+    const bool last = k + 1 == parts.size();
+    if (toml::table* table = at->as_table()) {
+      if (last) {
+        value.get("value")->visit([&](auto&& v) { table->insert_or_assign(part, std::move(v)); });
+        return;
+      }
+      if (!table->get(part)) table->insert(part, toml::table{});
+      at = table->get(part);
+    } else if (toml::array* array = at->as_array()) {
+      std::size_t index = 0;
+      const auto [end, error] = std::from_chars(part.data(), part.data() + part.size(), index);
+      if (error != std::errc() || end != part.data() + part.size() || index >= array->size())
+        throw bad(fmt::format("\"{}\" is not an index of the array (it has {} entries)", part, array->size()));
+      if (last) {
+        value.get("value")->visit([&](auto&& v) { array->replace(array->cbegin() + static_cast<std::ptrdiff_t>(index), std::move(v)); });
+        return;
+      }
+      at = array->get(index);
+    } else {
+      throw bad(fmt::format("\"{}\" is a value, not a table", parts[k - 1]));
+    }
+  }
 }
 
 // Reads the keys of one table, remembering which it read, so that the rest can be reported as unknown.
@@ -453,6 +532,12 @@ void read_probe(TableReader& r, ProbeSpec& p, const Context& ctx) {
     if (r.find("trajectory") || r.find("keyframes"))
       r.fail_at(*r.find("position"), "position", "a tool held at a position has no trajectory or keyframes: give one or the other");
   }
+  if (const toml::node* node = r.find("direction")) {
+    if (!r.find("position")) r.fail_at(*node, "direction", "only a tool held at a position (position = [x, y, z]) presses along a direction");
+    const Vec3 d = r.as_vec3(*node, "direction");
+    if (!(d.norm() > 1e-12)) r.fail_at(*node, "direction", "must not be zero (the direction the tool presses in)");
+    p.direction = d.normalized();
+  }
   if (const toml::node* node = r.find("orientation")) {
     const toml::array* a = node->as_array();
     if (!a || a->size() != 4) r.fail_at(*node, "orientation", "expected a unit quaternion [w, x, y, z]");
@@ -544,8 +629,16 @@ void read_array_of_tables(TableReader& root, std::string_view key, Read read) {
 
 }  // namespace
 
-Scene parse_scene(std::string_view text, const std::string& name, const std::string& base_dir) {
-  Context ctx{name, base_dir};
+SceneSetting parse_scene_setting(std::string_view text) {
+  const std::size_t equals = text.find('=');
+  if (equals == std::string_view::npos || equals == 0)
+    throw Error(fmt::format("--set {}: expected key=value (e.g. material.young=2e5)", text));
+  return {std::string(text.substr(0, equals)), std::string(text.substr(equals + 1))};
+}
+
+Scene parse_scene(std::string_view text, const std::string& name, const std::string& base_dir,
+                  const std::vector<SceneSetting>& settings) {
+  Context ctx{name, base_dir, &settings};
   toml::table root;
   check_key_nesting(text, name);
   try {
@@ -553,6 +646,7 @@ Scene parse_scene(std::string_view text, const std::string& name, const std::str
   } catch (const toml::parse_error& e) {
     throw Error(fmt::format("{}:{}: TOML syntax error: {}", name, e.source().begin.line, e.description()));
   }
+  for (const SceneSetting& s : settings) apply_setting(root, s, name);
   Scene scene;
   scene.path = name;
   TableReader top(ctx, root, "");
@@ -605,14 +699,14 @@ Scene parse_scene(std::string_view text, const std::string& name, const std::str
   return scene;
 }
 
-Scene read_scene_file(const std::string& path) {
+Scene read_scene_file(const std::string& path, const std::vector<SceneSetting>& settings) {
   check_input_file(path, "scene file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(fmt::format("{}: cannot open the scene file", path));
   std::stringstream buffer;
   buffer << in.rdbuf();
   const std::string dir = std::filesystem::path(path).parent_path().string();
-  return parse_scene(buffer.str(), path, dir.empty() ? "." : dir);
+  return parse_scene(buffer.str(), path, dir.empty() ? "." : dir, settings);
 }
 
 }  // namespace pointhaptics
