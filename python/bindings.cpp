@@ -1,6 +1,7 @@
 // Python bindings (pybind11): load a scene or build a model from NumPy arrays, step, read positions,
 // displacements, forces and energy as NumPy arrays (views without copies where the data lives in the
 // simulation), drive the probe. Long calls release the GIL.
+#include <pointhaptics/fem/calculix_indentation.hpp>
 #include <pointhaptics/haptics/devices/virtual_device.hpp>
 #include <pointhaptics/mechanics/forces.hpp>
 #include <pointhaptics/io/point_cloud_file.hpp>
@@ -13,6 +14,8 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <memory>
 #include <mutex>
@@ -72,6 +75,8 @@ struct PySimulation {
   std::unique_ptr<ph::Simulation> sim;
   ph::Scene scene;
   bool from_scene = false;                  ///< scene.object describes the object (not from_points)
+  ph::InteractiveOptions interactive;        ///< with a device's [probe]: its session (run_scene())
+  std::optional<ph::InteractiveResult> last_session;  ///< the last run_scene() with a device's probe, for summary()
   std::optional<ph::ObjectSurface> surface;  ///< built on the first surface_* call
   ph::Points surface_vertices;               ///< its deformed vertices, 3 x m, kept current after every step
   std::mutex mutex;
@@ -105,17 +110,40 @@ std::unique_lock<std::mutex> locked(PySimulation& p) {
   return lock;
 }
 
-std::unique_ptr<PySimulation> from_scene(const std::string& path, int threads) {
+// {key: value} -> scene settings: each value as JSON, which TOML reads for numbers, strings, booleans and
+// lists (a NaN or None is then a named error of the setting)
+std::vector<ph::SceneSetting> settings_of(const py::object& settings) {
+  std::vector<ph::SceneSetting> out;
+  if (settings.is_none()) return out;
+  const py::object dumps = py::module_::import("json").attr("dumps");
+  for (const auto& [key, value] : settings.cast<py::dict>())
+    out.push_back({py::str(key).cast<std::string>(), dumps(value).cast<std::string>()});
+  return out;
+}
+
+std::unique_ptr<PySimulation> open_session(ph::Scene scene, int threads) {
   auto p = std::make_unique<PySimulation>();
   ph::SessionOptions options;
   options.threads = threads;
-  options.make_device = false;  // Python drives the probe itself (run_probe)
-  ph::SceneSession session = ph::open_scene_file(path, options);
+  options.make_device = false;  // made by run_scene(), or Python drives the probe itself (probe())
+  ph::SceneSession session = ph::open_scene(std::move(scene), options);
   p->scene = std::move(session.scene);
   p->sim = std::move(session.simulation);
+  p->interactive = std::move(session.interactive);
   p->from_scene = true;
   return p;
 }
+
+std::unique_ptr<PySimulation> from_scene(const std::string& path, int threads, const py::object& settings) {
+  return open_session(ph::read_scene_file(path, settings_of(settings)), threads);
+}
+
+std::unique_ptr<PySimulation> from_scene_text(const std::string& text, const std::string& base_dir, int threads,
+                                              const py::object& settings, const std::string& name) {
+  return open_session(ph::parse_scene(text, name, base_dir, settings_of(settings)), threads);
+}
+
+py::list vec_list(const ph::Vec3& v) { return py::cast(std::vector<double>{v.x(), v.y(), v.z()}); }
 
 std::unique_ptr<PySimulation> from_points(const RowPoints& X, double spacing, py::object fixed, py::object forces,
                                           double young, double poisson, double density, double damping, const std::string& kernel,
@@ -171,6 +199,43 @@ PYBIND11_MODULE(_pointhaptics, m) {
   py::register_exception<ph::Error>(m, "Error", PyExc_ValueError);
 
   m.attr("__version__") = "0.1.0";
+  m.def(
+      "calculix_indentation",
+      [](const std::vector<double>& depths, double sphere_radius, double block_radius, double height, double young,
+         double poisson, const std::string& model, int elements_per_radius, int threads) {
+        if (depths.empty()) throw ph::Error("calculix_indentation: depths are needed (m)");
+        ph::fem::IndentationProblem problem;
+        problem.sphere_radius = sphere_radius;
+        problem.block_radius = block_radius;
+        problem.height = height;
+        problem.material.young = young;
+        problem.material.poisson = poisson;
+        problem.material.model = enum_value<ph::MaterialModel>("calculix_indentation", "model", model);
+        problem.elements_per_radius = elements_per_radius;
+        double deepest = 0;
+        for (double d : depths) {
+          if (!(d >= 0) || !std::isfinite(d)) throw ph::Error("calculix_indentation: depths must be >= 0 (m)");
+          deepest = std::max(deepest, d);
+        }
+        problem.max_depth = deepest;
+        problem.increments = std::max(6, static_cast<int>(depths.size()));
+        ph::fem::IndentationSolution solution;
+        {
+          py::gil_scoped_release release;
+          solution = ph::fem::solve_indentation(problem, threads);
+        }
+        std::vector<double> forces;
+        for (double d : depths) forces.push_back(d > 0 ? solution.force_at(d) : 0.0);
+        return forces;
+      },
+      py::arg("depths"), py::arg("sphere_radius") = 0.01, py::arg("block_radius") = 0.04, py::arg("height") = 0.04,
+      py::arg("young") = 1e5, py::arg("poisson") = 0.3, py::arg("model") = "neo_hookean", py::arg("elements_per_radius") = 20,
+      py::arg("threads") = 1,
+      "CalculiX's force (N) of a rigid frictionless sphere (sphere_radius, m) pressed into a cylinder (block_radius, "
+      "height; m; bottom held) to each of `depths` (m): an axisymmetric CAX8 model, NLGEOM, with the material "
+      "`model` (svk | neo_hookean | mooney_rivlin with young and poisson its small-strain moduli), elements of "
+      "R / elements_per_radius at the contact (`pointhaptics experiment contact` shows its convergence). Needs ccx "
+      "(Debian's calculix-ccx). Releases the GIL.");
   py::class_<PySimulation>(m, "Simulation", R"doc(A deformable object made of points, its state and its solver.
 
 Make one with Simulation.from_scene(path) (a scene file, as `pointhaptics run` reads) or
@@ -183,9 +248,20 @@ every array still speaks of all n points.
 Calls on one Simulation from several threads follow each other (each object has a lock); step(), run() and
 probe() release the GIL while they work. Errors are pointhaptics.Error (a ValueError) with a message that
 names the problem.)doc")
-      .def_static("from_scene", &from_scene, py::arg("path"), py::arg("threads") = 0,
+      .def_static("from_scene", &from_scene, py::arg("path"), py::arg("threads") = 0, py::arg("settings") = py::none(),
                   "Load a scene file (TOML: [object], [material], [kernel], [solver], [[fixed]], [[load]], [lod] ...) and "
-                  "prepare its simulation, with its levels of detail. threads: of the force evaluation (0: all).")
+                  "prepare its simulation, with its levels of detail. threads: of the force evaluation (0: all). settings: "
+                  "{key: value} set over the file's, as `pointhaptics run --set` (e.g. {'material.young': 2e5, "
+                  "'load.0.total': [0, -0.02, 0]}).")
+      .def_static("from_scene_text", &from_scene_text, py::arg("text"), py::arg("base_dir") = ".", py::arg("threads") = 0,
+                  py::arg("settings") = py::none(), py::arg("name") = "<string>",
+                  "As from_scene, from the scene's text: relative file paths are taken from base_dir, and messages name "
+                  "`name` for the file (what a study sends to its workers).")
+      .def("__reduce__",
+           [](const PySimulation&) -> py::object {
+             throw ph::Error("a Simulation does not travel to another process: send its scene (path or text) and settings, "
+                             "and open it there (pointhaptics.study does)");
+           })
       .def_static("from_points", &from_points, py::arg("points"), py::arg("spacing"), py::arg("fixed") = py::none(),
                   py::arg("forces") = py::none(), py::arg("young") = 1e5, py::arg("poisson") = 0.4, py::arg("density") = 1000.0,
                   py::arg("damping") = 0.0, py::arg("kernel") = "poly6", py::arg("support_factor") = 2.0,
@@ -316,6 +392,67 @@ names the problem.)doc")
           },
           "The object's surface triangles, a (t, 3) integer array of rows of surface_vertices (a copy), counter-clockwise "
           "seen from outside")
+      .def(
+          "run_scene",
+          [](PySimulation& p) {
+            if (!p.from_scene) throw ph::Error("run_scene: this Simulation was made from_points; it has no scene to run");
+            py::gil_scoped_release release;
+            const std::lock_guard<std::mutex> lock(p.mutex);
+            if (p.scene.probe.present && !p.scene.probe.held()) {
+              // a device's probe: its session in simulated time (`pointhaptics run --deterministic`)
+              const std::unique_ptr<ph::Device> device = ph::make_scene_device(p.scene);
+              ph::InteractiveOptions options = p.interactive;
+              options.real_time = false;
+              options.log = false;
+              p.last_session = ph::run_interactive(*p.sim, *device, options);
+            } else {
+              p.sim->run(p.scene.solver.duration);
+            }
+            p.carry_surface();
+            if (p.sim->diagnostics().failed) throw ph::Error(p.sim->diagnostics().failure);
+          },
+          "Run the scene as `pointhaptics run --deterministic` does: solver.duration seconds of dynamics, or the static "
+          "solve, or with a device's [probe] its session in simulated time. Raises pointhaptics.Error on a failed step; "
+          "releases the GIL.")
+      .def_property_readonly(
+          "duration", [](PySimulation& p) { return p.scene.solver.duration; }, "The scene's solver.duration (s)")
+      .def(
+          "hold_tool",
+          [](PySimulation& p, const std::array<double, 3>& position) {
+            const auto lock = locked(p);
+            ph::HeldTool* tool = p.sim->held_tool();
+            if (!tool) throw ph::Error("hold_tool: the scene holds no tool ([probe] position = [x, y, z])");
+            const ph::Vec3 x(position[0], position[1], position[2]);
+            if (!x.allFinite()) throw ph::Error("hold_tool: the position is not finite");
+            p.sim->set_tool_pose(ph::ToolPose{x, tool->pose().orientation});
+          },
+          py::arg("position"),
+          "Move the held tool ([probe] position) to `position` (scene axes, m), keeping its orientation; the next step "
+          "(static: the equilibrium) starts from the state reached, so a force-depth curve is a sequence of "
+          "hold_tool() and step().")
+      .def_property_readonly(
+          "tool",
+          [](PySimulation& p) -> py::object {
+            const auto lock = locked(p);
+            ph::ToolSummary t = p.last_session ? p.last_session->tool : p.sim->tool_summary();
+            if (!t.present) return py::none();
+            py::dict d;
+            d["kind"] = t.kind;
+            d["position"] = vec_list(t.position);
+            d["force"] = vec_list(t.force);
+            d["torque"] = vec_list(t.torque);
+            d["friction"] = vec_list(t.friction);
+            d["contacts"] = t.contacts;
+            d["penetration"] = t.penetration;
+            if (p.scene.probe.held()) {
+              d["start"] = vec_list(p.scene.probe.position);
+              d["direction"] = vec_list(p.scene.probe.direction);
+            }
+            return d;
+          },
+          "The tool now (None without one), as the result JSON's tool block: kind, position (m), force (N, the object "
+          "on the tool, scene axes), torque (N m), friction (N), contacts, penetration (m); a held tool adds start "
+          "(its scene position) and direction (the unit vector it presses along, [probe] direction).")
       .def("energy",
            [](PySimulation& p) {
              const auto lock = locked(p);
@@ -331,7 +468,8 @@ names the problem.)doc")
           "summary",
           [](PySimulation& p) {
             const auto lock = locked(p);
-            const ph::RunSummary summary = p.sim->summary();
+            ph::RunSummary summary = p.sim->summary();
+            if (p.last_session) ph::add_interactive_summary(summary, *p.last_session);
             return summary_dict(p.sim->model(), p.sim->state(), summary);
           },
           "The run so far, with the result JSON's blocks and keys (`pointhaptics run --json`): solver (kind, converged, "

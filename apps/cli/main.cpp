@@ -220,13 +220,7 @@ int run_command(const RunOptions& opt) {
     errors.attempt([&] { ph::write_mesh(opt.surface, ph::TriangleMesh{ph::deformed_surface(*surface, sim.state().u), surface->mesh.F}, "--surface"); });
   ph::RunSummary summary = sim.summary();
   summary.interrupted = interrupted.load();
-  if (haptic) {
-    summary.tool = interactive.tool;
-    summary.haptic_ticks = interactive.haptic.ticks;
-    summary.haptic_rate_hz = interactive.haptic.rate_hz;
-    summary.haptic_period_p99_us = interactive.haptic.period_p99_us;
-    summary.haptic_max_force_n = interactive.haptic.max_force_n;
-  }
+  if (haptic) ph::add_interactive_summary(summary, interactive);
   if (!opt.json.empty()) errors.attempt([&] { ph::write_result_json(opt.json, sim.model(), sim.state(), summary); });
   if (!opt.quiet) {
     print_summary(sim, summary, setup_s);

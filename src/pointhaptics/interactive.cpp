@@ -132,4 +132,12 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
   return result;
 }
 
+void add_interactive_summary(RunSummary& summary, const InteractiveResult& interactive) {
+  summary.tool = interactive.tool;
+  summary.haptic_ticks = interactive.haptic.ticks;
+  summary.haptic_rate_hz = interactive.haptic.rate_hz;
+  summary.haptic_period_p99_us = interactive.haptic.period_p99_us;
+  summary.haptic_max_force_n = interactive.haptic.max_force_n;
+}
+
 }  // namespace pointhaptics

@@ -77,4 +77,7 @@ struct InteractiveResult {
 /// (sim.diagnostics() says why). Throws Error on bad options.
 InteractiveResult run_interactive(Simulation& sim, Device& device, const InteractiveOptions& options);
 
+/// A run's summary with its interactive session's: the probe's tool block and the haptic loop's figures.
+void add_interactive_summary(RunSummary& summary, const InteractiveResult& interactive);
+
 }  // namespace pointhaptics
