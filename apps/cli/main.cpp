@@ -6,6 +6,7 @@
 #include "experiment_lod.hpp"
 #include "experiment_materials.hpp"
 #include "progress_bar.hpp"
+#include "python_command.hpp"
 
 #include <pointhaptics/io/mesh_file.hpp>
 #include <pointhaptics/pointhaptics.hpp>
@@ -412,7 +413,19 @@ int main(int argc, char** argv) {
                             "One configuration instead of the sweep, both schemes: \"k1,k2[,min_neighbours];P1:K1;P2:K2\" "
                             "(units of h; P = 0: the whole object)");
 
+  // studies and fits: Python's argparse reads their options (`pointhaptics study --help`)
+  CLI::App* study_cmd = app.add_subcommand(
+      "study", "Run a parameter study on Dask: study.toml --out DIR [--scheduler tcp://HOST:PORT] [--workers N] (docs/studies.md)");
+  CLI::App* fit_cmd = app.add_subcommand(
+      "fit", "Fit material parameters to a measured indentation curve: measured.csv --scene S --params K1,K2 --out DIR (docs/studies.md)");
+  for (CLI::App* cmd : {study_cmd, fit_cmd}) {
+    cmd->set_help_flag();
+    cmd->prefix_command();
+  }
+
   CLI11_PARSE(app, argc, argv);
+  if (*study_cmd) return ph::cli::run_python_module("pointhaptics.studies", study_cmd->remaining());
+  if (*fit_cmd) return ph::cli::run_python_module("pointhaptics.identification", fit_cmd->remaining());
   try {
     if (*run_cmd) return run_command(run);
 #ifdef PH_HAVE_VIEWER

@@ -34,9 +34,9 @@ def dask_client(scheduler: str | None = None, workers: int | None = None):
     n = workers or os.cpu_count() or 1
     if n < 1:
         raise ValueError("workers: must be >= 1")
-    # processes, one thread each: a simulation holds its worker's core, and the GIL is not shared; no dashboard
-    # (it needs bokeh, and a study does not)
-    with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+    # processes, one thread each: a simulation holds its worker's core, and the GIL is not shared; its web
+    # server on a free port (two studies at once do not collide)
+    with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
                       silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
         _wait_for_workers(client, n, "the local cluster")
         yield client
