@@ -160,8 +160,17 @@ def test_a_worker_killed_mid_study_loses_no_run(dask_cluster, tmp_path):
     result = {}
     thread = threading.Thread(target=lambda: result.update(table=ph.study(str(study), scheduler=address, progress=False)))
     thread.start()
-    time.sleep(2.0)  # the workers are busy: 16 runs of about 0.6 s each on 2 workers, after the client connects
-    assert thread.is_alive()  # mid-study
+    from distributed import Client
+
+    # mid-study: some runs done (16 of about 0.6 s each on 2 workers), the rest to come
+    with Client(address, timeout="60s") as watcher:
+        def done(dask_scheduler):
+            return sum(ts.state == "memory" for ts in dask_scheduler.tasks.values())
+
+        deadline = time.monotonic() + 120
+        while watcher.run_on_scheduler(done) < 2 and time.monotonic() < deadline:
+            time.sleep(0.05)
+    assert thread.is_alive()
     os.killpg(workers[0].pid, signal.SIGKILL)
     thread.join(timeout=300)
     assert workers[0].poll() is not None  # it is gone
