@@ -9,6 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 namespace pointhaptics {
 namespace {
 
@@ -94,6 +96,50 @@ TEST(ProbeOnSurface, ASlowPressRendersTheSameForceInBothSolversAndMostOfTheMater
   const double reference = static_force(implicit_press.probe);
   EXPECT_GT(implicit_press.felt.y(), 0.7 * reference);
   EXPECT_LT(implicit_press.felt.y(), reference);
+}
+
+// Pressed in, then pushed up and down by 0.5 mm and dragged sideways: the local model the haptic side renders
+// between updates takes its stiffness from the object's compliance (issue 16, item 4), so it predicts the
+// next update's force better than the contact's own stiffness (the held object's) or no stiffness at all.
+TEST(ProbeOnSurface, TheLocalModelsStiffnessIsTheObjectsAndPredictsTheNextUpdate) {
+  for (const std::string solver : {"explicit", "implicit"}) {
+    const Scene scene = block_scene(solver);
+    Simulation sim(build_scene_model(scene), scene.solver, 1);
+    const ObjectSurface surface = build_object_surface(scene, sim.model());
+    const double down = -2 * R - 0.0015;
+    VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), false},
+                                     {0.3, Vec3(0, down, 0), false},
+                                     {0.4, Vec3(0, down + 0.0005, 0), false},
+                                     {0.5, Vec3(0, down - 0.0005, 0), false},
+                                     {0.6, Vec3(0, down, 0), false},
+                                     {0.8, Vec3(0.004, down, 0), false}}),
+                         known_device_specs("touch"));
+    InteractiveOptions o;
+    o.probe.radius = R;
+    o.mapping.origin = Vec3(0, 0.02 + 2 * R, 0);
+    o.duration = 0.8;
+    o.real_time = false;
+    o.surface = std::make_shared<const ObjectSurface>(surface);
+    Mat3 K = Mat3::Zero(), held = Mat3::Zero();
+    o.after_step = [&](long long) {
+      K = sim.probe()->contact_model().K;
+      held = sim.probe()->held_stiffness();
+    };
+    const InteractiveResult r = run_interactive(sim, device, o);
+    ASSERT_FALSE(sim.diagnostics().failed) << sim.diagnostics().failure;
+    const LocalModelSummary& m = r.local_model;
+    std::printf("%s: %lld updates, mean force %.4f N; stray mean / max: rendered %.3g / %.3g N, hold %.3g / %.3g N, held object "
+                "%.3g / %.3g N; K_yy %.4g N/m, held %.4g N/m\n",
+                solver.c_str(), m.updates, m.force_mean_n, m.rendered_mean_n, m.rendered_max_n, m.hold_mean_n, m.hold_max_n,
+                m.held_object_mean_n, m.held_object_max_n, K(1, 1), held(1, 1));
+    EXPECT_GT(m.updates, 300);
+    EXPECT_LT(m.rendered_mean_n, m.held_object_mean_n);
+    EXPECT_LT(m.rendered_mean_n, m.hold_mean_n);
+    // softer than the contact alone, and never pulling
+    EXPECT_LT(K(1, 1), 0.0);
+    EXPECT_GT(K(1, 1), held(1, 1));
+    EXPECT_LE(Eigen::SelfAdjointEigenSolver<Mat3>(K).eigenvalues().maxCoeff(), 1e-9 * std::abs(K(1, 1)));
+  }
 }
 
 }  // namespace

@@ -23,7 +23,7 @@ contact = [0.075, 0.03, 0.015]
 )";
 
 TEST(SceneSession, AProbeSceneGetsItsDeviceOptionsAndLevelsOfDetail) {
-  const SceneSession s = open_scene(parse_scene(test::cantilever_scene() + probe_and_lod), {1, 0, true});
+  const SceneSession s = open_scene(parse_scene(test::cantilever_scene() + probe_and_lod), {1, 0, true, {}});
   ASSERT_TRUE(s.simulation);
   EXPECT_TRUE(s.simulation->lod_enabled());
   EXPECT_LT(s.simulation->simulated_model().n_points, s.simulation->model().n_points);
@@ -35,14 +35,14 @@ TEST(SceneSession, AProbeSceneGetsItsDeviceOptionsAndLevelsOfDetail) {
   EXPECT_DOUBLE_EQ(s.interactive.duration, 2.0);
   EXPECT_GE(s.setup_seconds, 0.0);
   // a front end with its own device (the viewer, Python) gets the same options without one
-  const SceneSession without = open_scene(parse_scene(test::cantilever_scene() + probe_and_lod), {1, 0, false});
+  const SceneSession without = open_scene(parse_scene(test::cantilever_scene() + probe_and_lod), {1, 0, false, {}});
   EXPECT_FALSE(without.device);
   EXPECT_EQ(without.interactive.mapping.origin, s.interactive.mapping.origin);
   EXPECT_EQ(without.simulation->simulated_model().n_points, s.simulation->simulated_model().n_points);
 }
 
 TEST(SceneSession, APlainSceneHasNeitherDeviceNorLevelsOfDetail) {
-  const SceneSession s = open_scene(parse_scene(test::cantilever_scene()), {1, 0, true});
+  const SceneSession s = open_scene(parse_scene(test::cantilever_scene()), {1, 0, true, {}});
   EXPECT_FALSE(s.device);
   EXPECT_FALSE(s.simulation->lod_enabled());
   EXPECT_EQ(s.simulation->solver().kind, SolverKind::EXPLICIT);
@@ -53,7 +53,7 @@ TEST(SceneSession, BadScenesAreNamedErrors) {
   EXPECT_THROW(open_scene_file("/nonexistent/scene.toml"), Error);
   // a model beyond the memory allowed is refused before it is built
   try {
-    open_scene(parse_scene(test::cantilever_scene()), {1, 1e3, true});
+    open_scene(parse_scene(test::cantilever_scene()), {1, 1e3, true, {}});
     FAIL() << "accepted";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("memory"), std::string::npos) << e.what();

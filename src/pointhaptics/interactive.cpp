@@ -1,6 +1,7 @@
 #include <pointhaptics/interactive.hpp>
 
 #include <pointhaptics/haptics/haptic_log.hpp>
+#include <pointhaptics/haptics/local_model_stray.hpp>
 
 #include <fmt/format.h>
 
@@ -38,15 +39,20 @@ void publish_display(Simulation& sim, const HapticFrame& haptic, long long step,
 
 // One simulation step with the latest device point; then the local contact model is published for the
 // haptic loop (run_interactive publishes the display frames, at most one per display_period).
-int simulation_step(Simulation& sim, HapticLoop& loop) {
+// `stray` compares each model with the one before (`previous`, and its held-object stiffness).
+int simulation_step(Simulation& sim, HapticLoop& loop, LocalModelStray& stray, ContactModel& previous, Mat3& previous_held) {
   loop.frames().update();
   const HapticFrame& frame = loop.frames().front();
   sim.inputs().device = frame.device;
   sim.inputs().button = frame.button;
   sim.step();
-  loop.contact_models().back() = sim.probe()->contact_model();
+  const ProbeTool& probe = *sim.probe();
+  loop.contact_models().back() = probe.contact_model();
   loop.contact_models().publish();
-  return sim.probe()->contact_model().contacts;
+  stray.add(previous, previous_held, probe.contact_model());
+  previous = probe.contact_model();
+  previous_held = probe.held_stiffness();
+  return probe.contact_model().contacts;
 }
 
 }  // namespace
@@ -71,6 +77,9 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
   HapticLoop loop(device, options.mapping, gains, options.rules, options.haptic_rate,
                   options.log || streamed ? static_cast<std::size_t>(4 * options.haptic_rate) + 64 : 0);
   InteractiveResult result;
+  LocalModelStray stray;
+  ContactModel previous;
+  Mat3 previous_held = Mat3::Zero();
   const auto take_log = [&] {
     if (streamed) loop.take_log(options.log_sink);
     else if (options.log) loop.take_log([&](const HapticLogRow& row) { result.log.push_back(row); });
@@ -100,7 +109,7 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
         std::this_thread::sleep_for(std::chrono::duration<double>(sim.time() - t0 - wall));
         continue;
       }
-      result.max_contacts = std::max(result.max_contacts, simulation_step(sim, loop));
+      result.max_contacts = std::max(result.max_contacts, simulation_step(sim, loop, stray, previous, previous_held));
       ++result.simulation_steps;
       display(false);
       take_log();
@@ -116,7 +125,7 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
       if (!loop.tick(t, h)) break;
       take_log();
       while (sim.time() - t0 < t - 1e-12 && !sim.diagnostics().failed) {
-        result.max_contacts = std::max(result.max_contacts, simulation_step(sim, loop));
+        result.max_contacts = std::max(result.max_contacts, simulation_step(sim, loop, stray, previous, previous_held));
         ++result.simulation_steps;
         display(false);
         if (options.after_step) options.after_step(result.simulation_steps);
@@ -129,6 +138,7 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
   take_log();
   result.log_dropped = loop.log_dropped();
   result.tool = sim.tool_summary();  // before the probe is detached
+  result.local_model = stray.summary();
   return result;
 }
 
@@ -138,6 +148,7 @@ void add_interactive_summary(RunSummary& summary, const InteractiveResult& inter
   summary.haptic_rate_hz = interactive.haptic.rate_hz;
   summary.haptic_period_p99_us = interactive.haptic.period_p99_us;
   summary.haptic_max_force_n = interactive.haptic.max_force_n;
+  summary.local_model = interactive.local_model;
 }
 
 }  // namespace pointhaptics

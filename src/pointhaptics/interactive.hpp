@@ -66,6 +66,7 @@ struct InteractiveResult {
   double simulation_wall_s = 0;
   int max_contacts = 0;
   ToolSummary tool;               ///< the probe at the end (the result JSON's tool block)
+  LocalModelSummary local_model;  ///< how far each local model strayed from the next update
 };
 
 /// Run the simulation with a probe driven by `device` for options.duration. Real time: the haptic loop

@@ -43,7 +43,7 @@ const StepReport& ModelSimulation::step() {
   // the solver: internal, external and tool forces, time integration or equilibrium, held points
   DynamicForces* tools = probe_ ? static_cast<DynamicForces*>(&probe_->tool) : held_tool_.get();
   report_ = solver_impl_->step(model_, state_, ws_, tools);
-  if (tools && report_.status != StepStatus::FAILED) tools->after_step(model_, state_);
+  if (tools && report_.status != StepStatus::FAILED) tools->after_step(model_, state_, ws_);
   const auto solved = clock::now();
   // a state that is not finite is not a result, whatever the solver said; nor is an inverted one (counted)
   check_finite(report_);

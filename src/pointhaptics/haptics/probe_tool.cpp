@@ -9,7 +9,7 @@ namespace pointhaptics {
 ProbeTool::ProbeTool(const Model& model, const ProbeParams& params, double coupling_stiffness, double max_force,
                      std::optional<SurfaceContact> surface)
     : contact_(model, params), surface_(std::move(surface)), k_(coupling_stiffness), max_force_(max_force),
-      scratch_(Points::Zero(3, model.n_points)) {}
+      scratch_(Points::Zero(3, model.n_points)), compliance_solver_(model) {}
 
 bool ProbeTool::pushing_surface() const {
   const ProbeMode mode = contact_.params().mode;
@@ -65,14 +65,57 @@ void ProbeTool::place(const Model& model, const State& state, const Vec3& device
 void ProbeTool::add(const Model& model, const State& state, Points& f) {
   if (!pushing_surface() || !probe_.allFinite()) {
     last_ = contact_.apply(model, state.u, probe_, button_, state.time, f);
+    held_K_ = last_.K;
     return;
   }
   surface_->add_forces(model, state.u, f);
   last_ = contact_model_of(surface_->last_load(), state.time, probe_);
 }
 
-void ProbeTool::after_step(const Model& model, const State& state) {
-  if (pushing_surface() && probe_.allFinite()) last_ = surface_model(model, state, probe_, false);
+void ProbeTool::after_step(const Model& model, const State& state, Workspace& ws) {
+  if (!pushing_surface() || !probe_.allFinite()) return;
+  last_ = surface_model(model, state, probe_, false);
+  held_K_ = last_.K;
+  if (last_.contacts > 0) last_.K = compliance_stiffness(model, state, ws, last_.K);
+  compliance_contacts_ = last_.contacts;
+}
+
+Mat3 ProbeTool::compliance_stiffness(const Model& model, const State& state, Workspace& ws, const Mat3& held) {
+  // the static tangent of the object with the contact: an object held nowhere has none (it gives way as a
+  // whole), and keeps the held object's stiffness
+  if (std::find(model.fixed.begin(), model.fixed.end(), 1) == model.fixed.end()) return held;
+  const Points no_load;
+  NewtonProblem problem;
+  problem.load = &no_load;
+  problem.term = &*surface_;
+  // a workspace of its own: the step's keeps what the solver carries to the next step (its last forces)
+  if (!compliance_ws_) compliance_ws_ = std::make_unique<Workspace>(model, ws.n_threads());
+  compliance_solver_.linearise(model, problem, state.u, *compliance_ws_);
+  if (compliance_load_.cols() != model.n_points) {
+    compliance_load_ = Points::Zero(3, model.n_points);
+    for (Points& x : compliance_) x = Points::Zero(3, model.n_points);
+  }
+  if (compliance_contacts_ == 0)
+    for (Points& x : compliance_) x.setZero();  // a new contact: the last solutions are of another one
+  Mat3 coupling, sum = Mat3::Zero();
+  for (int a = 0; a < 3; ++a) {
+    compliance_load_.setZero();
+    sum = surface_->add_tool_load(Vec3::Unit(a), compliance_load_);
+    const int iterations =
+        compliance_solver_.solve_linearised(model, problem, compliance_load_, compliance_[a], compliance_tolerance, compliance_budget,
+                                            *compliance_ws_);
+    if (iterations < 0 || !compliance_[a].allFinite()) {
+      for (Points& x : compliance_) x.setZero();
+      return held;
+    }
+    coupling.col(a) = surface_->tool_response(compliance_[a]);  // B^T H^-1 B e_a
+  }
+  // symmetric (it is, but for the solves' tolerance) and negative semi-definite: the haptic side's coupling
+  // solve needs K <= 0, and a partial solve keeps it there but for round-off
+  const Mat3 K = 0.5 * (coupling + coupling.transpose()) - sum;
+  Eigen::SelfAdjointEigenSolver<Mat3> eigen(K);
+  if (eigen.info() != Eigen::Success || !K.allFinite()) return held;
+  return eigen.eigenvectors() * eigen.eigenvalues().cwiseMin(0.0).asDiagonal() * eigen.eigenvectors().transpose();
 }
 
 // Implicit steps take the contact's forces at the step's start and its normal stiffness, per point, as springs
@@ -93,6 +136,8 @@ void ProbeTool::remap(const Model& model, const std::vector<index_t>& new_index)
   contact_.remap(model, new_index);
   surface_.reset();  // its map is over the points it was built for: the point spheres from now on
   scratch_ = Points::Zero(3, model.n_points);
+  compliance_ws_.reset();
+  compliance_load_.resize(3, 0);
 }
 
 }  // namespace pointhaptics

@@ -5,6 +5,8 @@
 #include <pointhaptics/haptics/surface_contact.hpp>
 #include <pointhaptics/solvers/solver.hpp>
 
+#include <array>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -27,8 +29,9 @@ class ProbeTool final : public DynamicForces {
   void add(const Model& model, const State& state, Points& f) override;
   bool add_stiffness(const Model&, const State&, Eigen::Matrix<double, 9, Eigen::Dynamic>& springs) override;
   double max_point_stiffness() const override;
-  /// Pushing on the surface: the local contact model at the step's end state, for the haptic side.
-  void after_step(const Model& model, const State& state) override;
+  /// Pushing on the surface: the local contact model at the step's end state, for the haptic side, its
+  /// stiffness through the object's compliance (compliance_stiffness()).
+  void after_step(const Model& model, const State& state, Workspace& ws) override;
 
   /// Whether the probe touches the object's surface (else the point spheres).
   bool on_surface() const { return surface_.has_value(); }
@@ -39,6 +42,8 @@ class ProbeTool final : public DynamicForces {
   const Vec3& probe() const { return probe_; }
   /// The local contact model of the last force evaluation, for the haptic side.
   const ContactModel& contact_model() const { return last_; }
+  /// Its stiffness against the held object (the contact's own, before the object's compliance is taken in).
+  const Mat3& held_stiffness() const { return held_K_; }
   /// Points in contact when the step began (before place()): contact onset is 0 before, > 0 after.
   int contacts_before_step() const { return contacts_before_; }
   const ProbeContact& contact() const { return contact_; }
@@ -47,6 +52,12 @@ class ProbeTool final : public DynamicForces {
   bool pushing_surface() const;
   /// The local model of the surface contact at the probe position p (u as in the last evaluation when same_u).
   ContactModel surface_model(const Model& model, const State& state, const Vec3& p, bool same_u);
+  /// The stiffness the tool feels with the object free to give (issue 16, item 4): K = B^T H^-1 B - sum_v H_v,
+  /// the Schur complement of the points in the tangent of the object and the contact (H: the static tangent,
+  /// B = W^T sum_v H_v: the points' load per unit of tool motion), by three warm-started CG solves within a
+  /// budget of iterations (a partial solve gives a K between the held object's and the true one, stiffer
+  /// than the truth, never softer). Falls back to the held object's -sum_v H_v when a solve fails.
+  Mat3 compliance_stiffness(const Model& model, const State& state, Workspace& ws, const Mat3& held);
 
   ProbeContact contact_;
   std::optional<SurfaceContact> surface_;
@@ -56,7 +67,17 @@ class ProbeTool final : public DynamicForces {
   bool button_ = false;
   int contacts_before_ = 0;
   ContactModel last_;
+  Mat3 held_K_ = Mat3::Zero();
   Points scratch_;
+  /// the compliance solves: relative tolerance, CG iterations per direction and step (warm-started, the rest
+  /// of the convergence comes over the next steps)
+  static constexpr double compliance_tolerance = 1e-2;
+  static constexpr int compliance_budget = 20;
+  NewtonSolver compliance_solver_;
+  std::unique_ptr<Workspace> compliance_ws_;
+  Points compliance_load_;                   // B e, one direction at a time
+  std::array<Points, 3> compliance_;         // H^-1 B e_a: the warm starts of the next step
+  int compliance_contacts_ = 0;              // contacts when they were made (0: start cold)
 };
 
 }  // namespace pointhaptics

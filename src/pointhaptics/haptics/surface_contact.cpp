@@ -164,6 +164,26 @@ void SurfaceContact::add_tangent_product(const Points& dx, Points& out) const {
   }
 }
 
+Mat3 SurfaceContact::add_tool_load(const Vec3& e, Points& b) const {
+  Mat3 sum = Mat3::Zero();
+  for (const Active& a : active_) {
+    sum += a.preconditioner;
+    const Vec3 h = a.preconditioner * e;
+    for (index_t k = map_.points.begin(a.vertex); k < map_.points.end(a.vertex); ++k) b.col(map_.points.index[k]) += map_.weight[k] * h;
+  }
+  return sum;
+}
+
+Vec3 SurfaceContact::tool_response(const Points& x) const {
+  Vec3 f = Vec3::Zero();
+  for (const Active& a : active_) {
+    Vec3 y = Vec3::Zero();
+    for (index_t k = map_.points.begin(a.vertex); k < map_.points.end(a.vertex); ++k) y += map_.weight[k] * x.col(map_.points.index[k]);
+    f += a.preconditioner * y;
+  }
+  return f;
+}
+
 void SurfaceContact::add_diagonal_blocks(Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks) const {
   // the positive parts only (the normal and the friction's stiffness): the preconditioner wants positive blocks
   for (const Active& a : active_)

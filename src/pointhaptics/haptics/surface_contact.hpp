@@ -76,6 +76,13 @@ class SurfaceContact final : public EnergyTerm {
   void linearise(const Model& model, const Points& u, TangentMode mode) override;
   void add_tangent_product(const Points& dx, Points& out) const override;
   void add_diagonal_blocks(Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks) const override;
+  /// The tool's coupling to the points, at the last linearise(): b += W^T sum_v H_v e, the load on the points
+  /// when the tool moves by e with them held (H_v the vertex's positive stiffness, k_v n_v n_v^T pressing, the
+  /// friction's sticking); returns sum_v H_v, the tool's stiffness against the held object.
+  Mat3 add_tool_load(const Vec3& e, Points& b) const;
+  /// The other side of that coupling: sum_v H_v W_v x, the force the vertices' stiffness makes on the tool when
+  /// the points move by x (so B^T x, with B's columns add_tool_load() of the axes).
+  Vec3 tool_response(const Points& x) const;
   /// Uzawa's update at u: true (multipliers kept) when no vertex is deeper in the tool than the tolerance.
   bool update_multipliers(const Model& model, const Points& u) override;
 

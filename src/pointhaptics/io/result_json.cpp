@@ -52,8 +52,19 @@ std::string result_json(const Model& model, const State& state, const RunSummary
                            {"reaction", g < s.reactions.size() ? vec(s.reactions[g]) : vec(Vec3::Zero())}});
   doc["constraints"] = constraints;
   // zero without a probe
-  doc["haptic"] = {{"ticks", s.haptic_ticks}, {"rate_hz", s.haptic_rate_hz}, {"period_p99_us", s.haptic_period_p99_us},
-                   {"max_force_n", s.haptic_max_force_n}};
+  const LocalModelSummary& m = s.local_model;
+  doc["haptic"] = {{"ticks", s.haptic_ticks},
+                   {"rate_hz", s.haptic_rate_hz},
+                   {"period_p99_us", s.haptic_period_p99_us},
+                   {"max_force_n", s.haptic_max_force_n},
+                   {"local_model", {{"updates", m.updates},
+                                    {"force_mean_n", m.force_mean_n},
+                                    {"stray_mean_n", m.rendered_mean_n},
+                                    {"stray_max_n", m.rendered_max_n},
+                                    {"hold_stray_mean_n", m.hold_mean_n},
+                                    {"hold_stray_max_n", m.hold_max_n},
+                                    {"held_object_stray_mean_n", m.held_object_mean_n},
+                                    {"held_object_stray_max_n", m.held_object_max_n}}}};
   if (s.tool.present) {
     const ToolSummary& t = s.tool;
     doc["tool"] = {{"kind", t.kind},         {"position", vec(t.position)}, {"force", vec(t.force)},

@@ -36,6 +36,17 @@ struct ToolSummary {
   Vec3 friction = Vec3::Zero();              ///< N, the part of `force` friction makes (held tools with friction)
 };
 
+/// How far the haptic side's local model F(p) = f0 + K (p - p0) strays from the next update's force f0' at
+/// its p0' (issue 16, item 4): |f0 + K (p0' - p0) - f0'| over the updates made in contact, N, for the K
+/// rendered, for none (the force held between updates) and for the held object's (the contact's own stiffness).
+struct LocalModelSummary {
+  long long updates = 0;       ///< updates compared (both in contact)
+  double force_mean_n = 0;     ///< mean |f0'|, N
+  double rendered_mean_n = 0, rendered_max_n = 0;
+  double hold_mean_n = 0, hold_max_n = 0;
+  double held_object_mean_n = 0, held_object_max_n = 0;
+};
+
 struct RunSummary {
   std::string solver_kind;
   bool converged = false;
@@ -62,6 +73,7 @@ struct RunSummary {
   // haptic loop (runs with a probe)
   long long haptic_ticks = 0;
   double haptic_rate_hz = 0, haptic_period_p99_us = 0, haptic_max_force_n = 0;
+  LocalModelSummary local_model;
   LodSummary lod;
   ToolSummary tool;
 };

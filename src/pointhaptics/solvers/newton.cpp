@@ -98,9 +98,40 @@ void NewtonSolver::build_preconditioner(const Model& model, const NewtonProblem&
   }
 }
 
+void NewtonSolver::apply_tangent(const Model& model, const NewtonProblem& problem, const Points& p, Workspace& ws, Points& q) const {
+  tangent_.apply(model, p, ws, q);
+  if (problem.inertia > 0) q += problem.inertia * (p.array().rowwise() * model.mass.transpose().array()).matrix();
+  if (problem.springs)
+    for (index_t i = 0; i < model.n_points; ++i) q.col(i) += Eigen::Map<const Mat3>(problem.springs->col(i).data()) * p.col(i);
+  if (problem.term) problem.term->add_tangent_product(p, q);
+  mask_held(model, q);
+}
+
+void NewtonSolver::linearise(const Model& model, const NewtonProblem& problem, const Points& u, Workspace& ws) {
+  tangent_.linearise(model, u, TangentMode::PROJECTED, &ws);
+  if (problem.term) problem.term->linearise(model, u, TangentMode::PROJECTED);
+  build_preconditioner(model, problem, ws);
+  preconditioner_mode_ = TangentMode::PROJECTED;
+}
+
+int NewtonSolver::solve_linearised(const Model& model, const NewtonProblem& problem, const Points& b, Points& x,
+                                   double tolerance, int max_iterations, Workspace& ws) {
+  SolverScratch& s = ws.solver_scratch();
+  Points &r = s.r, &dx = s.dx;
+  // the residual of the warm start, then CG on the correction
+  apply_tangent(model, problem, x, ws, r);
+  r = b - r;
+  mask_held(model, r);
+  const double target = tolerance * b.norm(), left = r.norm();
+  if (!(left > target)) return 0;
+  long long iterations = 0;
+  const bool positive = conjugate_gradients(model, problem, r, target / left, max_iterations, ws, dx, iterations);
+  if (positive) x += dx;
+  return positive ? static_cast<int>(iterations) : -static_cast<int>(iterations);
+}
+
 bool NewtonSolver::conjugate_gradients(const Model& model, const NewtonProblem& problem, const Points& r, double eta,
                                        int max_iterations, Workspace& ws, Points& x, long long& iterations) {
-  const double inertia = problem.inertia;
   SolverScratch& s = ws.solver_scratch();
   Points &cg_r = s.cg_r, &cg_z = s.cg_z, &cg_p = s.cg_p, &cg_q = s.cg_q;
   x.setZero();
@@ -110,13 +141,7 @@ bool NewtonSolver::conjugate_gradients(const Model& model, const NewtonProblem& 
   double rz = dot(cg_r, cg_z);
   const double target = eta * r.norm();
   for (int k = 0; k < max_iterations; ++k) {
-    tangent_.apply(model, cg_p, ws, cg_q);
-    if (inertia > 0) cg_q += inertia * (cg_p.array().rowwise() * model.mass.transpose().array()).matrix();
-    if (problem.springs)
-      for (index_t i = 0; i < model.n_points; ++i)
-        cg_q.col(i) += Eigen::Map<const Mat3>(problem.springs->col(i).data()) * cg_p.col(i);
-    if (problem.term) problem.term->add_tangent_product(cg_p, cg_q);
-    mask_held(model, cg_q);
+    apply_tangent(model, problem, cg_p, ws, cg_q);
     const double curvature = dot(cg_p, cg_q);
     ++iterations;
     if (!(curvature > 0)) return false;  // negative curvature: the caller switches to the projected tangent

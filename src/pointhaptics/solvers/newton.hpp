@@ -73,6 +73,16 @@ class NewtonSolver {
   NewtonStats solve(const Model& model, const NewtonProblem& problem, Points& u, Workspace& ws,
                     const NewtonSettings& settings);
 
+  /// The problem's tangent at u, for solve_linearised(): its positive semi-definite part (TangentMode::PROJECTED)
+  /// and the block-Jacobi preconditioner. (A tool's compliance: what the object gives under a load.)
+  void linearise(const Model& model, const NewtonProblem& problem, const Points& u, Workspace& ws);
+  /// H x = b over the free points with the tangent of the last linearise(), by PCG from the x given (a warm
+  /// start) to |b - H x| <= tolerance |b| or max_iterations; x keeps the last iterate. Uses the workspace's
+  /// solver scratch. Returns the CG iterations taken (negative when CG met a direction of non-positive
+  /// curvature: x is then the last iterate before it).
+  int solve_linearised(const Model& model, const NewtonProblem& problem, const Points& b, Points& x, double tolerance,
+                       int max_iterations, Workspace& ws);
+
  private:
   /// Pi(u); `step`: the material within a viscoelastic step (viscoelasticity.hpp)
   double energy(const Model& model, const NewtonProblem& problem, const Points& u, std::vector<Mat3>& gradients,
@@ -85,6 +95,8 @@ class NewtonSolver {
   bool conjugate_gradients(const Model& model, const NewtonProblem& problem, const Points& r, double eta,
                            int max_iterations, Workspace& ws, Points& x, long long& iterations);
   void mask_held(const Model& model, Points& x) const;
+  /// q = H p with H the problem's tangent as last linearised (material, inertia, springs, term), zero at held points
+  void apply_tangent(const Model& model, const NewtonProblem& problem, const Points& p, Workspace& ws, Points& q) const;
 
   Tangent tangent_;
   TangentMode preconditioner_mode_ = TangentMode::EXACT;

@@ -29,8 +29,9 @@ class DynamicForces {
   /// The forces as a term of the energy, which the Newton solvers (static, implicit) minimise with the
   /// material's instead of calling add() and add_stiffness(); nullptr if they have none.
   virtual EnergyTerm* energy_term() { return nullptr; }
-  /// Once per step, after it, at the state it reached (a probe's local contact model for the haptic side).
-  virtual void after_step(const Model&, const State&) {}
+  /// Once per step, after it, at the state it reached (a probe's local contact model for the haptic side);
+  /// `ws` is the step's workspace (its threads; what it holds is the solver's, for the next step).
+  virtual void after_step(const Model&, const State&, Workspace&) {}
 };
 
 enum class StepStatus {
