@@ -90,23 +90,30 @@ Mat3 ProbeTool::compliance_stiffness(const Model& model, const State& state, Wor
   problem.term = &*surface_;
   // a workspace of its own: the step's keeps what the solver carries to the next step (its last forces)
   if (!compliance_ws_) compliance_ws_ = std::make_unique<Workspace>(model, ws.n_threads());
-  compliance_solver_.linearise(model, problem, state.u, *compliance_ws_);
+  // the contact's tangent every step; the material's every few (a 9x9 eigen decomposition per point made it
+  // cost twice the step of a 2.6k-point block), and at every new contact
+  const bool material = compliance_contacts_ == 0 || compliance_turn_ % compliance_relinearise == 0;
+  compliance_solver_.linearise(model, problem, state.u, *compliance_ws_, material);
   if (compliance_load_.cols() != model.n_points) {
     compliance_load_ = Points::Zero(3, model.n_points);
     for (Points& x : compliance_) x = Points::Zero(3, model.n_points);
   }
   if (compliance_contacts_ == 0)
     for (Points& x : compliance_) x.setZero();  // a new contact: the last solutions are of another one
+  // one direction's solve per step, in turn (the other two keep their last solutions, warm starts of their
+  // next turn): the compliance changes slowly at a hand's speed, and three solves a step tripled its cost
+  const int turn = compliance_turn_++ % 3;
   Mat3 coupling, sum = Mat3::Zero();
   for (int a = 0; a < 3; ++a) {
     compliance_load_.setZero();
     sum = surface_->add_tool_load(Vec3::Unit(a), compliance_load_);
-    const int iterations =
-        compliance_solver_.solve_linearised(model, problem, compliance_load_, compliance_[a], compliance_tolerance, compliance_budget,
-                                            *compliance_ws_);
-    if (iterations < 0 || !compliance_[a].allFinite()) {
-      for (Points& x : compliance_) x.setZero();
-      return held;
+    if (a == turn || compliance_contacts_ == 0) {
+      const int iterations = compliance_solver_.solve_linearised(model, problem, compliance_load_, compliance_[a], compliance_tolerance,
+                                                                  compliance_budget, *compliance_ws_);
+      if (iterations < 0 || !compliance_[a].allFinite()) {
+        for (Points& x : compliance_) x.setZero();
+        return held;
+      }
     }
     coupling.col(a) = surface_->tool_response(compliance_[a]);  // B^T H^-1 B e_a
   }

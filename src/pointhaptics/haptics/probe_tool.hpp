@@ -54,9 +54,9 @@ class ProbeTool final : public DynamicForces {
   ContactModel surface_model(const Model& model, const State& state, const Vec3& p, bool same_u);
   /// The stiffness the tool feels with the object free to give (issue 16, item 4): K = B^T H^-1 B - sum_v H_v,
   /// the Schur complement of the points in the tangent of the object and the contact (H: the static tangent,
-  /// B = W^T sum_v H_v: the points' load per unit of tool motion), by three warm-started CG solves within a
-  /// budget of iterations (a partial solve gives a K between the held object's and the true one, stiffer
-  /// than the truth, never softer). Falls back to the held object's -sum_v H_v when a solve fails.
+  /// B = W^T sum_v H_v: the points' load per unit of tool motion), by three warm-started CG solves, one a
+  /// step in turn within a budget of iterations (a partial solve from zero gives a K between the held
+  /// object's and the true one). Falls back to the held object's -sum_v H_v when a solve fails.
   Mat3 compliance_stiffness(const Model& model, const State& state, Workspace& ws, const Mat3& held);
 
   ProbeContact contact_;
@@ -69,15 +69,18 @@ class ProbeTool final : public DynamicForces {
   ContactModel last_;
   Mat3 held_K_ = Mat3::Zero();
   Points scratch_;
-  /// the compliance solves: relative tolerance, CG iterations per direction and step (warm-started, the rest
-  /// of the convergence comes over the next steps)
+  /// the compliance solves: relative tolerance and CG iterations of a direction's turn (warm-started, the rest
+  /// of the convergence comes over the next turns)
   static constexpr double compliance_tolerance = 1e-2;
-  static constexpr int compliance_budget = 20;
+  static constexpr int compliance_budget = 10;
+  /// steps between linearisations of the material's tangent (in between it lags; the contact's is made anew)
+  static constexpr int compliance_relinearise = 12;
   NewtonSolver compliance_solver_;
   std::unique_ptr<Workspace> compliance_ws_;
   Points compliance_load_;                   // B e, one direction at a time
   std::array<Points, 3> compliance_;         // H^-1 B e_a: the warm starts of the next step
-  int compliance_contacts_ = 0;              // contacts when they were made (0: start cold)
+  int compliance_contacts_ = 0;              // contacts when they were made (0: start cold, all three solved)
+  long long compliance_turn_ = 0;
 };
 
 }  // namespace pointhaptics

@@ -107,9 +107,10 @@ void NewtonSolver::apply_tangent(const Model& model, const NewtonProblem& proble
   mask_held(model, q);
 }
 
-void NewtonSolver::linearise(const Model& model, const NewtonProblem& problem, const Points& u, Workspace& ws) {
-  tangent_.linearise(model, u, TangentMode::PROJECTED, &ws);
+void NewtonSolver::linearise(const Model& model, const NewtonProblem& problem, const Points& u, Workspace& ws, bool material) {
   if (problem.term) problem.term->linearise(model, u, TangentMode::PROJECTED);
+  if (!material) return;
+  tangent_.linearise(model, u, TangentMode::PROJECTED, &ws);
   build_preconditioner(model, problem, ws);
   preconditioner_mode_ = TangentMode::PROJECTED;
 }

@@ -74,8 +74,10 @@ class NewtonSolver {
                     const NewtonSettings& settings);
 
   /// The problem's tangent at u, for solve_linearised(): its positive semi-definite part (TangentMode::PROJECTED)
-  /// and the block-Jacobi preconditioner. (A tool's compliance: what the object gives under a load.)
-  void linearise(const Model& model, const NewtonProblem& problem, const Points& u, Workspace& ws);
+  /// and the block-Jacobi preconditioner. (A tool's compliance: what the object gives under a load.) Without
+  /// `material` only the term is linearised again, the material's tangent and the preconditioner lag (they
+  /// cost most: a 9x9 eigen decomposition per point).
+  void linearise(const Model& model, const NewtonProblem& problem, const Points& u, Workspace& ws, bool material = true);
   /// H x = b over the free points with the tangent of the last linearise(), by PCG from the x given (a warm
   /// start) to |b - H x| <= tolerance |b| or max_iterations; x keeps the last iterate. Uses the workspace's
   /// solver scratch. Returns the CG iterations taken (negative when CG met a direction of non-positive
