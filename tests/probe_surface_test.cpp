@@ -39,6 +39,17 @@ dt = 1e-3
   return s;
 }
 
+// a probe of radius R on the block's surface, the device's origin 2 R above its top face, in simulated time
+InteractiveOptions probe_options(const ObjectSurface& surface, double duration) {
+  InteractiveOptions o;
+  o.probe.radius = R;
+  o.mapping.origin = Vec3(0, 0.02 + 2 * R, 0);
+  o.duration = duration;
+  o.real_time = false;
+  o.surface = std::make_shared<const ObjectSurface>(surface);
+  return o;
+}
+
 struct Press {
   Vec3 probe;      // the probe's final position
   Vec3 felt;       // the last force rendered to the device
@@ -52,12 +63,7 @@ Press press(const std::string& solver) {
   const ObjectSurface surface = build_object_surface(scene, sim.model());
   VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), false}, {0.4, Vec3(0, -2 * R - 0.0015, 0), false}, {0.6, Vec3(0, -2 * R - 0.0015, 0), false}}),
                        known_device_specs("touch"));
-  InteractiveOptions o;
-  o.probe.radius = R;
-  o.mapping.origin = Vec3(0, 0.02 + 2 * R, 0);
-  o.duration = 0.6;
-  o.real_time = false;
-  o.surface = std::make_shared<const ObjectSurface>(surface);
+  InteractiveOptions o = probe_options(surface, 0.6);
   Press p;
   o.after_step = [&](long long) {
     p.probe = sim.probe()->probe();
@@ -114,12 +120,7 @@ TEST(ProbeOnSurface, TheLocalModelsStiffnessIsTheObjectsAndPredictsTheNextUpdate
                                      {0.6, Vec3(0, down, 0), false},
                                      {0.8, Vec3(0.004, down, 0), false}}),
                          known_device_specs("touch"));
-    InteractiveOptions o;
-    o.probe.radius = R;
-    o.mapping.origin = Vec3(0, 0.02 + 2 * R, 0);
-    o.duration = 0.8;
-    o.real_time = false;
-    o.surface = std::make_shared<const ObjectSurface>(surface);
+    InteractiveOptions o = probe_options(surface, 0.8);
     Mat3 K = Mat3::Zero(), held = Mat3::Zero();
     o.after_step = [&](long long) {
       K = sim.probe()->contact_model().K;

@@ -50,6 +50,13 @@ def _wait_for_workers(client, n: int, where: str, timeout: float = 120) -> None:
                          f"({len(client.scheduler_info().get('workers', {}))} did)") from None
 
 
+def add_arguments(parser) -> None:
+    """The command-line options that say where the simulations run, and how chatty (study and fit alike)."""
+    parser.add_argument("--scheduler", help="an existing Dask cluster, tcp://HOST:PORT (default: a local cluster)")
+    parser.add_argument("--workers", type=int, help="local cluster: worker processes (default: the cores)")
+    parser.add_argument("--quiet", "-q", action="store_true", help="no progress")
+
+
 def workers_of(client) -> int:
     return len(client.scheduler_info().get("workers", {}))
 

@@ -259,9 +259,7 @@ def main(argv=None) -> int:
     parser.add_argument("--model", help="material.model to fit (svk, neo_hookean, mooney_rivlin, corotated)")
     parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="other scene keys (repeatable)")
     parser.add_argument("--out", required=True, help="output folder: fit.json, fit.csv, fit.png")
-    parser.add_argument("--scheduler", help="an existing Dask cluster, tcp://HOST:PORT (default: a local cluster)")
-    parser.add_argument("--workers", type=int, help="local cluster: worker processes (default: the cores)")
-    parser.add_argument("--quiet", "-q", action="store_true", help="no progress")
+    cluster.add_arguments(parser)
     a = parser.parse_args(argv)
     try:
         settings = {}

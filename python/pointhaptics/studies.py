@@ -264,9 +264,7 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="pointhaptics study", description="Run a parameter study on Dask (docs/studies.md)")
     parser.add_argument("study", help="the study file (TOML)")
     parser.add_argument("--out", required=True, help="output folder: study.csv, study.json, a PNG per output")
-    parser.add_argument("--scheduler", help="an existing Dask cluster, tcp://HOST:PORT (default: a local cluster)")
-    parser.add_argument("--workers", type=int, help="local cluster: worker processes (default: the cores)")
-    parser.add_argument("--quiet", "-q", action="store_true", help="no progress")
+    cluster.add_arguments(parser)
     a = parser.parse_args(argv)
     try:
         table = run_study(a.study, out=a.out, scheduler=a.scheduler, workers=a.workers, progress=not a.quiet)
