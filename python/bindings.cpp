@@ -110,14 +110,43 @@ std::unique_lock<std::mutex> locked(PySimulation& p) {
   return lock;
 }
 
-// {key: value} -> scene settings: each value as JSON, which TOML reads for numbers, strings, booleans and
-// lists (a NaN or None is then a named error of the setting)
+// A Python value as TOML text: numbers, booleans, strings, lists and dicts (inline tables, e.g. lod.levels =
+// [{"distance": 3.0, "K": 6}]); NumPy scalars by their item(); NaN and infinities as TOML's nan and inf (which
+// the scene reader then names as not finite)
+std::string toml_value(const std::string& key, py::handle v) {
+  if (py::isinstance<py::bool_>(v)) return v.cast<bool>() ? "true" : "false";
+  if (py::isinstance<py::int_>(v)) return py::str(v).cast<std::string>();
+  if (py::isinstance<py::float_>(v)) {
+    const double x = v.cast<double>();
+    if (std::isnan(x)) return "nan";
+    if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
+    return fmt::format("{:.17g}", x);
+  }
+  if (py::isinstance<py::str>(v)) return py::module_::import("json").attr("dumps")(v).cast<std::string>();
+  if (py::isinstance<py::list>(v) || py::isinstance<py::tuple>(v)) {
+    std::string out = "[";
+    for (py::handle item : v) out += (out.size() > 1 ? ", " : "") + toml_value(key, item);
+    return out + "]";
+  }
+  if (py::isinstance<py::dict>(v)) {
+    std::string out = "{";
+    for (const auto& [k, item] : v.cast<py::dict>())
+      out += fmt::format("{}{} = {}", out.size() > 1 ? ", " : " ", toml_value(key, py::str(k)), toml_value(key, item));
+    return out + " }";
+  }
+  if (py::hasattr(v, "item")) return toml_value(key, v.attr("item")());  // a NumPy scalar
+  throw ph::Error(fmt::format("settings: {}: a value of type {} is not a scene value (numbers, booleans, strings, lists, dicts)", key,
+                              py::str(py::type::of(v).attr("__name__")).cast<std::string>()));
+}
+
+// {key: value} -> scene settings
 std::vector<ph::SceneSetting> settings_of(const py::object& settings) {
   std::vector<ph::SceneSetting> out;
   if (settings.is_none()) return out;
-  const py::object dumps = py::module_::import("json").attr("dumps");
-  for (const auto& [key, value] : settings.cast<py::dict>())
-    out.push_back({py::str(key).cast<std::string>(), dumps(value).cast<std::string>()});
+  for (const auto& [key, value] : settings.cast<py::dict>()) {
+    const std::string k = py::str(key).cast<std::string>();
+    out.push_back({k, toml_value(k, value)});
+  }
   return out;
 }
 

@@ -40,6 +40,14 @@ def test_settings_change_the_scene_and_text_travels_instead_of_objects():
     np.testing.assert_array_equal(again.displacement, base.displacement)
     with pytest.raises(ph.Error, match=r"material.young \(set to -1\): -1 is out of range"):
         ph.Simulation.from_scene(scene("cantilever_static.toml"), settings={"material.young": -1})
+    # inline tables and NumPy values too
+    lod = ph.Simulation.from_scene(scene("half_sphere_lod.toml"), threads=1,
+                                   settings={"lod.levels": [{"distance": 4.0, "K": np.int64(7)}], "lod.k1": np.float64(1.2)})
+    assert "lod" in lod.summary()
+    with pytest.raises(ph.Error, match="lod.levels"):
+        ph.Simulation.from_scene(scene("half_sphere_lod.toml"), settings={"lod.levels": [{"distance": 4.0, "K": 11}]})
+    with pytest.raises(ph.Error, match="material.young: a value of type object is not a scene value"):
+        ph.Simulation.from_scene(scene("cantilever_static.toml"), settings={"material.young": object()})
     with pytest.raises(ph.Error, match="does not travel to another process"):
         pickle.dumps(base)
     # the functions a worker runs travel by reference
@@ -68,7 +76,7 @@ def test_a_study_gathers_its_runs_reports_a_failing_one_and_writes_its_outputs(t
     table = ph.study(SMALL_STUDY, out=str(tmp_path), workers=2, progress=False)
     assert list(table.index) == [0, 1, 2, 3, 4]
     bad = table.loc[2]
-    assert "material.young (set to -1.0)" in bad["error"] and np.isnan(bad["tip"])
+    assert "material.young (set to -1)" in bad["error"] and np.isnan(bad["tip"])
     good = table.drop(index=2)
     assert (good["error"] == "").all() and np.all(np.isfinite(good["tip"]))
     # the stiffer, the less it sags; the run at the reference's modulus has no error against it
