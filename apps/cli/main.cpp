@@ -232,6 +232,11 @@ int run_command(const RunOptions& opt) {
                  "{} simulation steps\n",
                  h.ticks, h.rate_hz, h.period_p50_us, h.period_p99_us, h.period_max_us, h.tick_max_us, h.spin_mean_us, h.max_force_n,
                  interactive.max_contacts, interactive.simulation_steps);
+      const ph::LocalModelSummary& m = interactive.local_model;
+      if (m.updates > 0)
+        fmt::print("local model     over {} updates in contact (mean force {:.3g} N) it strayed from the next by {:.3g} N on "
+                   "average, {:.3g} N at most (held force: {:.3g} N; the contact's own stiffness: {:.3g} N)\n",
+                   m.updates, m.force_mean_n, m.rendered_mean_n, m.rendered_max_n, m.hold_mean_n, m.held_object_mean_n);
       if (options_real_time && interactive.simulation_wall_s > 0) {
         // a real-time run whose simulation could not keep up with the wall clock says by how much
         const double simulated = sim.time() - start_time;
