@@ -76,11 +76,21 @@ void ProbeTool::after_step(const Model& model, const State& state, Workspace& ws
   if (!pushing_surface() || !probe_.allFinite()) return;
   last_ = surface_model(model, state, probe_, false);
   held_K_ = last_.K;
-  if (last_.contacts > 0) last_.K = compliance_stiffness(model, state, ws, last_.K);
+  // made before the first touch: a step that allocates it (and linearises the material) as the probe arrives
+  // let the hand run ahead of a slow simulation (under a sanitizer) and the probe through the surface
+  if (!compliance_ws_) compliance_ws_ = std::make_unique<Workspace>(model, ws.n_threads());
+  if (last_.contacts > 0 && compliance_contacts_ > 0) {
+    last_.K = compliance_stiffness(model, state, last_.K);
+  } else if (last_.contacts > 0) {
+    // a new contact: the held object's stiffness this step, the compliance's solves from the next one on,
+    // the material linearised first (the last solutions are of another contact)
+    for (Points& x : compliance_) x.setZero();
+    compliance_turn_ = 0;
+  }
   compliance_contacts_ = last_.contacts;
 }
 
-Mat3 ProbeTool::compliance_stiffness(const Model& model, const State& state, Workspace& ws, const Mat3& held) {
+Mat3 ProbeTool::compliance_stiffness(const Model& model, const State& state, const Mat3& held) {
   // the static tangent of the object with the contact: an object held nowhere has none (it gives way as a
   // whole), and keeps the held object's stiffness
   if (std::find(model.fixed.begin(), model.fixed.end(), 1) == model.fixed.end()) return held;
@@ -88,18 +98,14 @@ Mat3 ProbeTool::compliance_stiffness(const Model& model, const State& state, Wor
   NewtonProblem problem;
   problem.load = &no_load;
   problem.term = &*surface_;
-  // a workspace of its own: the step's keeps what the solver carries to the next step (its last forces)
-  if (!compliance_ws_) compliance_ws_ = std::make_unique<Workspace>(model, ws.n_threads());
   // the contact's tangent every step; the material's every few (a 9x9 eigen decomposition per point made it
-  // cost twice the step of a 2.6k-point block), and at every new contact
-  const bool material = compliance_contacts_ == 0 || compliance_turn_ % compliance_relinearise == 0;
+  // cost twice the step of a 2.6k-point block), and after every new contact
+  const bool material = compliance_turn_ % compliance_relinearise == 0;
   compliance_solver_.linearise(model, problem, state.u, *compliance_ws_, material);
   if (compliance_load_.cols() != model.n_points) {
     compliance_load_ = Points::Zero(3, model.n_points);
     for (Points& x : compliance_) x = Points::Zero(3, model.n_points);
   }
-  if (compliance_contacts_ == 0)
-    for (Points& x : compliance_) x.setZero();  // a new contact: the last solutions are of another one
   // one direction's solve per step, in turn (the other two keep their last solutions, warm starts of their
   // next turn): the compliance changes slowly at a hand's speed, and three solves a step tripled its cost
   const int turn = compliance_turn_++ % 3;
@@ -107,7 +113,7 @@ Mat3 ProbeTool::compliance_stiffness(const Model& model, const State& state, Wor
   for (int a = 0; a < 3; ++a) {
     compliance_load_.setZero();
     sum = surface_->add_tool_load(Vec3::Unit(a), compliance_load_);
-    if (a == turn || compliance_contacts_ == 0) {
+    if (a == turn) {
       const int iterations = compliance_solver_.solve_linearised(model, problem, compliance_load_, compliance_[a], compliance_tolerance,
                                                                   compliance_budget, *compliance_ws_);
       if (iterations < 0 || !compliance_[a].allFinite()) {

@@ -57,7 +57,7 @@ class ProbeTool final : public DynamicForces {
   /// B = W^T sum_v H_v: the points' load per unit of tool motion), by three warm-started CG solves, one a
   /// step in turn within a budget of iterations (a partial solve from zero gives a K between the held
   /// object's and the true one). Falls back to the held object's -sum_v H_v when a solve fails.
-  Mat3 compliance_stiffness(const Model& model, const State& state, Workspace& ws, const Mat3& held);
+  Mat3 compliance_stiffness(const Model& model, const State& state, const Mat3& held);
 
   ProbeContact contact_;
   std::optional<SurfaceContact> surface_;
@@ -76,10 +76,10 @@ class ProbeTool final : public DynamicForces {
   /// steps between linearisations of the material's tangent (in between it lags; the contact's is made anew)
   static constexpr int compliance_relinearise = 12;
   NewtonSolver compliance_solver_;
-  std::unique_ptr<Workspace> compliance_ws_;
+  std::unique_ptr<Workspace> compliance_ws_;  // its own: the step's keeps what the solver carries to the next step
   Points compliance_load_;                   // B e, one direction at a time
   std::array<Points, 3> compliance_;         // H^-1 B e_a: the warm starts of the next step
-  int compliance_contacts_ = 0;              // contacts when they were made (0: start cold, all three solved)
+  int compliance_contacts_ = 0;              // contacts at the last step (0: the next contact is new)
   long long compliance_turn_ = 0;
 };
 
