@@ -47,6 +47,7 @@ InteractiveOptions probe_options(const ObjectSurface& surface, double duration) 
   o.duration = duration;
   o.real_time = false;
   o.surface = std::make_shared<const ObjectSurface>(surface);
+  o.probe.object_stiffness = true;
   return o;
 }
 

@@ -396,6 +396,16 @@ TEST(SceneToml, BadHeldToolIsANamedError) {
             std::string::npos);
 }
 
+TEST(SceneToml, TheLocalModelsStiffnessIsChosen) {
+  const std::string probe = "\n[probe]\nkeyframes = [[0.0, 0.0, 0.0, 0.0]]\n";
+  EXPECT_FALSE(parse_scene(std::string(full_scene) + probe, "t.toml", ".").probe.object_stiffness);
+  EXPECT_TRUE(parse_scene(std::string(full_scene) + probe + "local_stiffness = \"object\"\n", "t.toml", ".").probe.object_stiffness);
+  EXPECT_NE(error_of("keyframes = [[0.0, 0.0, 0.0, 0.0]]", "keyframes = [[0.0, 0.0, 0.0, 0.0]]\nlocal_stiffness = \"soft\"",
+                     std::string(full_scene) + probe)
+                .find("probe.local_stiffness: unknown value \"soft\""),
+            std::string::npos);
+}
+
 TEST(SceneToml, AHeldToolPressesAlongItsDirection) {
   std::string text = std::string(full_scene) + held_tool_section;
   EXPECT_EQ(parse_scene(text, "t.toml", ".").probe.direction, Vec3(0, -1, 0));  // the default

@@ -76,6 +76,7 @@ void ProbeTool::after_step(const Model& model, const State& state, Workspace& ws
   if (!pushing_surface() || !probe_.allFinite()) return;
   last_ = surface_model(model, state, probe_, false);
   held_K_ = last_.K;
+  if (!contact_.params().object_stiffness) return;
   // made before the first touch: a step that allocates it (and linearises the material) as the probe arrives
   // let the hand run ahead of a slow simulation (under a sanitizer) and the probe through the surface
   if (!compliance_ws_) compliance_ws_ = std::make_unique<Workspace>(model, ws.n_threads());
