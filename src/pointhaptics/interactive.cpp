@@ -39,8 +39,8 @@ void publish_display(Simulation& sim, const HapticFrame& haptic, long long step,
 
 // One simulation step with the latest device point; then the local contact model is published for the
 // haptic loop (run_interactive publishes the display frames, at most one per display_period).
-// `stray` compares each model with the one before (`previous`, and its held-object stiffness).
-int simulation_step(Simulation& sim, HapticLoop& loop, LocalModelStray& stray, ContactModel& previous, Mat3& previous_held) {
+// `stray` compares each model with the one before.
+int simulation_step(Simulation& sim, HapticLoop& loop, LocalModelStray& stray) {
   loop.frames().update();
   const HapticFrame& frame = loop.frames().front();
   sim.inputs().device = frame.device;
@@ -49,9 +49,7 @@ int simulation_step(Simulation& sim, HapticLoop& loop, LocalModelStray& stray, C
   const ProbeTool& probe = *sim.probe();
   loop.contact_models().back() = probe.contact_model();
   loop.contact_models().publish();
-  stray.add(previous, previous_held, probe.contact_model());
-  previous = probe.contact_model();
-  previous_held = probe.held_stiffness();
+  stray.add(probe.contact_model(), probe.held_stiffness());
   return probe.contact_model().contacts;
 }
 
@@ -78,8 +76,6 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
                   options.log || streamed ? static_cast<std::size_t>(4 * options.haptic_rate) + 64 : 0);
   InteractiveResult result;
   LocalModelStray stray;
-  ContactModel previous;
-  Mat3 previous_held = Mat3::Zero();
   const auto take_log = [&] {
     if (streamed) loop.take_log(options.log_sink);
     else if (options.log) loop.take_log([&](const HapticLogRow& row) { result.log.push_back(row); });
@@ -109,7 +105,7 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
         std::this_thread::sleep_for(std::chrono::duration<double>(sim.time() - t0 - wall));
         continue;
       }
-      result.max_contacts = std::max(result.max_contacts, simulation_step(sim, loop, stray, previous, previous_held));
+      result.max_contacts = std::max(result.max_contacts, simulation_step(sim, loop, stray));
       ++result.simulation_steps;
       display(false);
       take_log();
@@ -125,7 +121,7 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
       if (!loop.tick(t, h)) break;
       take_log();
       while (sim.time() - t0 < t - 1e-12 && !sim.diagnostics().failed) {
-        result.max_contacts = std::max(result.max_contacts, simulation_step(sim, loop, stray, previous, previous_held));
+        result.max_contacts = std::max(result.max_contacts, simulation_step(sim, loop, stray));
         ++result.simulation_steps;
         display(false);
         if (options.after_step) options.after_step(result.simulation_steps);

@@ -2,14 +2,18 @@
 
 namespace pointhaptics {
 
-void LocalModelStray::add(const ContactModel& previous, const Mat3& previous_held, const ContactModel& next) {
-  if (previous.contacts == 0 || next.contacts == 0 || previous.grabbing || next.grabbing) return;
-  const Vec3 step = next.p0 - previous.p0;
-  ++updates_;
-  force_sum_ += next.f0.norm();
-  rendered_.add((previous.f0 + previous.K * step - next.f0).norm());
-  hold_.add((previous.f0 - next.f0).norm());
-  held_object_.add((previous.f0 + previous_held * step - next.f0).norm());
+void LocalModelStray::add(const ContactModel& next, const Mat3& next_held) {
+  const ContactModel& previous = previous_;
+  if (previous.contacts > 0 && next.contacts > 0 && !previous.grabbing && !next.grabbing) {
+    const Vec3 step = next.p0 - previous.p0;
+    ++updates_;
+    force_sum_ += next.f0.norm();
+    rendered_.add((previous.f0 + previous.K * step - next.f0).norm());
+    hold_.add((previous.f0 - next.f0).norm());
+    held_object_.add((previous.f0 + previous_held_ * step - next.f0).norm());
+  }
+  previous_ = next;
+  previous_held_ = next_held;
 }
 
 LocalModelSummary LocalModelStray::summary() const {

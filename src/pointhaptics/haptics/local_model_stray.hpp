@@ -11,9 +11,9 @@ namespace pointhaptics {
 
 class LocalModelStray {
  public:
-  /// A new model `next` after `previous` (whose stiffness against the held object was `previous_held`): compared
-  /// when both are in contact.
-  void add(const ContactModel& previous, const Mat3& previous_held, const ContactModel& next);
+  /// A new model `next` (`next_held`: its stiffness against the held object), compared with the one before it
+  /// when both are in contact, and kept for the next.
+  void add(const ContactModel& next, const Mat3& next_held);
   LocalModelSummary summary() const;
 
  private:
@@ -24,6 +24,8 @@ class LocalModelStray {
       max = std::max(max, x);
     }
   };
+  ContactModel previous_;
+  Mat3 previous_held_ = Mat3::Zero();
   long long updates_ = 0;
   double force_sum_ = 0;
   Figure rendered_, hold_, held_object_;

@@ -109,21 +109,17 @@ Mat3 ProbeTool::compliance_stiffness(const Model& model, const State& state, con
   }
   // one direction's solve per step, in turn (the other two keep their last solutions, warm starts of their
   // next turn): the compliance changes slowly at a hand's speed, and three solves a step tripled its cost
-  const int turn = compliance_turn_++ % 3;
-  Mat3 coupling, sum = Mat3::Zero();
-  for (int a = 0; a < 3; ++a) {
-    compliance_load_.setZero();
-    sum = surface_->add_tool_load(Vec3::Unit(a), compliance_load_);
-    if (a == turn) {
-      const int iterations = compliance_solver_.solve_linearised(model, problem, compliance_load_, compliance_[a], compliance_tolerance,
-                                                                  compliance_budget, *compliance_ws_);
-      if (iterations < 0 || !compliance_[a].allFinite()) {
-        for (Points& x : compliance_) x.setZero();
-        return held;
-      }
-    }
-    coupling.col(a) = surface_->tool_response(compliance_[a]);  // B^T H^-1 B e_a
+  const int turn = static_cast<int>(compliance_turn_++ % 3);
+  compliance_load_.setZero();
+  const Mat3 sum = surface_->add_tool_load(Vec3::Unit(turn), compliance_load_);
+  const int iterations = compliance_solver_.solve_linearised(model, problem, compliance_load_, compliance_[turn], compliance_tolerance,
+                                                              compliance_budget, *compliance_ws_);
+  if (iterations < 0 || !compliance_[turn].allFinite()) {
+    for (Points& x : compliance_) x.setZero();
+    return held;
   }
+  Mat3 coupling;
+  for (int a = 0; a < 3; ++a) coupling.col(a) = surface_->tool_response(compliance_[a]);  // B^T H^-1 B e_a
   // symmetric (it is, but for the solves' tolerance) and negative semi-definite: the haptic side's coupling
   // solve needs K <= 0, and a partial solve keeps it there but for round-off
   const Mat3 K = 0.5 * (coupling + coupling.transpose()) - sum;
