@@ -75,6 +75,9 @@ void print_summary(ph::Simulation& sim, const ph::RunSummary& s, double setup_s)
   else
     fmt::print("solver          {}: {} steps of {:.3g} s, {} sub-steps (stable sub-step {:.3g} s), t = {:.4g} s\n",
                s.solver_kind, s.steps, sim.solver().dt, s.substeps, s.stable_dt, st.time);
+  if (s.preconditioner == "cholesky")
+    fmt::print("preconditioner  cholesky: {} factorisation{} of the tangent, factor {:.1f} MB\n", s.factorisations,
+               s.factorisations == 1 ? "" : "s", s.factor_bytes / 1e6);
   fmt::print("displacement    max {:.4g} m at point {} ({:.4g}, {:.4g}, {:.4g})\n", max_u, worst, m.X(0, worst), m.X(1, worst),
              m.X(2, worst));
   // the out-of-balance force: |f_int + f_ext| over the free points relative to the load; in dynamics it is

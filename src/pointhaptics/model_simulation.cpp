@@ -77,6 +77,8 @@ void ModelSimulation::record(const StepReport& report, double seconds) {
   d.substeps += report.substeps;
   d.iterations += report.iterations;
   d.cg_iterations += report.cg_iterations;
+  d.factorisations += report.factorisations;
+  d.factor_bytes = std::max(d.factor_bytes, report.factor_bytes);
   if (solver_.kind != SolverKind::EXPLICIT) d.residual = report.residual;
   if (report.status == StepStatus::AT_BUDGET) ++d.budget_steps;
   d.status = report.status;

@@ -28,6 +28,8 @@ struct StepDiagnostics {
   long long substeps = 0;       ///< explicit sub-steps, static load increments
   long long iterations = 0;     ///< Newton iterations (explicit: sub-steps)
   long long cg_iterations = 0;
+  long long factorisations = 0; ///< preconditioner = "cholesky": numeric factorisations of the tangent
+  double factor_bytes = 0;      ///< ... and the largest factor's size, bytes
   long long budget_steps = 0;   ///< implicit steps the iteration budget ended above the tolerance
   double residual = 0;          ///< the last Newton residual
   long long inverted_steps = 0; ///< steps that ended with inverted neighbourhoods (det F <= 0)

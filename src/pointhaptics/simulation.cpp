@@ -191,6 +191,9 @@ RunSummary Simulation::summary() {
   s.substeps = d.substeps;
   s.iterations = d.iterations;
   s.cg_iterations = d.cg_iterations;
+  if (sim.solver().kind != SolverKind::EXPLICIT) s.preconditioner = std::string(enum_name(sim.solver().preconditioner));
+  s.factorisations = d.factorisations;
+  s.factor_bytes = d.factor_bytes;
   s.budget_steps = d.budget_steps;
   s.stable_dt = sim.stable_dt();
   // a viscoelastic material's stress at the state: its history's, not the last step's in ws

@@ -150,6 +150,19 @@ TEST(SceneToml, UnknownChoicesListTheAllowedOnes) {
   EXPECT_EQ(parse_scene(svk).material.model, MaterialModel::SVK);
 }
 
+TEST(SceneToml, ThePreconditionerIsChosen) {
+  EXPECT_EQ(parse_scene(std::string(full_scene)).solver.preconditioner, Preconditioner::BLOCK_JACOBI);
+  std::string text = full_scene;
+  text.replace(text.find("dt = 2e-3"), 9, "dt = 2e-3\npreconditioner = \"cholesky\"\nrefactor_iterations = 4");
+  const Scene scene = parse_scene(text);
+  EXPECT_EQ(scene.solver.preconditioner, Preconditioner::CHOLESKY);
+  EXPECT_EQ(scene.solver.refactor_iterations, 4);
+  EXPECT_NE(error_of("dt = 2e-3", "dt = 2e-3\npreconditioner = \"ilu\"")
+                .find("solver.preconditioner: unknown value \"ilu\" (expected block_jacobi | cholesky)"),
+            std::string::npos);
+  EXPECT_NE(error_of("dt = 2e-3", "dt = 2e-3\nrefactor_iterations = 0").find("solver.refactor_iterations"), std::string::npos);
+}
+
 TEST(SceneToml, MooneyRivlinTakesC10C01AndBulkInsteadOfYoungAndPoisson) {
   const std::string material = "young = 1e5\npoisson = 0.4";
   std::string text = full_scene;

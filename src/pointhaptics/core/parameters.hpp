@@ -117,6 +117,13 @@ struct LodParams {
 
 enum class SolverKind { STATIC, EXPLICIT, IMPLICIT };
 
+/// What preconditions Newton's conjugate gradients (static and implicit solvers).
+enum class Preconditioner {
+  BLOCK_JACOBI,  ///< the tangent's inverted 3x3 diagonal blocks: cheap, many iterations on stiff problems
+  CHOLESKY,      ///< a sparse Cholesky factor of the assembled tangent, reused across iterations and steps
+                 ///< while CG converges in few iterations (lagged), refactorised when it no longer does
+};
+
 /// [solver]: which solver advances the object, and how far.
 struct SolverSpec {
   SolverKind kind = SolverKind::EXPLICIT;
@@ -126,6 +133,8 @@ struct SolverSpec {
   int max_iterations = 50;     ///< static, implicit: Newton iterations per solve
   int max_cg_iterations = 2000;///< static, implicit: CG iterations per Newton iteration
   int iteration_budget = 0;    ///< implicit: Newton iterations per step in real time, keeping the iterate (0 = off)
+  Preconditioner preconditioner = Preconditioner::BLOCK_JACOBI;  ///< static, implicit
+  int refactor_iterations = 8; ///< cholesky: refactorise after a CG solve of more iterations than this
 };
 
 /// The one table per enum of the names the scene file, the command line and Python use: to_string(),
@@ -151,6 +160,11 @@ struct EnumNames<VolumeMode> {
 template <>
 struct EnumNames<LodScheme> {
   static constexpr std::array<std::pair<LodScheme, std::string_view>, 2> table{{{LodScheme::RANDOM, "random"}, {LodScheme::DITHER, "dither"}}};
+};
+template <>
+struct EnumNames<Preconditioner> {
+  static constexpr std::array<std::pair<Preconditioner, std::string_view>, 2> table{
+      {{Preconditioner::BLOCK_JACOBI, "block_jacobi"}, {Preconditioner::CHOLESKY, "cholesky"}}};
 };
 template <>
 struct EnumNames<SolverKind> {

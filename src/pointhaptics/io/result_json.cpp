@@ -41,6 +41,11 @@ std::string result_json(const Model& model, const State& state, const RunSummary
   doc["solver"]["collapsed"] = s.collapsed;
   if (s.interrupted) doc["solver"]["interrupted"] = true;
   if (s.solver_kind == "implicit") doc["solver"]["budget_steps"] = s.budget_steps;
+  if (!s.preconditioner.empty()) doc["solver"]["preconditioner"] = s.preconditioner;
+  if (s.preconditioner == "cholesky") {
+    doc["solver"]["factorisations"] = s.factorisations;
+    doc["solver"]["factor_bytes"] = s.factor_bytes;
+  }
   doc["energy"] = {{"strain", s.strain_energy}, {"kinetic", s.kinetic_energy}};
   doc["timing"] = {{"wall_s", s.wall_s},
                    {"step_ms_mean", s.step_ms_mean},

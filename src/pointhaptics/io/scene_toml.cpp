@@ -410,6 +410,8 @@ void read_solver(TableReader& r, SolverSpec& s) {
   s.max_iterations = count("max_iterations", s.max_iterations, 1, 100000);
   s.max_cg_iterations = count("max_cg_iterations", s.max_cg_iterations, 1, 10000000);
   s.iteration_budget = count("iteration_budget", s.iteration_budget, 0, 1000);
+  s.preconditioner = r.enumeration("preconditioner", s.preconditioner);
+  s.refactor_iterations = count("refactor_iterations", s.refactor_iterations, 1, 1000);
 }
 
 // box = { min, max }, sphere = { centre, radius } or cylinder = { centre, axis, radius, half_length }: exactly one

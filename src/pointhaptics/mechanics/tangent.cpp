@@ -72,6 +72,27 @@ void Tangent::apply(const Model& model, const Points& du, Workspace& ws, Points&
   });
 }
 
+void Tangent::moduli(const Model& model, std::vector<double>& out, Workspace* ws) const {
+  const index_t stencils = model.stencil_end();
+  out.resize(81 * static_cast<std::size_t>(stencils));
+  const double* base = linearisation_.data();
+  const bool projected = mode_ == TangentMode::PROJECTED;
+  with_material(model, ws ? viscous_step(*ws) : ViscousStep{}, [&](const auto& energy) {
+    using L = typename std::decay_t<decltype(energy)>::Linearisation;
+    for_each_point(stencils, ws, [&](index_t i) {
+      const L at = load_linearisation<L>(base, i);
+      double* C = out.data() + 81 * static_cast<std::size_t>(i);
+      // column k of the moduli: dP for the unit dG with entry k (column-major) set
+      for (int k = 0; k < 9; ++k) {
+        Mat3 dG = Mat3::Zero();
+        dG.data()[k] = 1.0;
+        const Mat3 dP = model.stiffness_volume[i] * energy.stress_derivative(i, at, dG, projected);
+        std::memcpy(C + 9 * k, dP.data(), 9 * sizeof(double));
+      }
+    });
+  });
+}
+
 void Tangent::diagonal_blocks(const Model& model, Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks, Workspace* ws) const {
   const Csr& nbr = model.neighbours;
   const index_t n = model.n_points, stencil_end = model.stencil_end();

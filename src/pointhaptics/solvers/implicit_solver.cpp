@@ -46,6 +46,8 @@ StepReport ImplicitSolver::step(const Model& model, State& state, Workspace& ws,
   StepReport report;
   report.iterations = stats.iterations;
   report.cg_iterations = stats.cg_iterations;
+  report.factorisations = stats.factorisations;
+  report.factor_bytes = newton_.cholesky_stats().factor_bytes;
   report.residual = stats.residual;
   if (!stats.converged) {
     report.status = StepStatus::FAILED;

@@ -13,8 +13,8 @@ namespace {
 
 double dot(const Points& a, const Points& b) { return (a.array() * b.array()).sum(); }
 
-// z = B r with B the preconditioner's inverted diagonal blocks
-void precondition(const Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks, const Points& r, Points& z) {
+// z = B r with B the block-Jacobi preconditioner's inverted diagonal blocks
+void precondition_blocks(const Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks, const Points& r, Points& z) {
   for (Eigen::Index i = 0; i < r.cols(); ++i) z.col(i) = Eigen::Map<const Mat3>(blocks.col(i).data()) * r.col(i);
 }
 
@@ -73,7 +73,27 @@ double NewtonSolver::residual(const Model& model, const NewtonProblem& problem, 
   return r.norm() / scale;
 }
 
+bool NewtonSolver::blocks_stale(const Model& model, const NewtonProblem& problem, Workspace& ws) const {
+  return refresh_blocks_ || blocks_model_ != &model || ws.solver_scratch().blocks.cols() != model.n_points ||
+         blocks_inertia_ != problem.inertia || blocks_springs_ != (problem.springs != nullptr) || blocks_term_ != (problem.term != nullptr);
+}
+
+void NewtonSolver::note_cg_rate(long long iterations, double eta) {
+  const double decades = std::max(1.0, -std::log10(std::max(eta, 1e-300)));
+  const double rate = static_cast<double>(iterations) / decades;
+  if (cg_rate_at_build_ < 0)
+    cg_rate_at_build_ = rate;
+  else if (rate > 1.5 * cg_rate_at_build_ + 1)
+    refresh_blocks_ = true;
+}
+
 void NewtonSolver::build_preconditioner(const Model& model, const NewtonProblem& problem, Workspace& ws) {
+  blocks_model_ = &model;
+  blocks_inertia_ = problem.inertia;
+  blocks_springs_ = problem.springs != nullptr;
+  blocks_term_ = problem.term != nullptr;
+  refresh_blocks_ = false;
+  cg_rate_at_build_ = -1;
   const double inertia = problem.inertia;
   Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks = ws.solver_scratch().blocks;
   tangent_.diagonal_blocks(model, blocks, &ws);
@@ -96,6 +116,31 @@ void NewtonSolver::build_preconditioner(const Model& model, const NewtonProblem&
       B = t > 0 && std::isfinite(t) ? Mat3(Mat3::Identity() / t) : Mat3(Mat3::Identity());
     }
   }
+}
+
+bool NewtonSolver::factorise(const Model& model, const NewtonProblem& problem, Workspace& ws) {
+  if (!cholesky_.analysed_for(model)) {
+    build_tangent_pattern(model, matrix_);
+    cholesky_.analyse(model, matrix_);
+  }
+  assemble_tangent(model, tangent_, matrix_, &ws);
+  // the inertia, the springs and the term's diagonal blocks (its coupling between points is left out)
+  added_blocks_.setZero(9, model.n_points);
+  if (problem.term) problem.term->add_diagonal_blocks(added_blocks_);
+  for (index_t i = 0; i < model.n_points; ++i) {
+    Eigen::Map<Mat3> block(matrix_.values.data() + 9 * static_cast<std::size_t>(matrix_.diagonal[i]));
+    block += Eigen::Map<const Mat3>(added_blocks_.col(i).data());
+    block.diagonal().array() += problem.inertia * model.mass[i];
+    if (problem.springs) block += Eigen::Map<const Mat3>(problem.springs->col(i).data());
+  }
+  return cholesky_.factorise(matrix_);
+}
+
+void NewtonSolver::precondition(const Points& r, Points& z, Workspace& ws) {
+  if (use_cholesky_)
+    cholesky_.solve(r, z);
+  else
+    precondition_blocks(ws.solver_scratch().blocks, r, z);
 }
 
 void NewtonSolver::apply_tangent(const Model& model, const NewtonProblem& problem, const Points& p, Workspace& ws, Points& q) const {
@@ -137,7 +182,7 @@ bool NewtonSolver::conjugate_gradients(const Model& model, const NewtonProblem& 
   Points &cg_r = s.cg_r, &cg_z = s.cg_z, &cg_p = s.cg_p, &cg_q = s.cg_q;
   x.setZero();
   cg_r = r;
-  precondition(s.blocks, cg_r, cg_z);
+  precondition(cg_r, cg_z, ws);
   cg_p = cg_z;
   double rz = dot(cg_r, cg_z);
   const double target = eta * r.norm();
@@ -150,7 +195,7 @@ bool NewtonSolver::conjugate_gradients(const Model& model, const NewtonProblem& 
     x += alpha * cg_p;
     cg_r -= alpha * cg_q;
     if (cg_r.norm() <= target) break;
-    precondition(s.blocks, cg_r, cg_z);
+    precondition(cg_r, cg_z, ws);
     const double rz_next = dot(cg_r, cg_z);
     cg_p = cg_z + (rz_next / rz) * cg_p;
     rz = rz_next;
@@ -195,10 +240,23 @@ NewtonStats NewtonSolver::solve(const Model& model, const NewtonProblem& problem
       if (problem.term) problem.term->linearise(model, u, mode);
       // the block-Jacobi preconditioner is rebuilt at the first iteration of a solve and when the tangent's
       // mode changes; in between it lags (it changes slowly, and costs a few tangent products)
-      if (stats.iterations == 1 || mode != preconditioner_mode_) build_preconditioner(model, problem, ws);
+      // the block-Jacobi preconditioner is rebuilt when the tangent's mode changes, for another model or problem,
+      // and when CG has slowed with it; in between it lags across iterations and steps (it changes slowly, and
+      // costs a few tangent products: a quarter of an implicit step on the 10k-point beam when rebuilt every step)
+      if (mode != preconditioner_mode_ || blocks_stale(model, problem, ws)) build_preconditioner(model, problem, ws);
       preconditioner_mode_ = mode;
+      // the Cholesky factor lags across iterations and solves while CG converges fast with it
+      use_cholesky_ = settings.preconditioner == Preconditioner::CHOLESKY && cholesky_.factorised() && !refactorise_;
+      if (settings.preconditioner == Preconditioner::CHOLESKY && !use_cholesky_) {
+        use_cholesky_ = factorise(model, problem, ws);
+        if (use_cholesky_) ++stats.factorisations;
+        refactorise_ = !use_cholesky_;
+      }
+      const long long cg_before = stats.cg_iterations;
       const bool positive =
           conjugate_gradients(model, problem, r, eta, settings.max_cg_iterations, ws, dx, stats.cg_iterations);
+      if (use_cholesky_ && stats.cg_iterations - cg_before > settings.refactor_iterations) refactorise_ = true;
+      if (!use_cholesky_ && positive) note_cg_rate(stats.cg_iterations - cg_before, eta);
       if (positive && dot(dx, r) > 0) {
         descent = true;
         break;
@@ -206,7 +264,7 @@ NewtonStats NewtonSolver::solve(const Model& model, const NewtonProblem& problem
       ++stats.projected;
     }
     if (!descent) {
-      precondition(s.blocks, r, dx);  // preconditioned steepest descent, a descent direction for SPD blocks
+      precondition(r, dx, ws);  // preconditioned steepest descent, a descent direction for SPD blocks
       if (!(dot(dx, r) > 0)) dx = r;
     }
     // backtracking line search: a step is taken when it lowers Pi (Armijo) or the residual. Near

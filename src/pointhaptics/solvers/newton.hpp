@@ -6,6 +6,7 @@
 #include <vector>
 #include <pointhaptics/mechanics/tangent.hpp>
 #include <pointhaptics/mechanics/viscoelasticity.hpp>
+#include <pointhaptics/solvers/sparse_cholesky.hpp>
 
 namespace pointhaptics {
 
@@ -16,6 +17,10 @@ struct NewtonSettings {
   /// Accept the last iterate when max_iterations is reached instead of reporting failure
   /// (the real-time budget of implicit dynamics).
   bool accept_at_budget = false;
+  Preconditioner preconditioner = Preconditioner::BLOCK_JACOBI;
+  /// CHOLESKY: the factor is refreshed at the next Newton iteration after a CG solve that took more
+  /// iterations than this
+  int refactor_iterations = 8;
 };
 
 /// A term of the energy beyond the material, the loads, the inertia and the per-point springs: a tool's
@@ -58,6 +63,7 @@ struct NewtonStats {
   bool converged = false;
   int iterations = 0;            ///< Newton iterations
   long long cg_iterations = 0;   ///< CG iterations, summed
+  int factorisations = 0;        ///< CHOLESKY: numeric factorisations of the tangent in this solve
   int projected = 0;             ///< iterations that fell back to the positive semi-definite tangent
   double residual = 0;           ///< |r|_free / max(|b|, |f_int|, |k M (u - a)|) at the end
   bool stalled = false;          ///< converged at the round-off floor above the tolerance
@@ -92,6 +98,11 @@ class NewtonSolver {
   /// r = -grad Pi at u, zero at held points; returns the relative residual
   double residual(const Model& model, const NewtonProblem& problem, const Points& u, Workspace& ws, Points& r) const;
   void build_preconditioner(const Model& model, const NewtonProblem& problem, Workspace& ws);
+  /// Assemble the problem's tangent (as last linearised) and factorise it; false when it is not positive
+  /// definite (CG then uses the block-Jacobi preconditioner).
+  bool factorise(const Model& model, const NewtonProblem& problem, Workspace& ws);
+  /// z = B r with the preconditioner in use
+  void precondition(const Points& r, Points& z, Workspace& ws);
   /// PCG on (K + k M) x = r over the free points to relative tolerance eta; returns false when it meets
   /// a direction of non-positive curvature (an indefinite tangent).
   bool conjugate_gradients(const Model& model, const NewtonProblem& problem, const Points& r, double eta,
@@ -100,8 +111,29 @@ class NewtonSolver {
   /// q = H p with H the problem's tangent as last linearised (material, inertia, springs, term), zero at held points
   void apply_tangent(const Model& model, const NewtonProblem& problem, const Points& p, Workspace& ws, Points& q) const;
 
+  /// The block-Jacobi blocks are stale: made for another model or problem, or CG has slowed since
+  bool blocks_stale(const Model& model, const NewtonProblem& problem, Workspace& ws) const;
+  /// Note one CG solve's iterations (to relative tolerance eta) for the lagged preconditioners.
+  void note_cg_rate(long long iterations, double eta);
+
   Tangent tangent_;
   TangentMode preconditioner_mode_ = TangentMode::EXACT;
+  // the block-Jacobi blocks lag across Newton iterations and solves (steps) like the Cholesky factor: made
+  // for one model and problem, refreshed when CG's iterations per decade of residual grow by half
+  const Model* blocks_model_ = nullptr;
+  double blocks_inertia_ = -1;
+  bool blocks_springs_ = false, blocks_term_ = false, refresh_blocks_ = true;
+  double cg_rate_at_build_ = -1;  ///< CG iterations per decade in the first solve after a rebuild (-1: none yet)
+  // CHOLESKY: the assembled tangent, its factor (kept across solves), and whether CG uses it now
+  TangentMatrix matrix_;
+  Eigen::Matrix<double, 9, Eigen::Dynamic> added_blocks_;
+  SparseCholesky cholesky_;
+  bool use_cholesky_ = false;
+  bool refactorise_ = true;
+
+ public:
+  /// The factor's size and timings (zero unless the CHOLESKY preconditioner ran).
+  const CholeskyStats& cholesky_stats() const { return cholesky_.stats(); }
 };
 
 }  // namespace pointhaptics

@@ -15,6 +15,8 @@ NewtonSettings newton_settings(const SolverSpec& spec) {
   s.tolerance = spec.tolerance > 0 ? spec.tolerance : spec.kind == SolverKind::STATIC ? 1e-8 : 1e-6;
   s.max_iterations = spec.max_iterations;
   s.max_cg_iterations = spec.max_cg_iterations;
+  s.preconditioner = spec.preconditioner;
+  s.refactor_iterations = spec.refactor_iterations;
   if (spec.kind == SolverKind::IMPLICIT && spec.iteration_budget > 0) {
     s.max_iterations = spec.iteration_budget;
     s.accept_at_budget = true;

@@ -28,6 +28,7 @@ StaticStats load_stepping(const Model& model, State& state, Workspace& ws, Newto
     const NewtonStats ns = newton.solve(model, problem, trial, ws, settings);
     stats.iterations += ns.iterations;
     stats.cg_iterations += ns.cg_iterations;
+    stats.factorisations += ns.factorisations;
     stats.projected += ns.projected;
     stats.residual = ns.residual;
     if (ns.converged) {
@@ -82,6 +83,8 @@ StepReport StaticSolver::step(const Model& model, State& state, Workspace& ws, D
   report.substeps = stats.load_steps;
   report.iterations = stats.iterations;
   report.cg_iterations = stats.cg_iterations;
+  report.factorisations = stats.factorisations;
+  report.factor_bytes = newton_.cholesky_stats().factor_bytes;
   report.residual = stats.residual;
   report.failure = stats.failure;
   return report;

@@ -9,6 +9,7 @@ struct StaticStats {
   bool converged = false;
   int iterations = 0;            ///< Newton iterations over all load steps
   long long cg_iterations = 0;
+  int factorisations = 0;        ///< preconditioner = "cholesky": numeric factorisations of the tangent
   int projected = 0;             ///< Newton iterations that used the positive semi-definite tangent
   int load_steps = 0;            ///< converged load increments
   int cutbacks = 0;              ///< failed increments that were retried with a smaller one

@@ -1,0 +1,127 @@
+#include <pointhaptics/solvers/sparse_cholesky.hpp>
+
+#include <cholmod.h>
+
+#include <chrono>
+#include <vector>
+
+namespace pointhaptics {
+
+struct SparseCholesky::Factor {
+  cholmod_common common;
+  cholmod_sparse* A = nullptr;  // lower triangle, compressed columns over the free dofs
+  cholmod_factor* L = nullptr;
+  cholmod_dense *X = nullptr, *Y = nullptr, *E = nullptr;  // cholmod_solve2's result and workspace, reused
+  std::vector<double> b;                                   // the right-hand side over the free dofs
+  std::vector<index_t> dof;                                // the first free dof of each point, -1 when held
+  std::vector<std::size_t> source;                         // A's values: their places in TangentMatrix::values
+  const Model* model = nullptr;
+  index_t n_points = 0;
+  bool good = false;  // L holds a positive definite factor
+
+  Factor() {
+    cholmod_start(&common);
+    common.print = 0;  // failures are reported by return values, never printed
+  }
+  ~Factor() {
+    release();
+    cholmod_finish(&common);
+  }
+  void release() {
+    cholmod_free_dense(&X, &common);
+    cholmod_free_dense(&Y, &common);
+    cholmod_free_dense(&E, &common);
+    cholmod_free_factor(&L, &common);
+    cholmod_free_sparse(&A, &common);
+    good = false;
+  }
+};
+
+SparseCholesky::SparseCholesky() : factor_(std::make_unique<Factor>()) {}
+SparseCholesky::~SparseCholesky() = default;
+SparseCholesky::SparseCholesky(SparseCholesky&&) noexcept = default;
+SparseCholesky& SparseCholesky::operator=(SparseCholesky&&) noexcept = default;
+
+bool SparseCholesky::analysed_for(const Model& model) const {
+  return factor_->L && factor_->model == &model && factor_->n_points == model.n_points;
+}
+bool SparseCholesky::factorised() const { return factor_->good; }
+
+void SparseCholesky::analyse(const Model& model, const TangentMatrix& K) {
+  const auto start = std::chrono::steady_clock::now();
+  Factor& f = *factor_;
+  f.release();
+  const index_t n = model.n_points;
+  f.dof.assign(n, -1);
+  index_t dofs = 0;
+  for (index_t i = 0; i < n; ++i)
+    if (!model.fixed[i]) f.dof[i] = dofs, dofs += 3;
+  // the lower triangle by columns: column (k, b) holds rows (j, a) with j after k (points in order, so free
+  // dofs in order), and a >= b on the diagonal block; K is symmetric, so its value is K_kj(b, a)
+  const Csr& pattern = K.pattern;
+  f.source.clear();
+  std::vector<int> column_start{0}, rows;
+  for (index_t k = 0; k < n; ++k) {
+    if (f.dof[k] < 0) continue;
+    for (int b = 0; b < 3; ++b) {
+      for (index_t e = pattern.begin(k); e < pattern.end(k); ++e) {
+        const index_t j = pattern.index[e];
+        if (j < k || f.dof[j] < 0) continue;
+        for (int a = j == k ? b : 0; a < 3; ++a) {
+          rows.push_back(f.dof[j] + a);
+          f.source.push_back(9 * static_cast<std::size_t>(e) + b + 3 * a);
+        }
+      }
+      column_start.push_back(static_cast<int>(rows.size()));
+    }
+  }
+  f.A = cholmod_allocate_sparse(dofs, dofs, rows.size(), /*sorted=*/1, /*packed=*/1, /*stype=*/-1, CHOLMOD_REAL, &f.common);
+  std::copy(column_start.begin(), column_start.end(), static_cast<int*>(f.A->p));
+  std::copy(rows.begin(), rows.end(), static_cast<int*>(f.A->i));
+  f.L = cholmod_analyze(f.A, &f.common);
+  f.b.assign(dofs, 0.0);
+  f.model = &model;
+  f.n_points = n;
+  stats_ = {};
+  stats_.factor_nonzeros = f.common.lnz;
+  stats_.analyse_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+bool SparseCholesky::factorise(const TangentMatrix& K) {
+  Factor& f = *factor_;
+  if (!f.L) return false;
+  const auto start = std::chrono::steady_clock::now();
+  double* x = static_cast<double*>(f.A->x);
+  for (std::size_t p = 0; p < f.source.size(); ++p) x[p] = K.values[f.source[p]];
+  const int ok = cholmod_factorize(f.A, f.L, &f.common);
+  // a failed factorisation leaves L incomplete (minor < n) but reusable by the next attempt
+  f.good = ok && f.common.status == CHOLMOD_OK && f.L->minor == f.L->n;
+  ++stats_.factorisations;
+  stats_.factorise_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (f.good) {
+    stats_.factor_nonzeros = static_cast<double>(f.L->is_super ? f.L->xsize : f.L->nzmax);
+    stats_.factor_bytes = stats_.factor_nonzeros * (sizeof(double) + (f.L->is_super ? 0 : sizeof(int))) +
+                          static_cast<double>(f.L->is_super ? f.L->ssize : f.L->n + 1) * sizeof(int);
+  }
+  return f.good;
+}
+
+void SparseCholesky::solve(const Points& r, Points& z) {
+  Factor& f = *factor_;
+  const index_t n = f.n_points;
+  for (index_t i = 0; i < n; ++i)
+    if (f.dof[i] >= 0)
+      for (int a = 0; a < 3; ++a) f.b[f.dof[i] + a] = r(a, i);
+  cholmod_dense B{};
+  B.nrow = B.d = B.nzmax = f.b.size();
+  B.ncol = 1;
+  B.x = f.b.data();
+  B.xtype = CHOLMOD_REAL;
+  B.dtype = CHOLMOD_DOUBLE;
+  cholmod_solve2(CHOLMOD_A, f.L, &B, nullptr, &f.X, nullptr, &f.Y, &f.E, &f.common);
+  const double* x = static_cast<const double*>(f.X->x);
+  for (index_t i = 0; i < n; ++i)
+    for (int a = 0; a < 3; ++a) z(a, i) = f.dof[i] >= 0 ? x[f.dof[i] + a] : 0.0;
+}
+
+}  // namespace pointhaptics
