@@ -123,6 +123,35 @@ void force_benchmark(benchmark::State& state) {
   time_forces(state, bench_model(static_cast<int>(state.range(0))), static_cast<int>(state.range(1)));
 }
 
+// What bounds the force loop (issue 19, item 4): the bench box of ~10k points with its neighbour lists
+// rewired so that the loop's gathers come from near memory or from L1 alone, with and without the hourglass
+// pass. The arithmetic, the loads and the stores are the real loop's, only where the neighbours' data sit
+// changes (the forces are meaningless: timing only). range(0): 0 the real neighbours, 1 near (j within 12
+// points of i: a stencil's data in a few cache lines), 2 cached (j among the first 32 points: all in L1);
+// range(1): the hourglass pass on (1) or off (0).
+const std::array<std::string_view, 3> stream_variants = {"real", "near", "cached"};
+
+const Model& stream_model(int variant, bool hourglass) {
+  static std::map<std::pair<int, bool>, std::unique_ptr<Model>> cache;
+  auto& slot = cache[{variant, hourglass}];
+  if (!slot) {
+    slot = std::make_unique<Model>(bench_model(10000));
+    Model& model = *slot;
+    if (!hourglass) model.material.hourglass = 0;
+    const index_t n = model.n_points;
+    for (index_t i = 0; i < n; ++i)
+      for (index_t e = model.neighbours.begin(i), k = 0; e < model.neighbours.end(i); ++e, ++k) {
+        if (variant == 1) model.neighbours.index[e] = std::clamp<index_t>(i + (k % 24) - 12 + (k % 24 >= 12), 0, n - 1);
+        if (variant == 2) model.neighbours.index[e] = k % 32;
+      }
+  }
+  return *slot;
+}
+
+void stream_benchmark(benchmark::State& state) {
+  time_forces(state, stream_model(static_cast<int>(state.range(0)), state.range(1) != 0), 1);
+}
+
 void material_benchmark(benchmark::State& state) {
   time_forces(state, material_model(static_cast<int>(state.range(0)), static_cast<int>(state.range(2))), static_cast<int>(state.range(1)));
 }
@@ -320,7 +349,7 @@ class CollectingReporter : public benchmark::ConsoleReporter {
  public:
   nlohmann::json force = nlohmann::json::array(), step = nlohmann::json::array(), beam = nlohmann::json::array(),
                  haptic = nlohmann::json::array(), materials = nlohmann::json::array(), surface = nlohmann::json::array(),
-                 stiff_cantilever = nlohmann::json::array(), cholesky = nlohmann::json::array();
+                 stiff_cantilever = nlohmann::json::array(), cholesky = nlohmann::json::array(), force_streams = nlohmann::json::array();
   void ReportRuns(const std::vector<Run>& runs) override {
     ConsoleReporter::ReportRuns(runs);
     for (const Run& run : runs) {
@@ -350,6 +379,16 @@ class CollectingReporter : public benchmark::ConsoleReporter {
                            {"triangles", static_cast<long long>(run.counters.at("triangles").value)},
                            {"weights_per_vertex", static_cast<double>(run.counters.at("weights_per_vertex").value)},
                            {"carry_us", run.GetAdjustedRealTime()}});  // the benchmark's unit is microseconds
+        continue;
+      }
+      if (run.benchmark_name().rfind("force_streams/", 0) == 0) {
+        const std::string name = run.benchmark_name();
+        const size_t slash = name.find('/', 14);
+        force_streams.push_back({{"neighbours", name.substr(14, slash - 14)},
+                                 {"hourglass", name.find("hourglass:on") != std::string::npos},
+                                 {"points", static_cast<long long>(run.counters.at("points").value)},
+                                 {"ns_per_pair", static_cast<double>(run.counters.at("ns_per_pair").value)},
+                                 {"point_steps_per_s", static_cast<double>(run.counters.at("point_steps_per_s").value)}});
         continue;
       }
       if (run.benchmark_name().rfind("stiff_cantilever/", 0) == 0) {
@@ -411,6 +450,11 @@ int run_bench_suite(const BenchOptions& options) {
       benchmark::RegisterBenchmark(fmt::format("beam4x1x1/{}/threads:{}", solver ? "implicit" : "explicit", t).c_str(),
                                    beam_benchmark)
           ->Args({solver, t})->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
+  for (int variant = 0; variant < static_cast<int>(stream_variants.size()); ++variant)
+    for (int hourglass : {1, 0})
+      benchmark::RegisterBenchmark(fmt::format("force_streams/{}/hourglass:{}/threads:1", stream_variants[variant], hourglass ? "on" : "off").c_str(),
+                                   stream_benchmark)
+          ->Args({variant, hourglass})->Unit(benchmark::kMicrosecond)->MinTime(options.min_time)->UseRealTime();
   for (int preconditioner : {0, 1})
     benchmark::RegisterBenchmark(fmt::format("stiff_cantilever/{}/threads:{}", preconditioner ? "cholesky" : "block_jacobi",
                                              options.threads.back()).c_str(), stiff_cantilever_benchmark)
@@ -466,7 +510,8 @@ int run_bench_suite(const BenchOptions& options) {
     const std::string text =
         nlohmann::json{{"force", reporter.force}, {"step", reporter.step}, {"beam_4x1x1", reporter.beam}, {"haptic", reporter.haptic},
                        {"materials", reporter.materials}, {"surface", reporter.surface},
-                       {"stiff_cantilever", reporter.stiff_cantilever}, {"cholesky", reporter.cholesky}}.dump(1);
+                       {"stiff_cantilever", reporter.stiff_cantilever}, {"cholesky", reporter.cholesky},
+                       {"force_streams", reporter.force_streams}}.dump(1);
     try {
       write_text_file(options.json_path, "--json", [&](TextOutput& out) { out.print("{}\n", text); });
     } catch (const Error& e) {
