@@ -76,6 +76,20 @@ TEST(SparseCholesky, SolvesTheAssembledTangentOverTheFreePoints) {
   EXPECT_LT(error, 1e-9 * scale);
 }
 
+TEST(SparseCholesky, AModelChangedInPlaceIsAnalysedAgain) {
+  Model model = cantilever(1e5, 0.015);
+  const TangentMatrix K = tangent_at_rest(model);
+  SparseCholesky chol;
+  chol.analyse(model, K);
+  ASSERT_TRUE(chol.analysed_for(model));
+  index_t free = 0;
+  while (model.fixed[free]) ++free;
+  model.fixed[free] = 1;  // one more held point: other free dofs, another ordering
+  EXPECT_FALSE(chol.analysed_for(model));
+  const Model other = cantilever(1e5, 0.015);
+  EXPECT_FALSE(chol.analysed_for(other));
+}
+
 TEST(SparseCholesky, RefusesAMatrixThatIsNotPositiveDefinite) {
   const Model model = cantilever(1e5, 0.015);
   TangentMatrix K = tangent_at_rest(model);

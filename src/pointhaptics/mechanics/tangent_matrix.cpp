@@ -87,11 +87,12 @@ void build_tangent_pattern(const Model& model, TangentMatrix& K) {
     pattern.offset.push_back(pattern.n_entries());
   }
   K.values.assign(9 * static_cast<std::size_t>(pattern.n_entries()), 0.0);
+  K.model_pairs = model.n_pairs();
 }
 
 void assemble_tangent(const Model& model, const Tangent& tangent, TangentMatrix& K, Workspace* ws) {
   const index_t n = model.n_points;
-  if (K.pattern.n_rows() != n) build_tangent_pattern(model, K);
+  if (K.pattern.n_rows() != n || K.model_pairs != model.n_pairs()) build_tangent_pattern(model, K);
   tangent.moduli(model, K.moduli, ws);
   const std::vector<double>& moduli = K.moduli;
   const Csr& pattern = K.pattern;

@@ -15,6 +15,7 @@ struct TangentMatrix {
   std::vector<double> values;     ///< K_jk per entry, 9 doubles, column-major 3x3, N/m
   std::vector<std::vector<index_t>> slots;  ///< assembly scratch: a row's entry per point, per thread (-1: none)
   std::vector<double> moduli;                ///< assembly scratch: the stencils' moduli (Tangent::moduli)
+  index_t model_pairs = -1;                  ///< the neighbour pairs of the model the pattern was built for
   index_t n_blocks() const { return pattern.n_entries(); }
 };
 
@@ -22,7 +23,7 @@ struct TangentMatrix {
 void build_tangent_pattern(const Model& model, TangentMatrix& K);
 
 /// K's values from the tangent as last linearised, through the stencils' moduli C_i = v_i dP_i/dG_i
-/// (Tangent::moduli()); builds the pattern first when K has none for a model of this size:
+/// (Tangent::moduli()); builds the pattern first when K has none for a model of this size (points and pairs):
 /// K_jk = sum_i (d_ij (x) I)^T C_i (d_ik (x) I) over the stencils i that contain j and k (d_ii = d_self),
 /// the matrix of what Tangent::apply() computes without assembling. The hourglass energy, whose exact tangent
 /// couples points three stencils apart, enters as an upper bound that stays in this pattern (tangent_matrix.cpp,

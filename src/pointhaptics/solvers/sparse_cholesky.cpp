@@ -2,6 +2,7 @@
 
 #include <cholmod.h>
 
+#include <algorithm>
 #include <chrono>
 #include <vector>
 
@@ -16,7 +17,7 @@ struct SparseCholesky::Factor {
   std::vector<index_t> dof;                                // the first free dof of each point, -1 when held
   std::vector<std::size_t> source;                         // A's values: their places in TangentMatrix::values
   const Model* model = nullptr;
-  index_t n_points = 0;
+  index_t n_points = 0, n_pairs = 0, n_free = 0;
   bool good = false;  // L holds a positive definite factor
 
   Factor() {
@@ -43,7 +44,9 @@ SparseCholesky::SparseCholesky(SparseCholesky&&) noexcept = default;
 SparseCholesky& SparseCholesky::operator=(SparseCholesky&&) noexcept = default;
 
 bool SparseCholesky::analysed_for(const Model& model) const {
-  return factor_->L && factor_->model == &model && factor_->n_points == model.n_points;
+  const Factor& f = *factor_;
+  if (!f.L || f.model != &model || f.n_points != model.n_points || f.n_pairs != model.n_pairs()) return false;
+  return f.n_free == static_cast<index_t>(std::count(model.fixed.begin(), model.fixed.end(), 0));
 }
 bool SparseCholesky::factorised() const { return factor_->good; }
 
@@ -82,6 +85,8 @@ void SparseCholesky::analyse(const Model& model, const TangentMatrix& K) {
   f.b.assign(dofs, 0.0);
   f.model = &model;
   f.n_points = n;
+  f.n_pairs = model.n_pairs();
+  f.n_free = dofs / 3;
   stats_ = {};
   stats_.factor_nonzeros = f.common.lnz;
   stats_.analyse_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -26,7 +26,7 @@ class SparseCholesky {
   /// Order and analyse K's pattern over the points that are not held (Model::fixed). Call again when the model
   /// (its points, stencils or held points) changes.
   void analyse(const Model& model, const TangentMatrix& K);
-  /// The model analyse() was called for (its address and size), else false.
+  /// The model analyse() was called for (its address, points, pairs and free points), else false.
   bool analysed_for(const Model& model) const;
   /// Factorise K with its current values: false when K is not positive definite over the free points (then
   /// there is no factor until the next successful call).
