@@ -25,4 +25,11 @@ with open(os.path.join(out, "point-load.csv"), newline="") as f:
     profile = list(csv.DictReader(f))
 bottom_point, bottom_fem = float(profile[-1]["point_uy_m"]), float(profile[-1]["calculix_uy_m"])
 assert abs(bottom_point / bottom_fem - 1) < 0.03, (bottom_point, bottom_fem)
+# the speed at equal accuracy: both within 1% of the reference, the point model faster
+with open(os.path.join(out, "summary.md")) as f:
+    summary = f.read()
+speed = [line for line in summary.splitlines() if line.startswith("the cheapest point model within 1%")]
+assert len(speed) == 1, summary
+ratio = float(speed[0].split("the point model is ")[1].split("x faster")[0])
+assert ratio > 1, speed[0]
 print("experiment cantilever: ok")
