@@ -238,18 +238,19 @@ NewtonStats NewtonSolver::solve(const Model& model, const NewtonProblem& problem
     for (TangentMode mode : {TangentMode::EXACT, TangentMode::PROJECTED}) {
       tangent_.linearise(model, u, mode, &ws);
       if (problem.term) problem.term->linearise(model, u, mode);
-      // the block-Jacobi preconditioner is rebuilt at the first iteration of a solve and when the tangent's
-      // mode changes; in between it lags (it changes slowly, and costs a few tangent products)
       // the block-Jacobi preconditioner is rebuilt when the tangent's mode changes, for another model or problem,
       // and when CG has slowed with it; in between it lags across iterations and steps (it changes slowly, and
       // costs a few tangent products: a quarter of an implicit step on the 10k-point beam when rebuilt every step)
       if (mode != preconditioner_mode_ || blocks_stale(model, problem, ws)) build_preconditioner(model, problem, ws);
       preconditioner_mode_ = mode;
       // the Cholesky factor lags across iterations and solves while CG converges fast with it
+      // (an exact tangent found indefinite once is not factorised again: only a projected one, which is not)
       use_cholesky_ = settings.preconditioner == Preconditioner::CHOLESKY && cholesky_.factorised() && !refactorise_;
-      if (settings.preconditioner == Preconditioner::CHOLESKY && !use_cholesky_) {
+      if (settings.preconditioner == Preconditioner::CHOLESKY && !use_cholesky_ &&
+          (mode == TangentMode::PROJECTED || !exact_indefinite_)) {
         use_cholesky_ = factorise(model, problem, ws);
         if (use_cholesky_) ++stats.factorisations;
+        if (!use_cholesky_ && mode == TangentMode::EXACT) exact_indefinite_ = true;
         refactorise_ = !use_cholesky_;
       }
       const long long cg_before = stats.cg_iterations;

@@ -130,6 +130,7 @@ class NewtonSolver {
   SparseCholesky cholesky_;
   bool use_cholesky_ = false;
   bool refactorise_ = true;
+  bool exact_indefinite_ = false;  ///< a factorisation of the exact tangent failed: factorise projected ones only
 
  public:
   /// The factor's size and timings (zero unless the CHOLESKY preconditioner ran).
