@@ -18,6 +18,17 @@ void precondition_blocks(const Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks,
   for (Eigen::Index i = 0; i < r.cols(); ++i) z.col(i) = Eigen::Map<const Mat3>(blocks.col(i).data()) * r.col(i);
 }
 
+// blocks += the problem's own 3x3 diagonal terms beyond the material: its further term's, the inertia's and the
+// springs' (both preconditioners take them; the term's coupling between points is left out)
+void add_problem_blocks(const Model& model, const NewtonProblem& problem, Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks) {
+  if (problem.term) problem.term->add_diagonal_blocks(blocks);
+  for (index_t i = 0; i < model.n_points; ++i) {
+    Eigen::Map<Mat3> B(blocks.col(i).data());
+    B.diagonal().array() += problem.inertia * model.mass[i];
+    if (problem.springs) B += Eigen::Map<const Mat3>(problem.springs->col(i).data());
+  }
+}
+
 }  // namespace
 
 NewtonSolver::NewtonSolver(const Model&) {}
@@ -97,15 +108,13 @@ void NewtonSolver::build_preconditioner(const Model& model, const NewtonProblem&
   const double inertia = problem.inertia;
   Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks = ws.solver_scratch().blocks;
   tangent_.diagonal_blocks(model, blocks, &ws);
-  if (problem.term) problem.term->add_diagonal_blocks(blocks);
+  add_problem_blocks(model, problem, blocks);
   for (index_t i = 0; i < model.n_points; ++i) {
     Eigen::Map<Mat3> B(blocks.col(i).data());
     if (model.fixed[i]) {
       B.setZero();
       continue;
     }
-    B.diagonal().array() += inertia * model.mass[i];
-    if (problem.springs) B += Eigen::Map<const Mat3>(problem.springs->col(i).data());
     Mat3 sym = 0.5 * (B + B.transpose());
     Eigen::LLT<Mat3> llt(sym);
     if (llt.info() == Eigen::Success && std::isfinite(sym.trace())) {
@@ -124,15 +133,10 @@ bool NewtonSolver::factorise(const Model& model, const NewtonProblem& problem, W
     cholesky_.analyse(model, matrix_);
   }
   assemble_tangent(model, tangent_, matrix_, &ws);
-  // the inertia, the springs and the term's diagonal blocks (its coupling between points is left out)
   added_blocks_.setZero(9, model.n_points);
-  if (problem.term) problem.term->add_diagonal_blocks(added_blocks_);
-  for (index_t i = 0; i < model.n_points; ++i) {
-    Eigen::Map<Mat3> block(matrix_.values.data() + 9 * static_cast<std::size_t>(matrix_.diagonal[i]));
-    block += Eigen::Map<const Mat3>(added_blocks_.col(i).data());
-    block.diagonal().array() += problem.inertia * model.mass[i];
-    if (problem.springs) block += Eigen::Map<const Mat3>(problem.springs->col(i).data());
-  }
+  add_problem_blocks(model, problem, added_blocks_);
+  for (index_t i = 0; i < model.n_points; ++i)
+    Eigen::Map<Mat3>(matrix_.values.data() + 9 * static_cast<std::size_t>(matrix_.diagonal[i])) += Eigen::Map<const Mat3>(added_blocks_.col(i).data());
   return cholesky_.factorise(matrix_);
 }
 

@@ -90,6 +90,8 @@ class NewtonSolver {
   /// curvature: x is then the last iterate before it).
   int solve_linearised(const Model& model, const NewtonProblem& problem, const Points& b, Points& x, double tolerance,
                        int max_iterations, Workspace& ws);
+  /// The Cholesky factor's size and timings (zero unless the CHOLESKY preconditioner ran).
+  const CholeskyStats& cholesky_stats() const { return cholesky_.stats(); }
 
  private:
   /// Pi(u); `step`: the material within a viscoelastic step (viscoelasticity.hpp)
@@ -132,9 +134,6 @@ class NewtonSolver {
   bool refactorise_ = true;
   bool exact_indefinite_ = false;  ///< a factorisation of the exact tangent failed: factorise projected ones only
 
- public:
-  /// The factor's size and timings (zero unless the CHOLESKY preconditioner ran).
-  const CholeskyStats& cholesky_stats() const { return cholesky_.stats(); }
 };
 
 }  // namespace pointhaptics
