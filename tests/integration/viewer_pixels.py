@@ -104,8 +104,12 @@ def check_picture(png, info_path, expect_contact):
     if info["surface"]["drawn"]:
         assert info["surface"]["triangles"] > 100, info["surface"]
         vpix, _, _ = project(info, np.array(info["surface"]["sample_vertices"], float))
-        on = [np.linalg.norm(img[min(int(round(p[1])), h - 1), min(int(round(p[0])), w - 1)] - BACKGROUND) > 8
-              for p in vpix if np.linalg.norm(p - pc) > 1.3 * r_px and 0 <= p[0] < w and 0 <= p[1] < h]
+        # a vertex on the box's edges lies on the outline: the pixel or one next to it (as for the points)
+        def drawn(p):
+            x0, y0 = min(int(round(p[0])), w - 1), min(int(round(p[1])), h - 1)
+            window = img[max(y0 - 1, 0):y0 + 2, max(x0 - 1, 0):x0 + 2].reshape(-1, 3)
+            return np.any(np.linalg.norm(window - BACKGROUND, axis=1) > 8)
+        on = [drawn(p) for p in vpix if np.linalg.norm(p - pc) > 1.3 * r_px and 0 <= p[0] < w and 0 <= p[1] < h]
         assert len(on) > 20 and np.mean(on) > 0.9, f"{png}: {np.mean(on):.2f} of the surface's vertices on drawn pixels"
     lo, hi = pix.min(axis=0), pix.max(axis=0)
     margin = 3 * info["point_radius"] * ppm[0] + 10

@@ -73,8 +73,16 @@ void ProbeTool::add(const Model& model, const State& state, Points& f) {
 }
 
 void ProbeTool::after_step(const Model& model, const State& state, Workspace& ws) {
-  if (!pushing_surface() || !probe_.allFinite()) return;
-  last_ = surface_model(model, state, probe_, false);
+  if (!pushing_surface() || !probe_.allFinite()) {
+    if (surface_) surface_->reset_multipliers();
+    return;
+  }
+  surface_->load(model, state.u);  // the surface carried to the step's end
+  // the proxy: the multipliers take the penetration left at the step's end (Uzawa's update spread over
+  // steps), so that over a few steps the surface comes to touch the probe and the force is the material's;
+  // never pressing harder together than the coupling does (the probe's balance at the step's start)
+  const double pressing = std::min(max_force_, k_ * (device_ - probe_).norm());
+  last_ = contact_model_of(surface_->advance_multipliers(multiplier_rate, pressing), state.time, probe_);
   held_K_ = last_.K;
   if (!contact_.params().object_stiffness) return;
   // made before the first touch: a step that allocates it (and linearises the material) as the probe arrives

@@ -246,6 +246,21 @@ ToolLoad SurfaceContact::load(const Model&, const Points& u, bool same_u) {
   return for_each_pressing([](index_t, const ToolDistance&, double) {});
 }
 
+ToolLoad SurfaceContact::advance_multipliers(double rate, double max_force) {
+  const double far = reach(shape_);
+  Vec3 pressing = Vec3::Zero();
+  for (index_t v = 0; v < y_.cols(); ++v) {
+    double& lambda = lambda_[static_cast<std::size_t>(v)];
+    if (lambda == 0 && (y_.col(v) - pose_.position).squaredNorm() > far * far) continue;
+    const ToolDistance d = tool_distance(shape_, pose_, y_.col(v));
+    lambda = std::max(lambda + rate * penalty_[static_cast<std::size_t>(v)] * d.penetration(shape_), 0.0);
+    pressing += lambda * d.normal;
+  }
+  if (pressing.norm() > max_force)
+    for (double& lambda : lambda_) lambda *= max_force / pressing.norm();
+  return for_each_pressing([](index_t, const ToolDistance&, double) {});
+}
+
 void SurfaceContact::reset_multipliers() {
   std::fill(lambda_.begin(), lambda_.end(), 0.0);
   std::fill(anchors_.begin(), anchors_.end(), Anchor{});

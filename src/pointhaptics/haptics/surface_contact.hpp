@@ -93,6 +93,10 @@ class SurfaceContact final : public EnergyTerm {
   const ToolLoad& last_load() const { return last_load_; }
   /// Forget the multipliers and the friction's anchors (the tool lifted off, or moved far).
   void reset_multipliers();
+  /// Uzawa's update spread over time (a tool in dynamics, once a step, at the state and pose of the last
+  /// load()): lambda_v <- <lambda_v + rate k_v g_v>, then all scaled down if they press on the tool with more
+  /// than `max_force` together. Returns the load on the tool then.
+  ToolLoad advance_multipliers(double rate, double max_force);
   double friction() const { return friction_; }
   /// Upper bound of the contact's stiffness on one point, N/m (explicit stable step): max_j sum_v k_v w_vj^2.
   double max_point_stiffness() const { return max_point_stiffness_; }
