@@ -17,10 +17,8 @@ struct ProbeParams {
   double point_radius = 0;      ///< point spheres, m (0: half the model's spacing)
   double stiffness = 0;         ///< contact / grab spring per point, N/m (0: E x spacing, the object's own scale)
   /// On the surface: the local model's stiffness is the object's as the tool sees it (ProbeTool::
-  /// compliance_stiffness), not the contact's own. Off by default: until the probe is a proxy kept on the
-  /// surface, a simulation far behind the hand (a sanitizer build) let the softer model take the hand, then
-  /// the probe, through a beam.
-  bool object_stiffness = false;
+  /// compliance_stiffness), else the contact's own (the held object's, stiffer).
+  bool object_stiffness = true;
 };
 
 /// The force the object exerts on the probe near p0, linearised: F(p) = f0 + K (p - p0).
