@@ -150,5 +150,72 @@ TEST(ProbeOnSurface, TheLocalModelsStiffnessIsTheObjectsAndPredictsTheNextUpdate
   }
 }
 
+// Friction on a device's probe (issue 16, item 3): pressed into the block, then the device moved sideways,
+// so that the hand pushes along a line at an angle to the face's normal, as a tool resting on a slope. Inside
+// Coulomb's cone the probe stays where it is (it sticks, the hand feeling the friction that holds it);
+// without friction it follows the hand; dragged on, it slides with friction mu times the pressure.
+struct Slide {
+  double probe_x = 0, device_x = 0;  // where the probe and the device ended, m
+  Vec3 felt;                         // the last force rendered, N
+  double sliding_ratio = 0;          // friction over pressure on the tool, mean over the steps after t = 0.6 s
+};
+
+// down into the block by 0.3 s, held, then from 0.4 s moved sideways by `sideways` over `over` seconds, held
+Slide slide(const std::string& solver, double friction, double sideways, double over, double duration) {
+  const Scene scene = block_scene(solver);
+  Simulation sim(build_scene_model(scene), scene.solver, 1);
+  const ObjectSurface surface = build_object_surface(scene, sim.model());
+  const double down = -2 * R - 0.0015;
+  VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), false},
+                                   {0.3, Vec3(0, down, 0), false},
+                                   {0.4, Vec3(0, down, 0), false},
+                                   {0.4 + over, Vec3(sideways, down, 0), false},
+                                   {std::max(duration, 0.4 + over) + 0.1, Vec3(sideways, down, 0), false}}),
+                       known_device_specs("touch"));
+  InteractiveOptions o = probe_options(surface, duration);
+  o.probe.friction = friction;
+  Slide out;
+  double ratio_sum = 0;
+  int ratios = 0;
+  o.after_step = [&](long long) {
+    out.probe_x = sim.probe()->probe().x();
+    const ToolLoad& load = sim.probe()->surface_contact()->last_load();
+    if (sim.state().time > 0.6) {
+      ratio_sum += load.friction.norm() / (load.force - load.friction).norm();
+      ++ratios;
+    }
+  };
+  const InteractiveResult r = run_interactive(sim, device, o);
+  EXPECT_FALSE(sim.diagnostics().failed) << sim.diagnostics().failure;
+  out.felt = r.log.back().force;
+  out.device_x = r.log.back().position.x();
+  out.sliding_ratio = ratios ? ratio_sum / ratios : 0.0;
+  return out;
+}
+
+TEST(ProbeOnSurface, WithFrictionTheProbeRestsWhereTheHandPushesInsideTheConeAndSlidesBeyondIt) {
+  // the coupling (200 N/m for the touch) pulls sideways by about 0.2 N per mm of the probe behind the device,
+  // against about 1.2 N of pressure: 1 mm is well inside the cone of mu = 0.3
+  const double mu = 0.3;
+  const Slide frictionless = slide("explicit", 0.0, 0.001, 0.1, 0.7);
+  EXPECT_NEAR(frictionless.probe_x, frictionless.device_x, 0.1e-3);
+  EXPECT_LT(std::abs(frictionless.felt.x()), 0.02 * frictionless.felt.y());
+  for (const std::string solver : {"explicit", "implicit"}) {
+    const Slide rests = slide(solver, mu, 0.001, 0.1, 0.7);
+    std::printf("%s, resting: probe at %.3f mm, device at %.3f mm, felt (%.4f, %.4f) N\n", solver.c_str(), 1e3 * rests.probe_x,
+                1e3 * rests.device_x, rests.felt.x(), rests.felt.y());
+    // it stays (what moves is mostly the block's shear under it), and the hand feels what holds it
+    EXPECT_LT(std::abs(rests.probe_x), 0.3 * rests.device_x);
+    EXPECT_LT(rests.felt.x(), -0.05 * rests.felt.y());
+    EXPECT_LT(std::abs(rests.felt.x()), mu * rests.felt.y());
+  }
+  // dragged 6 mm over 0.4 s: it slides behind the hand with friction mu x pressure
+  const Slide slides = slide("explicit", mu, 0.006, 0.4, 0.8);
+  std::printf("sliding: probe at %.3f mm, device at %.3f mm, felt (%.4f, %.4f) N, friction / pressure %.4f\n", 1e3 * slides.probe_x,
+              1e3 * slides.device_x, slides.felt.x(), slides.felt.y(), slides.sliding_ratio);
+  EXPECT_GT(slides.probe_x, 0.5 * slides.device_x);
+  EXPECT_NEAR(slides.sliding_ratio, mu, 0.05 * mu);
+}
+
 }  // namespace
 }  // namespace pointhaptics

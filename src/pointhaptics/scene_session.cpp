@@ -82,6 +82,7 @@ InteractiveOptions scene_interactive_options(const Scene& scene, const Model& mo
   o.probe.mode = scene.probe.grab ? ProbeMode::GRAB : ProbeMode::PUSH;
   o.probe.stiffness = scene.probe.stiffness;
   o.probe.object_stiffness = scene.probe.object_stiffness;
+  o.probe.friction = scene.probe.friction;
   o.mapping.scale = scene.probe.scale;
   if (scene.probe.origin.allFinite()) {
     o.mapping.origin = scene.probe.origin;

@@ -64,11 +64,14 @@ void Simulation::attach_probe(const ProbeParams& params, double coupling_stiffne
   if (surface && !lod_) {
     SurfaceContactParams contact;
     // the contact no stiffer on a point than the point spheres' springs were (E x spacing): explicit steps keep
-    // their stable sub-step, implicit ones their linearly implicit springs. In dynamics it is a penalty: the
-    // multipliers updated once a step (an integral of the penetration) made a deep, fast push diverge
-    // (tests/deep_compression_test.cpp), so the probe sinks by the penalty's give; the static solver meets
-    // the constraint exactly
+    // their stable sub-step, implicit ones their linearly implicit springs. The probe's multipliers, advanced
+    // once a step (ProbeTool::after_step), keep it on the surface
     contact.max_point_stiffness = sim.model().material.young * sim.model().spacing;
+    contact.friction = params.friction;
+    // friction's penalty a tenth of the normal one (SurfaceContactParams::tangential_share): sliding, the
+    // friction then measured 0.288 of the pressure for mu = 0.3 (0.286 with a hundredth, where new contacts
+    // stuck for tens of steps; the full penalty made explicit steps chatter: 0.217)
+    contact.tangential_share = 0.1;
     on_surface.emplace(sim.model(), surface->mesh, surface->map, ToolShape{ToolKind::SPHERE, params.radius, 0}, contact);
   }
   sim.probe().emplace(

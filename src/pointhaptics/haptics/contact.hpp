@@ -16,6 +16,7 @@ struct ProbeParams {
   ProbeMode mode = ProbeMode::PUSH;
   double point_radius = 0;      ///< point spheres, m (0: half the model's spacing)
   double stiffness = 0;         ///< contact / grab spring per point, N/m (0: E x spacing, the object's own scale)
+  double friction = 0;          ///< Coulomb's coefficient on the surface (the point spheres are frictionless)
   /// On the surface: the local model's stiffness is the object's as the tool sees it (ProbeTool::
   /// compliance_stiffness), else the contact's own (the held object's, stiffer).
   bool object_stiffness = true;

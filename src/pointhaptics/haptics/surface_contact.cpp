@@ -28,6 +28,8 @@ SurfaceContact::SurfaceContact(const Model& model, const TriangleMesh& mesh, Sur
   lambda_.assign(area.size(), 0.0);
   if (!(params.friction >= 0) || !std::isfinite(params.friction)) throw Error("tool: friction must be >= 0");
   friction_ = params.friction;
+  if (!(params.tangential_share > 0) || !(params.tangential_share <= 1)) throw Error("tool: the friction's penalty share must be in (0, 1]");
+  tangential_share_ = params.tangential_share;
   if (friction_ > 0) anchors_.assign(area.size(), Anchor{});
   tolerance_ = params.tolerance > 0 ? params.tolerance : 1e-4 * shape.radius;
   // the explicit stable step's bound: a point's contact stiffness is at most sum_v k_v w_vj^2
@@ -79,9 +81,17 @@ Vec3 SurfaceContact::friction_trial(index_t v) const {
   return a.tau + tangential_penalty(v) * slip;
 }
 
-double SurfaceContact::tangential_penalty(index_t v) const { return tangential_share * penalty_[static_cast<std::size_t>(v)]; }
+double SurfaceContact::tangential_penalty(index_t v) const { return tangential_share_ * penalty_[static_cast<std::size_t>(v)]; }
 
 double SurfaceContact::friction_cone(index_t v) const { return friction_ * lambda_[static_cast<std::size_t>(v)]; }
+
+Mat3 SurfaceContact::friction_hessian(index_t v) const {
+  const Anchor& a = anchors_[static_cast<std::size_t>(v)];
+  const Vec3 t = friction_trial(v);
+  const double k = tangential_penalty(v), cone = friction_cone(v), norm = t.norm();
+  // inside the cone k P; beyond it the clamped force's derivative, (cone k / |t|) (P - t^ t^T)
+  return norm <= cone ? Mat3(k * a.tangent) : Mat3(cone * k / norm * (a.tangent - t * t.transpose() / (norm * norm)));
+}
 
 Vec3 SurfaceContact::friction_force(index_t v) const {
   const Vec3 t = friction_trial(v);
@@ -114,6 +124,7 @@ ToolLoad SurfaceContact::for_each_pressing(const Pressing& pressing) const {
     out.force += on_tool;
     out.friction += on_tool;
     out.torque += (y_.col(v) - pose_.position).cross(on_tool);
+    out.stiffness -= friction_hessian(v);  // the anchor moves with the tool: its slip by minus the tool's motion
   }
   return out;
 }
@@ -145,12 +156,8 @@ void SurfaceContact::linearise(const Model&, const Points& u, TangentMode mode) 
     active_.push_back({v, d.normal, pressure, hessian, penalty_[static_cast<std::size_t>(v)] * d.normal * d.normal.transpose()});
   });
   for (index_t v = 0; v < static_cast<index_t>(anchors_.size()); ++v) {
-    const Anchor& a = anchors_[static_cast<std::size_t>(v)];
-    if (!a.held) continue;
-    const Vec3 t = friction_trial(v);
-    const double k = tangential_penalty(v), cone = friction_cone(v), norm = t.norm();
-    // inside the cone k P; beyond it the clamped force's derivative, (cone k / |t|) (P - t^ t^T)
-    const Mat3 hessian = norm <= cone ? Mat3(k * a.tangent) : Mat3(cone * k / norm * (a.tangent - t * t.transpose() / (norm * norm)));
+    if (!anchors_[static_cast<std::size_t>(v)].held) continue;
+    const Mat3 hessian = friction_hessian(v);
     active_.push_back({v, Vec3::Zero(), 0.0, hessian, hessian});
   }
 }
@@ -217,28 +224,33 @@ bool SurfaceContact::update_multipliers(const Model& model, const Points& u) {
     const double k = penalty_[static_cast<std::size_t>(v)];
     const ToolDistance d = tool_distance(shape_, pose_, y_.col(v));
     lambda = std::max(lambda + k * d.penetration(shape_), 0.0);
-    if (anchors_.empty()) continue;
-    Anchor& a = anchors_[static_cast<std::size_t>(v)];
-    if (lambda == 0) {
-      a = Anchor{};  // lifted off: free again
-      continue;
-    }
-    const Mat3 tangent = Mat3::Identity() - d.normal * d.normal.transpose();
-    if (!a.held) {
-      // touches: anchored where it is as seen by the tool before its last move (so in a quasi-static step
-      // it slides at once, as it would have under the moving tool)
-      a.local = previous_pose_.orientation.conjugate() * (y_.col(v) - previous_pose_.position);
-      a.tangent = tangent;
-      a.held = true;
-    }
-    // the trial force on the new tangent plane, put on the new cone if beyond it (the anchor then follows)
-    const Vec3 t = tangent * friction_trial(v);
-    const double cone = friction_ * lambda;
-    a.tau = t.norm() > cone ? Vec3(cone / t.norm() * t) : t;
-    if (t.norm() > cone) a.local = pose_.orientation.conjugate() * (y_.col(v) - pose_.position);
-    a.tangent = tangent;
+    advance_anchor(v, d);
   }
   return false;
+}
+
+void SurfaceContact::advance_anchor(index_t v, const ToolDistance& d) {
+  if (anchors_.empty()) return;
+  Anchor& a = anchors_[static_cast<std::size_t>(v)];
+  const double lambda = lambda_[static_cast<std::size_t>(v)];
+  if (lambda == 0) {
+    a = Anchor{};  // lifted off: free again
+    return;
+  }
+  const Mat3 tangent = Mat3::Identity() - d.normal * d.normal.transpose();
+  if (!a.held) {
+    // touches: anchored where it is as seen by the tool before its last move (so in a quasi-static step
+    // it slides at once, as it would have under the moving tool)
+    a.local = previous_pose_.orientation.conjugate() * (y_.col(v) - previous_pose_.position);
+    a.tangent = tangent;
+    a.held = true;
+  }
+  // the trial force on the new tangent plane, put on the new cone if beyond it (the anchor then follows)
+  const Vec3 t = tangent * friction_trial(v);
+  const double cone = friction_ * lambda;
+  a.tau = t.norm() > cone ? Vec3(cone / t.norm() * t) : t;
+  if (t.norm() > cone) a.local = pose_.orientation.conjugate() * (y_.col(v) - pose_.position);
+  a.tangent = tangent;
 }
 
 ToolLoad SurfaceContact::load(const Model&, const Points& u, bool same_u) {
@@ -258,6 +270,11 @@ ToolLoad SurfaceContact::advance_multipliers(double rate, double max_force) {
   }
   if (pressing.norm() > max_force)
     for (double& lambda : lambda_) lambda *= max_force / pressing.norm();
+  // the friction's anchors and forces, on the multipliers just made
+  if (!anchors_.empty())
+    for (index_t v = 0; v < y_.cols(); ++v)
+      if (lambda_[static_cast<std::size_t>(v)] > 0 || anchors_[static_cast<std::size_t>(v)].held)
+        advance_anchor(v, tool_distance(shape_, pose_, y_.col(v)));
   return for_each_pressing([](index_t, const ToolDistance&, double) {});
 }
 

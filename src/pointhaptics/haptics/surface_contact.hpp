@@ -38,8 +38,16 @@ struct SurfaceContactParams {
   /// If > 0, N/m: the penalty is lowered so that no point's contact stiffness (sum_v k_v w_vj^2) exceeds it
   /// (explicit dynamics, whose stable sub-step it would otherwise shorten).
   double max_point_stiffness = 0;
-  /// Coulomb's coefficient (0: frictionless). The static solver meets it; dynamics ignores it so far.
+  /// Coulomb's coefficient (0: frictionless). The static solver meets it by Uzawa's updates, dynamics by
+  /// one update a step (advance_multipliers).
   double friction = 0;
+  /// The friction's penalty over the normal one. For the static solver a hundredth: the full penalty puts
+  /// the stick-slip kink within c / k of the anchor (1e-7 m on the contact experiment's block) and Newton's
+  /// iterations ran out on the first drag; the multipliers meet the stick exactly whatever it is. In
+  /// dynamics, with one multiplier update a step, that small a share left a vertex that starts to touch
+  /// sticking for tens of steps while its force grew to the cone (friction 5% short of mu x pressure on a
+  /// slide); a device's probe uses a tenth.
+  double tangential_share = 0.01;
 };
 
 /// What the object does to the tool.
@@ -95,7 +103,8 @@ class SurfaceContact final : public EnergyTerm {
   void reset_multipliers();
   /// Uzawa's update spread over time (a tool in dynamics, once a step, at the state and pose of the last
   /// load()): lambda_v <- <lambda_v + rate k_v g_v>, then all scaled down if they press on the tool with more
-  /// than `max_force` together. Returns the load on the tool then.
+  /// than `max_force` together; the friction's anchors as update_multipliers() moves them. Returns the load on
+  /// the tool then.
   ToolLoad advance_multipliers(double rate, double max_force);
   double friction() const { return friction_; }
   /// Upper bound of the contact's stiffness on one point, N/m (explicit stable step): max_j sum_v k_v w_vj^2.
@@ -122,15 +131,18 @@ class SurfaceContact final : public EnergyTerm {
   };
   /// The friction's trial force on the tool from an anchored vertex v at y_: tau + k s.
   Vec3 friction_trial(index_t v) const;
-  /// The friction's penalty: a share of the normal one. The full penalty puts the stick-slip kink within
-  /// c / k of the anchor (1e-7 m on the contact experiment's block) and Newton's iterations ran out on the
-  /// first drag; the multipliers meet the stick exactly whatever it is.
-  static constexpr double tangential_share = 0.01;
+  /// The friction's penalty: tangential_share of the normal one.
   double tangential_penalty(index_t v) const;
   /// Its cone's radius: friction x the vertex's normal multiplier.
   double friction_cone(index_t v) const;
   /// The force itself: the trial force put on the cone when beyond it.
   Vec3 friction_force(index_t v) const;
+  /// Its derivative by the vertex's position (minus its derivative by the tool's).
+  Mat3 friction_hessian(index_t v) const;
+  /// Uzawa's update of vertex v's anchor and tangential multiplier (at distance d from the tool), on its
+  /// normal multiplier as it now is: freed when that is 0, anchored when it starts to press, its force put on
+  /// the cone (the anchor following the vertex) when beyond it.
+  void advance_anchor(index_t v, const ToolDistance& d);
   /// y = Y + W u, the vertices that can touch the tool, and their contact values.
   void evaluate(const Points& u);
   /// The load of the vertices pressing on the tool at y_, calling pressing(v, distance, pressure) for each.
@@ -145,7 +157,7 @@ class SurfaceContact final : public EnergyTerm {
   std::vector<Anchor> anchors_;           // per vertex, with friction
   std::vector<Active> active_;            // at the last linearise()
   ToolLoad last_load_;
-  double tolerance_ = 0, max_point_stiffness_ = 0, friction_ = 0;
+  double tolerance_ = 0, max_point_stiffness_ = 0, friction_ = 0, tangential_share_ = 0.01;
   bool posed_ = false;
 };
 

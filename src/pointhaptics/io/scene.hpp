@@ -137,7 +137,7 @@ struct ProbeSpec {
   std::array<double, 4> orientation{1, 0, 0, 0};  ///< unit quaternion w, x, y, z: tool to scene axes
   bool capsule = false;                    ///< shape = "capsule" (else "sphere")
   double length = 0;                       ///< capsule: its axis segment, m, along the tool's local z
-  double friction = 0;                     ///< Coulomb's coefficient on the surface (a held tool, so far)
+  double friction = 0;                     ///< Coulomb's coefficient on the surface
   bool object_stiffness = true;            ///< local_stiffness = "object" (else "contact"): ProbeParams::object_stiffness
   int line = 0;
   bool held() const { return present && position.allFinite(); }
