@@ -56,13 +56,20 @@ struct Press {
   Vec3 felt;       // the last force rendered to the device
   int contacts = 0;
   double penetration = 0;  // the deepest surface vertex inside the probe at the end, m
+  long long selections = 0;  // of the active set, with levels of detail
 };
 
 // the probe's centre starts 2 R above the top face and goes down 2 R + 1.5 mm over 0.4 s, then holds
-Press press(const std::string& solver) {
+// With levels of detail (`lod`) the active set is selected around the top face's centre and follows the probe.
+Press press(const std::string& solver, bool lod = false) {
   const Scene scene = block_scene(solver);
   Simulation sim(build_scene_model(scene), scene.solver, 1);
   const ObjectSurface surface = build_object_surface(scene, sim.model());
+  if (lod) {
+    LodParams params;
+    params.levels = {{3.0, 6}};
+    sim.enable_lod(params, Vec3(0, 0.02, 0));
+  }
   VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), false}, {0.4, Vec3(0, -2 * R - 0.0015, 0), false}, {0.6, Vec3(0, -2 * R - 0.0015, 0), false}}),
                        known_device_specs("touch"));
   InteractiveOptions o = probe_options(surface, 0.6);
@@ -70,11 +77,16 @@ Press press(const std::string& solver) {
   o.after_step = [&](long long) {
     p.probe = sim.probe()->probe();
     p.contacts = sim.probe()->contact_model().contacts;
+    ASSERT_TRUE(sim.probe()->on_surface());
     p.penetration = sim.probe()->surface_contact()->last_load().penetration;
   };
   const InteractiveResult r = run_interactive(sim, device, o);
   EXPECT_FALSE(sim.diagnostics().failed) << sim.diagnostics().failure;
   p.felt = r.log.back().force;
+  if (lod) {
+    EXPECT_LT(sim.simulated_model().n_points, sim.model().n_points);
+    p.selections = sim.summary().lod.selections;
+  }
   return p;
 }
 
@@ -109,6 +121,19 @@ TEST(ProbeOnSurface, ASlowPressRendersTheMaterialsForceInBothSolversWithTheProbe
               explicit_press.felt.y(), implicit_press.felt.y(), reference, implicit_press.felt.y() / reference,
               implicit_press.penetration, 0.02 + R - implicit_press.probe.y());
   EXPECT_NEAR(implicit_press.felt.y(), reference, 0.02 * reference);
+}
+
+// With levels of detail the probe touches the part of the surface the active set carries (issue 16, item
+// 2): the same press renders the full model's force, on the surface.
+TEST(ProbeOnSurface, WithLevelsOfDetailTheProbeTouchesTheActiveSetsSurface) {
+  const Press full = press("explicit"), lod = press("explicit", true);
+  const double depth = 0.02 + R - lod.probe.y();
+  std::printf("levels of detail: felt %.4f N (full model %.4f N), penetration %.3g m of %.3g m, %lld selections\n", lod.felt.y(),
+              full.felt.y(), lod.penetration, depth, lod.selections);
+  ASSERT_GT(lod.contacts, 0);
+  EXPECT_GE(lod.selections, 1);
+  EXPECT_LT(lod.penetration, 0.01 * depth);
+  EXPECT_NEAR(lod.felt.y(), full.felt.y(), 0.03 * full.felt.y());
 }
 
 // Pressed in, then pushed up and down by 0.5 mm and dragged sideways: the local model the haptic side renders

@@ -63,7 +63,7 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
   const CouplingGains gains = coupling_budget(device.specs(), options.mapping.scale, options.coupling_safety);
   // in real time levels of detail are built on a worker thread and taken over at the first step after they
   // are ready; in deterministic runs in place, so that a run is reproducible
-  sim.attach_probe(options.probe, gains.stiffness, device.specs().max_force, options.real_time, options.surface.get());
+  sim.attach_probe(options.probe, gains.stiffness, device.specs().max_force, options.real_time, options.surface);
   struct Detach {  // the probe belongs to this run
     Simulation& sim;
     ~Detach() { sim.detach_probe(); }

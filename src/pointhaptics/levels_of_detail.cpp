@@ -109,7 +109,7 @@ void LevelsOfDetail::follow_probe() {
   if (!attached || active_->diagnostics().steps == 0) return;
   const ProbeTool& p = attached->tool;
   const bool onset = p.contacts_before_step() == 0 && p.contact_model().contacts > 0;
-  update(contact_of_probe(p.probe(), p.contact().grabbed(), p.contact().touched()), onset, attached->asynchronous_lod);
+  update(contact_of_probe(p.probe(), p.contact().grabbed(), p.touched()), onset, attached->asynchronous_lod);
 }
 
 std::vector<index_t> LevelsOfDetail::update(const Vec3& contact, bool onset, bool asynchronous) {
@@ -158,7 +158,13 @@ std::vector<index_t> LevelsOfDetail::take_over(LodBuild build, bool built_here) 
   sim->inputs_ = active_->inputs_;
   sim->probe_ = std::move(active_->probe_);
   active_ = std::move(sim);
-  if (active_->probe_) active_->probe_->tool.remap(active_->model(), new_index);
+  if (active_->probe_) {
+    ProbeAttachment& probe = *active_->probe_;
+    std::optional<SurfaceContact> surface;
+    if (probe.surface)
+      surface.emplace(probe_surface_contact(*probe.surface, probe.contact, probe.tool.contact().params().radius, active_->model(), &next));
+    probe.tool.remap(active_->model(), new_index, std::move(surface));
+  }
   active_->set_state(state);
   active_set_ = std::move(next);
   selection_ = std::move(build.selection);

@@ -1,5 +1,7 @@
 #include <pointhaptics/model_simulation.hpp>
 
+#include <pointhaptics/lod/active_surface.hpp>
+
 #include <pointhaptics/core/error.hpp>
 #include <pointhaptics/mechanics/inversion.hpp>
 #include <pointhaptics/solvers/explicit_solver.hpp>
@@ -9,6 +11,16 @@
 #include <chrono>
 
 namespace pointhaptics {
+
+SurfaceContact probe_surface_contact(const ObjectSurface& surface, const SurfaceContactParams& params, double radius,
+                                     const Model& model, const ActiveSet* active) {
+  const ToolShape sphere{ToolKind::SPHERE, radius, 0};
+  if (!active) return SurfaceContact(model, surface.mesh, surface.map, sphere, params);
+  ActiveSurface part = restrict_surface(surface.mesh, surface.map, *active);
+  SurfaceContact contact(model, part.mesh, std::move(part.map), sphere, params);
+  contact.set_vertex_ids(std::move(part.vertex_of));
+  return contact;
+}
 
 ModelSimulation::ModelSimulation(Model model, const SolverSpec& solver, int n_threads, double stable_dt)
     : model_(std::move(model)), solver_(solver), state_(State::at_rest(model_)), ws_(model_, n_threads), n_threads_(n_threads) {

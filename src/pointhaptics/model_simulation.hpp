@@ -6,6 +6,8 @@
 #include <pointhaptics/core/workspace.hpp>
 #include <pointhaptics/haptics/held_tool.hpp>
 #include <pointhaptics/haptics/probe_tool.hpp>
+#include <pointhaptics/lod/active_set.hpp>
+#include <pointhaptics/object_surface.hpp>
 #include <pointhaptics/solvers/solver.hpp>
 
 #include <memory>
@@ -46,7 +48,16 @@ struct StepDiagnostics {
 struct ProbeAttachment {
   ProbeTool tool;
   bool asynchronous_lod = false;  ///< levels of detail re-selected on a worker thread (real time)
+  /// The object's surface the probe pushes on (null: the point spheres), and its contact's settings: with
+  /// levels of detail every new active set gets the part of it that it carries (probe_surface_contact()).
+  std::shared_ptr<const ObjectSurface> surface;
+  SurfaceContactParams contact;
 };
+
+/// The probe's contact with `surface` (of the object) over `model`'s points: the whole surface, or with
+/// levels of detail (`active`: the active set `model` is) the part of it that the active set carries.
+SurfaceContact probe_surface_contact(const ObjectSurface& surface, const SurfaceContactParams& params, double radius,
+                                     const Model& model, const ActiveSet* active);
 
 class ModelSimulation {
  public:

@@ -33,9 +33,8 @@ SceneSession open_scene(Scene scene, const SessionOptions& options) {
                             contact);
   } else if (scene.probe.present) {
     s.interactive = scene_interactive_options(scene, s.simulation->model());
-    // the probe pushes on the object's surface; with levels of detail on the point spheres (the surface's map
-    // is over the object's points, the simulation's over the active set's)
-    if (!scene.lod.present) s.interactive.surface = std::make_shared<const ObjectSurface>(build_object_surface(scene, s.simulation->model()));
+    // the probe pushes on the object's surface (with levels of detail on the part the active set carries)
+    s.interactive.surface = std::make_shared<const ObjectSurface>(build_object_surface(scene, s.simulation->model()));
     if (options.make_device) s.device = make_scene_device(scene);
   }
   s.scene = std::move(scene);

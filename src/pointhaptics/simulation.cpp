@@ -56,26 +56,25 @@ void Simulation::set_state(const State& state) {
 }
 
 void Simulation::attach_probe(const ProbeParams& params, double coupling_stiffness, double max_force, bool asynchronous_lod,
-                              const ObjectSurface* surface) {
+                              std::shared_ptr<const ObjectSurface> surface) {
   ModelSimulation& sim = core();
   if (sim.solver().kind == SolverKind::STATIC) throw Error("probe: needs a dynamic solver (explicit or implicit)");
   if (sim.held_tool()) throw Error("probe: the simulation already holds a tool (one tool at a time)");
+  SurfaceContactParams contact;
+  // the contact no stiffer on a point than the point spheres' springs were (E x spacing): explicit steps keep
+  // their stable sub-step, implicit ones their linearly implicit springs. The probe's multipliers, advanced
+  // once a step (ProbeTool::after_step), keep it on the surface
+  contact.max_point_stiffness = sim.model().material.young * sim.model().spacing;
+  contact.friction = params.friction;
+  // friction's penalty a tenth of the normal one (SurfaceContactParams::tangential_share): sliding, the
+  // friction then measured 0.288 of the pressure for mu = 0.3 (0.286 with a hundredth, where new contacts
+  // stuck for tens of steps; the full penalty made explicit steps chatter: 0.217)
+  contact.tangential_share = 0.1;
   std::optional<SurfaceContact> on_surface;
-  if (surface && !lod_) {
-    SurfaceContactParams contact;
-    // the contact no stiffer on a point than the point spheres' springs were (E x spacing): explicit steps keep
-    // their stable sub-step, implicit ones their linearly implicit springs. The probe's multipliers, advanced
-    // once a step (ProbeTool::after_step), keep it on the surface
-    contact.max_point_stiffness = sim.model().material.young * sim.model().spacing;
-    contact.friction = params.friction;
-    // friction's penalty a tenth of the normal one (SurfaceContactParams::tangential_share): sliding, the
-    // friction then measured 0.288 of the pressure for mu = 0.3 (0.286 with a hundredth, where new contacts
-    // stuck for tens of steps; the full penalty made explicit steps chatter: 0.217)
-    contact.tangential_share = 0.1;
-    on_surface.emplace(sim.model(), surface->mesh, surface->map, ToolShape{ToolKind::SPHERE, params.radius, 0}, contact);
-  }
-  sim.probe().emplace(
-      ProbeAttachment{ProbeTool(sim.model(), params, coupling_stiffness, max_force, std::move(on_surface)), asynchronous_lod});
+  if (surface)
+    on_surface.emplace(probe_surface_contact(*surface, contact, params.radius, sim.model(), lod_ ? &lod_->active_set() : nullptr));
+  sim.probe().emplace(ProbeAttachment{ProbeTool(sim.model(), params, coupling_stiffness, max_force, std::move(on_surface)),
+                                      asynchronous_lod, std::move(surface), contact});
   sim.inputs() = StepInputs{};
 }
 

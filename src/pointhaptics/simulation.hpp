@@ -58,9 +58,9 @@ class Simulation {
   /// With levels of detail the active set follows its contact point, re-selected on a worker thread when
   /// `asynchronous_lod` (real time) and in place otherwise (reproducible runs). Throws Error for a static solver.
   /// `surface`: the object's surface, which the probe then pushes on (issue 16) instead of the point
-  /// spheres; without levels of detail only (with them the probe keeps the point spheres).
+  /// spheres; with levels of detail the part of it that the active set carries.
   void attach_probe(const ProbeParams& params, double coupling_stiffness, double max_force, bool asynchronous_lod,
-                    const ObjectSurface* surface = nullptr);
+                    std::shared_ptr<const ObjectSurface> surface = nullptr);
   void detach_probe();
   /// The probe (nullptr without one): its position and last local contact model. Its contact's point
   /// indices are the simulated model's; grabbed_points() gives the object's.

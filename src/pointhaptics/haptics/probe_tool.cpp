@@ -34,6 +34,17 @@ ContactModel ProbeTool::surface_model(const Model& model, const State& state, co
   return contact_model_of(surface_->load(model, state.u, same_u), state.time, p);
 }
 
+double ProbeTool::penetration_at(const Model& model, const State& state, const Vec3& p) {
+  surface_->set_pose(ToolPose{p, surface_->pose().orientation});
+  return surface_->load(model, state.u, true).penetration;
+}
+
+Vec3 ProbeTool::stop_at_surface(const Model& model, const State& state, const Vec3& from, Vec3 to) {
+  const double allowed = std::max(allowed_penetration * contact_.params().radius, penetration_at(model, state, from));
+  for (int halving = 0; halving < 6 && penetration_at(model, state, to) > allowed; ++halving) to = from + 0.5 * (to - from);
+  return penetration_at(model, state, to) > allowed ? from : to;
+}
+
 void ProbeTool::place(const Model& model, const State& state, const Vec3& device, bool button) {
   device_ = device;
   button_ = button;
@@ -54,6 +65,7 @@ void ProbeTool::place(const Model& model, const State& state, const Vec3& device
     // pass the surface and push it out from within
     const double longest = 0.25 * contact_.params().radius;
     if (pushing_surface() && (next - p).norm() > longest) next = p + (next - p) * (longest / (next - p).norm());
+    if (pushing_surface()) next = stop_at_surface(model, state, p, next);
     const bool settled = (next - p).norm() < 1e-9 + 1e-6 * contact_.params().radius;
     p = next;
     if (settled) break;
@@ -75,6 +87,7 @@ void ProbeTool::add(const Model& model, const State& state, Points& f) {
 void ProbeTool::after_step(const Model& model, const State& state, Workspace& ws) {
   if (!pushing_surface() || !probe_.allFinite()) {
     if (surface_) surface_->reset_multipliers();
+    surface_touched_.clear();
     return;
   }
   surface_->load(model, state.u);  // the surface carried to the step's end
@@ -83,6 +96,7 @@ void ProbeTool::after_step(const Model& model, const State& state, Workspace& ws
   // never pressing harder together than the coupling does (the probe's balance at the step's start)
   const double pressing = std::min(max_force_, k_ * (device_ - probe_).norm());
   last_ = contact_model_of(surface_->advance_multipliers(multiplier_rate, pressing), state.time, probe_);
+  surface_->pressing_points(surface_touched_);
   held_K_ = last_.K;
   if (!contact_.params().object_stiffness) return;
   // made before the first touch: a step that allocates it (and linearises the material) as the probe arrives
@@ -150,12 +164,18 @@ bool ProbeTool::add_stiffness(const Model& model, const State& state, Eigen::Mat
   return last_.contacts > 0;
 }
 
-void ProbeTool::remap(const Model& model, const std::vector<index_t>& new_index) {
+void ProbeTool::remap(const Model& model, const std::vector<index_t>& new_index, std::optional<SurfaceContact> surface) {
   contact_.remap(model, new_index);
-  surface_.reset();  // its map is over the points it was built for: the point spheres from now on
+  // the proxy's multipliers carry over to the vertices the new contact has (without them the probe sank by the
+  // penalty's give at every re-selection, and through a soft dome)
+  if (surface && surface_) surface->take_multipliers(*surface_);
+  surface_ = std::move(surface);
+  if (surface_ && probe_.allFinite()) surface_->set_pose(ToolPose{probe_, surface_->pose().orientation});
   scratch_ = Points::Zero(3, model.n_points);
+  compliance_solver_ = NewtonSolver(model);
   compliance_ws_.reset();
   compliance_load_.resize(3, 0);
+  compliance_contacts_ = 0;
 }
 
 }  // namespace pointhaptics

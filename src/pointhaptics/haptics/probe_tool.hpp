@@ -36,8 +36,9 @@ class ProbeTool final : public DynamicForces {
   /// Whether the probe touches the object's surface (else the point spheres).
   bool on_surface() const { return surface_.has_value(); }
   const SurfaceContact* surface_contact() const { return surface_ ? &*surface_ : nullptr; }
-  /// The model's points were renumbered (a level-of-detail re-selection): new_index[old], -1 if dropped.
-  void remap(const Model& model, const std::vector<index_t>& new_index);
+  /// The model's points were renumbered (a level-of-detail re-selection): new_index[old], -1 if dropped;
+  /// `surface`: the contact with the part of the surface the new model carries (none: the point spheres).
+  void remap(const Model& model, const std::vector<index_t>& new_index, std::optional<SurfaceContact> surface);
 
   const Vec3& probe() const { return probe_; }
   /// The local contact model of the last force evaluation, for the haptic side.
@@ -47,9 +48,17 @@ class ProbeTool final : public DynamicForces {
   /// Points in contact when the step began (before place()): contact onset is 0 before, > 0 after.
   int contacts_before_step() const { return contacts_before_; }
   const ProbeContact& contact() const { return contact_; }
+  /// The points the probe touches: on the surface those that carry most of each vertex pressing on it at the
+  /// last step's end, else the point spheres it pushed (the contact's).
+  const std::vector<index_t>& touched() const { return surface_ ? surface_touched_ : contact_.touched(); }
 
  private:
   bool pushing_surface() const;
+  /// The deepest surface vertex inside the probe at p, the surface as the step found it (evaluated already).
+  double penetration_at(const Model& model, const State& state, const Vec3& p);
+  /// The god-object's rule: the probe's move from `from` toward `to`, halved until no surface vertex is deeper
+  /// inside it than allowed_penetration x radius (or than at `from`, if deeper there), or no move at all.
+  Vec3 stop_at_surface(const Model& model, const State& state, const Vec3& from, Vec3 to);
   /// The local model of the surface contact at the probe position p (u as in the last evaluation when same_u).
   ContactModel surface_model(const Model& model, const State& state, const Vec3& p, bool same_u);
   /// The stiffness the tool feels with the object free to give (issue 16, item 4): K = B^T H^-1 B - sum_v H_v,
@@ -66,6 +75,12 @@ class ProbeTool final : public DynamicForces {
   /// (tests/deep_compression_test.cpp), a half keeps it stable and on a slow press leaves 0.16% of the
   /// depth inside the surface and the force at 0.999 of the material's (tests/probe_surface_test.cpp).
   static constexpr double multiplier_rate = 0.5;
+  /// How deep a surface vertex may be inside the probe when it is placed, over its radius. Without a bound, a
+  /// hand pushing fast into a soft, coarse dome (scenes/half_sphere_lod.toml: E = 1e4 Pa, spacing 4 mm, a 6 mm
+  /// probe) took the probe past the surface's vertices faster than the multipliers could build (their
+  /// penalty is E x spacing per point), and through; held back, the probe presses with the multipliers,
+  /// which catch up with the coupling's force over the next steps.
+  static constexpr double allowed_penetration = 0.1;
   ProbeContact contact_;
   std::optional<SurfaceContact> surface_;
   double k_, max_force_;
@@ -76,6 +91,7 @@ class ProbeTool final : public DynamicForces {
   ContactModel last_;
   Mat3 held_K_ = Mat3::Zero();
   Points scratch_;
+  std::vector<index_t> surface_touched_;
   /// the compliance solves: relative tolerance and CG iterations of a direction's turn (warm-started, the rest
   /// of the convergence comes over the next turns)
   static constexpr double compliance_tolerance = 1e-2;

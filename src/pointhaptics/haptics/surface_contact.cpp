@@ -253,6 +253,16 @@ void SurfaceContact::advance_anchor(index_t v, const ToolDistance& d) {
   a.tangent = tangent;
 }
 
+void SurfaceContact::pressing_points(std::vector<index_t>& out) const {
+  out.clear();
+  for_each_pressing([&](index_t v, const ToolDistance&, double) {
+    index_t best = map_.points.begin(v);
+    for (index_t e = best; e < map_.points.end(v); ++e)
+      if (map_.weight[e] > map_.weight[best]) best = e;
+    if (best < map_.points.end(v)) out.push_back(map_.points.index[best]);
+  });
+}
+
 ToolLoad SurfaceContact::load(const Model&, const Points& u, bool same_u) {
   if (!same_u) evaluate(u);
   return for_each_pressing([](index_t, const ToolDistance&, double) {});
@@ -276,6 +286,20 @@ ToolLoad SurfaceContact::advance_multipliers(double rate, double max_force) {
       if (lambda_[static_cast<std::size_t>(v)] > 0 || anchors_[static_cast<std::size_t>(v)].held)
         advance_anchor(v, tool_distance(shape_, pose_, y_.col(v)));
   return for_each_pressing([](index_t, const ToolDistance&, double) {});
+}
+
+void SurfaceContact::take_multipliers(const SurfaceContact& other) {
+  const auto id = [](const SurfaceContact& c, index_t v) { return c.ids_.empty() ? v : c.ids_[static_cast<std::size_t>(v)]; };
+  index_t n = 0;
+  for (index_t v = 0; v < other.y_.cols(); ++v) n = std::max(n, id(other, v) + 1);
+  std::vector<index_t> of_id(static_cast<std::size_t>(n), -1);  // object vertex -> the other's vertex
+  for (index_t v = 0; v < other.y_.cols(); ++v) of_id[static_cast<std::size_t>(id(other, v))] = v;
+  for (index_t v = 0; v < y_.cols(); ++v) {
+    const index_t object = id(*this, v);
+    const index_t o = object < n ? of_id[static_cast<std::size_t>(object)] : -1;
+    lambda_[static_cast<std::size_t>(v)] = o < 0 ? 0.0 : other.lambda_[static_cast<std::size_t>(o)];
+    if (!anchors_.empty()) anchors_[static_cast<std::size_t>(v)] = o < 0 || other.anchors_.empty() ? Anchor{} : other.anchors_[static_cast<std::size_t>(o)];
+  }
 }
 
 void SurfaceContact::reset_multipliers() {

@@ -99,6 +99,14 @@ class SurfaceContact final : public EnergyTerm {
   ToolLoad load(const Model& model, const Points& u, bool same_u = false);
   /// The load of the last add_forces(), which computes it on the way.
   const ToolLoad& last_load() const { return last_load_; }
+  /// The point that carries most of each vertex pressing on the tool at the last evaluation (out is cleared).
+  void pressing_points(std::vector<index_t>& out) const;
+  /// The object surface's vertex each of this contact's vertices is (a part of the surface, with levels of
+  /// detail; empty: the whole surface, in its order).
+  void set_vertex_ids(std::vector<index_t> ids) { ids_ = std::move(ids); }
+  /// The multipliers and anchors of `other` (the same tool on another part of the same object surface, or
+  /// the same part over other points) for the vertices both have: a new active set keeps the proxy's force.
+  void take_multipliers(const SurfaceContact& other);
   /// Forget the multipliers and the friction's anchors (the tool lifted off, or moved far).
   void reset_multipliers();
   /// Uzawa's update spread over time (a tool in dynamics, once a step, at the state and pose of the last
@@ -156,6 +164,7 @@ class SurfaceContact final : public EnergyTerm {
   std::vector<double> penalty_, lambda_;  // per vertex
   std::vector<Anchor> anchors_;           // per vertex, with friction
   std::vector<Active> active_;            // at the last linearise()
+  std::vector<index_t> ids_;              // the object surface's vertex of each vertex (empty: the same)
   ToolLoad last_load_;
   double tolerance_ = 0, max_point_stiffness_ = 0, friction_ = 0, tangential_share_ = 0.01;
   bool posed_ = false;

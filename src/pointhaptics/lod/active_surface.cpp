@@ -1,0 +1,30 @@
+#include <pointhaptics/lod/active_surface.hpp>
+
+#include <algorithm>
+
+namespace pointhaptics {
+
+ActiveSurface restrict_surface(const TriangleMesh& mesh, const SurfaceMap& map, const ActiveSet& active) {
+  ActiveSurface out;
+  const index_t m = map.n_vertices();
+  std::vector<index_t> kept(static_cast<std::size_t>(m), -1);
+  for (index_t v = 0; v < m; ++v) {
+    if (map.points.row_size(v) == 0) continue;
+    // the point that carries most of the vertex in the object
+    const auto first = map.weight.begin() + map.points.begin(v), last = map.weight.begin() + map.points.end(v);
+    const index_t nearest = map.points.index[static_cast<std::size_t>(std::max_element(first, last) - map.weight.begin())];
+    if (active.active_of[static_cast<std::size_t>(nearest)] < 0) continue;
+    kept[static_cast<std::size_t>(v)] = static_cast<index_t>(out.vertex_of.size());
+    out.vertex_of.push_back(v);
+  }
+  out.mesh.V.resize(3, static_cast<Eigen::Index>(out.vertex_of.size()));
+  for (std::size_t k = 0; k < out.vertex_of.size(); ++k) out.mesh.V.col(static_cast<Eigen::Index>(k)) = mesh.V.col(out.vertex_of[k]);
+  for (const auto& t : mesh.F) {
+    const std::array<index_t, 3> r{kept[static_cast<std::size_t>(t[0])], kept[static_cast<std::size_t>(t[1])], kept[static_cast<std::size_t>(t[2])]};
+    if (r[0] >= 0 && r[1] >= 0 && r[2] >= 0) out.mesh.F.push_back(r);
+  }
+  out.map = build_surface_map(active.model, out.mesh.V);
+  return out;
+}
+
+}  // namespace pointhaptics

@@ -1,0 +1,25 @@
+#pragma once
+/// @file The part of an object's surface that a level-of-detail active set carries (issue 16: the probe
+/// touches the surface with levels of detail too). A vertex stays when the point that carries most of it in
+/// the object is in the active model (selected, or in the frozen ring around them); the kept vertices are
+/// carried by the active model's own moving least squares (its points, with their widened supports where
+/// the selection thinned them: build_surface_map), as the absorbed points follow the selected ones. The
+/// triangles among kept vertices stay. The selection is centred on the contact and reaches bands beyond the
+/// probe, so what is left out is far from the tool.
+#include <pointhaptics/geometry/triangle_mesh.hpp>
+#include <pointhaptics/lod/active_set.hpp>
+#include <pointhaptics/mechanics/surface_map.hpp>
+
+#include <vector>
+
+namespace pointhaptics {
+
+struct ActiveSurface {
+  TriangleMesh mesh;               ///< the kept vertices and the triangles among them
+  SurfaceMap map;                  ///< over the active model's points (its own moving least squares)
+  std::vector<index_t> vertex_of;  ///< kept vertex -> the object surface's vertex
+};
+
+ActiveSurface restrict_surface(const TriangleMesh& mesh, const SurfaceMap& map, const ActiveSet& active);
+
+}  // namespace pointhaptics
