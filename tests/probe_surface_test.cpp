@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 
 namespace pointhaptics {
@@ -134,6 +135,50 @@ TEST(ProbeOnSurface, WithLevelsOfDetailTheProbeTouchesTheActiveSetsSurface) {
   EXPECT_GE(lod.selections, 1);
   EXPECT_LT(lod.penetration, 0.01 * depth);
   EXPECT_NEAR(lod.felt.y(), full.felt.y(), 0.03 * full.felt.y());
+}
+
+// A capsule posed by the device (issue 16, item 1): 20 mm long, 5 mm in radius, lying along x and tilted
+// by `tilt` (its +x end lower for tilt > 0), pressed in until its lowest point is 1 mm below the top face.
+// The end pressed deeper pushes back harder: the torque about the tool's centre turns it back level.
+ToolSummary press_capsule(double tilt) {
+  const Scene scene = block_scene("explicit");
+  Simulation sim(build_scene_model(scene), scene.solver, 1);
+  const ObjectSurface surface = build_object_surface(scene, sim.model());
+  const double radius = 0.005, length = 0.02;
+  const double centre = 0.02 - 0.001 + radius + 0.5 * length * std::sin(std::abs(tilt));
+  VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), false},
+                                   {0.3, Vec3(0, centre - (0.02 + 2 * R), 0), false},
+                                   {0.5, Vec3(0, centre - (0.02 + 2 * R), 0), false}}),
+                       known_device_specs("touch"));
+  InteractiveOptions o = probe_options(surface, 0.5);
+  o.probe.radius = radius;
+  o.probe.length = length;
+  // the local axis z turned onto x, then tilted about z
+  o.probe.orientation = Eigen::AngleAxisd(-tilt, Vec3::UnitZ()) * Eigen::AngleAxisd(0.5 * M_PI, Vec3::UnitY());
+  ToolSummary tool;
+  o.after_step = [&](long long) { tool = sim.tool_summary(); };
+  run_interactive(sim, device, o);
+  EXPECT_FALSE(sim.diagnostics().failed) << sim.diagnostics().failure;
+  return tool;
+}
+
+TEST(ProbeOnSurface, ATiltedCapsulePressesWithItsLowerEndAndFeelsTheTorque) {
+  const ToolSummary level = press_capsule(0.0), right = press_capsule(0.15), left = press_capsule(-0.15);
+  for (const ToolSummary* t : {&level, &right, &left}) {
+    std::printf("%s at y = %.5f m: force (%.4f, %.4f, %.4f) N, torque (%.3g, %.3g, %.3g) N m, %d contacts, %.3g m inside\n",
+                t->kind.c_str(), t->position.y(), t->force.x(), t->force.y(), t->force.z(), t->torque.x(), t->torque.y(), t->torque.z(),
+                t->contacts, t->penetration);
+    EXPECT_EQ(t->kind, "capsule");
+    EXPECT_GT(t->contacts, 0);
+    EXPECT_GT(t->force.y(), 0.05);
+    EXPECT_LT(t->penetration, 0.01 * 0.001);  // of the 1 mm it was pressed in
+  }
+  // level: the force through its centre; tilted: its lower end's push turns it back level, each way
+  const double lever = 0.5 * 0.02 * right.force.y();  // the torque were all the force at the lower end
+  EXPECT_LT(std::abs(level.torque.z()), 0.02 * lever);
+  EXPECT_GT(right.torque.z(), 0.2 * lever);
+  EXPECT_LT(left.torque.z(), -0.2 * lever);
+  EXPECT_NEAR(right.torque.z(), -left.torque.z(), 0.05 * right.torque.z());
 }
 
 // Pressed in, then pushed up and down by 0.5 mm and dragged sideways: the local model the haptic side renders

@@ -45,6 +45,7 @@ int simulation_step(Simulation& sim, HapticLoop& loop, LocalModelStray& stray) {
   const HapticFrame& frame = loop.frames().front();
   sim.inputs().device = frame.device;
   sim.inputs().button = frame.button;
+  sim.inputs().orientation = frame.orientation;
   sim.step();
   const ProbeTool& probe = *sim.probe();
   loop.contact_models().back() = probe.contact_model();

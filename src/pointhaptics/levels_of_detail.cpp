@@ -162,7 +162,7 @@ std::vector<index_t> LevelsOfDetail::take_over(LodBuild build, bool built_here) 
     ProbeAttachment& probe = *active_->probe_;
     std::optional<SurfaceContact> surface;
     if (probe.surface)
-      surface.emplace(probe_surface_contact(*probe.surface, probe.contact, probe.tool.contact().params().radius, active_->model(), &next));
+      surface.emplace(probe_surface_contact(*probe.surface, probe.contact, probe_shape(probe.tool.contact().params()), active_->model(), &next));
     probe.tool.remap(active_->model(), new_index, std::move(surface));
   }
   active_->set_state(state);

@@ -12,12 +12,11 @@
 
 namespace pointhaptics {
 
-SurfaceContact probe_surface_contact(const ObjectSurface& surface, const SurfaceContactParams& params, double radius,
+SurfaceContact probe_surface_contact(const ObjectSurface& surface, const SurfaceContactParams& params, const ToolShape& shape,
                                      const Model& model, const ActiveSet* active) {
-  const ToolShape sphere{ToolKind::SPHERE, radius, 0};
-  if (!active) return SurfaceContact(model, surface.mesh, surface.map, sphere, params);
+  if (!active) return SurfaceContact(model, surface.mesh, surface.map, shape, params);
   ActiveSurface part = restrict_surface(surface.mesh, surface.map, *active);
-  SurfaceContact contact(model, part.mesh, std::move(part.map), sphere, params);
+  SurfaceContact contact(model, part.mesh, std::move(part.map), shape, params);
   contact.set_vertex_ids(std::move(part.vertex_of));
   return contact;
 }
@@ -68,7 +67,7 @@ const StepReport& ModelSimulation::step() {
 }
 
 void ModelSimulation::place_tools() {
-  if (probe_) probe_->tool.place(model_, state_, inputs_.device, inputs_.button);
+  if (probe_) probe_->tool.place(model_, state_, inputs_.device, inputs_.button, inputs_.orientation);
 }
 
 void ModelSimulation::check_finite(StepReport& report) const {

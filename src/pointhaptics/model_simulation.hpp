@@ -22,6 +22,7 @@ namespace pointhaptics {
 struct StepInputs {
   Vec3 device = Vec3::Constant(NAN);  ///< the probe's device point in the scene, m (NaN: the probe is lifted off)
   bool button = false;                ///< the device's button (grab)
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  ///< the device's (turns a capsule probe)
 };
 
 /// Counters and timers of the steps so far: the simulation's diagnostics, read by summary().
@@ -56,7 +57,7 @@ struct ProbeAttachment {
 
 /// The probe's contact with `surface` (of the object) over `model`'s points: the whole surface, or with
 /// levels of detail (`active`: the active set `model` is) the part of it that the active set carries.
-SurfaceContact probe_surface_contact(const ObjectSurface& surface, const SurfaceContactParams& params, double radius,
+SurfaceContact probe_surface_contact(const ObjectSurface& surface, const SurfaceContactParams& params, const ToolShape& shape,
                                      const Model& model, const ActiveSet* active);
 
 class ModelSimulation {

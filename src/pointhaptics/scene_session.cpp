@@ -82,6 +82,9 @@ InteractiveOptions scene_interactive_options(const Scene& scene, const Model& mo
   o.probe.stiffness = scene.probe.stiffness;
   o.probe.object_stiffness = scene.probe.object_stiffness;
   o.probe.friction = scene.probe.friction;
+  o.probe.length = scene.probe.capsule ? scene.probe.length : 0.0;
+  const auto& q = scene.probe.orientation;
+  o.probe.orientation = Eigen::Quaterniond(q[0], q[1], q[2], q[3]);
   o.mapping.scale = scene.probe.scale;
   if (scene.probe.origin.allFinite()) {
     o.mapping.origin = scene.probe.origin;

@@ -72,7 +72,7 @@ void Simulation::attach_probe(const ProbeParams& params, double coupling_stiffne
   contact.tangential_share = 0.1;
   std::optional<SurfaceContact> on_surface;
   if (surface)
-    on_surface.emplace(probe_surface_contact(*surface, contact, params.radius, sim.model(), lod_ ? &lod_->active_set() : nullptr));
+    on_surface.emplace(probe_surface_contact(*surface, contact, probe_shape(params), sim.model(), lod_ ? &lod_->active_set() : nullptr));
   sim.probe().emplace(ProbeAttachment{ProbeTool(sim.model(), params, coupling_stiffness, max_force, std::move(on_surface)),
                                       asynchronous_lod, std::move(surface), contact});
   sim.inputs() = StepInputs{};
@@ -172,8 +172,14 @@ ToolSummary Simulation::tool_summary() {
             load.contacts, load.penetration, load.friction};
   }
   if (const ProbeTool* probe = this->probe()) {
-    // the probe's local model at the last step's end: the force the object exerts on it there
+    // the probe's local model at the last step's end: the force the object exerts on it there; on the surface
+    // its load there, with the torque, the friction and the deepest vertex
     const ContactModel& c = probe->contact_model();
+    if (const SurfaceContact* surface = probe->surface_contact()) {
+      const ToolLoad& load = surface->last_load();
+      return {true, surface->shape().kind == ToolKind::CAPSULE ? "capsule" : "sphere", probe->probe(), c.f0, load.torque, c.contacts,
+              load.penetration, load.friction};
+    }
     return {true, "sphere", probe->probe(), c.f0, Vec3::Zero(), c.contacts, 0.0, Vec3::Zero()};
   }
   return {};

@@ -4,6 +4,8 @@
 #include <pointhaptics/core/model.hpp>
 #include <pointhaptics/geometry/spatial_grid.hpp>
 
+#include <Eigen/Geometry>
+
 #include <vector>
 
 namespace pointhaptics {
@@ -17,6 +19,10 @@ struct ProbeParams {
   double point_radius = 0;      ///< point spheres, m (0: half the model's spacing)
   double stiffness = 0;         ///< contact / grab spring per point, N/m (0: E x spacing, the object's own scale)
   double friction = 0;          ///< Coulomb's coefficient on the surface (the point spheres are frictionless)
+  /// On the surface: > 0 makes the tool a capsule, its axis segment this long (m) along the tool's local z,
+  /// posed by `orientation` turned by the device's own (a device that reports none keeps `orientation`).
+  double length = 0;
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
   /// On the surface: the local model's stiffness is the object's as the tool sees it (ProbeTool::
   /// compliance_stiffness), else the contact's own (the held object's, stiffer).
   bool object_stiffness = true;

@@ -49,6 +49,7 @@ bool HapticLoop::tick(double t, double dt) {
     frame.probe = p;
     frame.device = d;
     frame.button = (state.buttons & 1u) != 0;
+    frame.orientation = state.orientation;
     frame.force = f;
     frame.tick = ticks_ + 1;
     frames_.publish();

@@ -26,6 +26,7 @@ struct HapticFrame {
   Vec3 probe = Vec3::Constant(NAN);  ///< scene position of the probe (NaN until the first tick)
   Vec3 device = Vec3::Constant(NAN); ///< scene position of the device point the coupling pulls toward
   bool button = false;
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  ///< the device's
   Vec3 force = Vec3::Zero();         ///< force commanded to the device, N
   long long tick = 0;                ///< ticks so far, this one included (a reader's rate meter)
 };

@@ -45,9 +45,10 @@ Vec3 ProbeTool::stop_at_surface(const Model& model, const State& state, const Ve
   return penetration_at(model, state, to) > allowed ? from : to;
 }
 
-void ProbeTool::place(const Model& model, const State& state, const Vec3& device, bool button) {
+void ProbeTool::place(const Model& model, const State& state, const Vec3& device, bool button, const Eigen::Quaterniond& orientation) {
   device_ = device;
   button_ = button;
+  if (surface_) surface_->set_pose(ToolPose{surface_->pose().position, (orientation * contact_.params().orientation).normalized()});
   contacts_before_ = last_.contacts;
   if (!device.allFinite()) {
     probe_ = device;

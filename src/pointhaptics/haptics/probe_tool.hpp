@@ -12,6 +12,11 @@
 
 namespace pointhaptics {
 
+/// The probe's shape on the surface: a sphere, or a capsule when params.length > 0.
+inline ToolShape probe_shape(const ProbeParams& params) {
+  return ToolShape{params.length > 0 ? ToolKind::CAPSULE : ToolKind::SPHERE, params.radius, params.length};
+}
+
 class ProbeTool final : public DynamicForces {
  public:
   /// coupling_stiffness: the spring between the device point and the probe, N/m; max_force: the device's
@@ -25,7 +30,9 @@ class ProbeTool final : public DynamicForces {
   /// balances the contact forces at the step's start; a few Newton steps on the local model from the last
   /// position. Within the step the probe stays there (re-solving it at every sub-step let the contact set
   /// chatter and excite the lattice). A non-finite device point lifts the probe off.
-  void place(const Model& model, const State& state, const Vec3& device, bool button);
+  /// `orientation`: the device's, which turns the tool from the params' orientation (a capsule).
+  void place(const Model& model, const State& state, const Vec3& device, bool button,
+             const Eigen::Quaterniond& orientation = Eigen::Quaterniond::Identity());
   void add(const Model& model, const State& state, Points& f) override;
   bool add_stiffness(const Model&, const State&, Eigen::Matrix<double, 9, Eigen::Dynamic>& springs) override;
   double max_point_stiffness() const override;
