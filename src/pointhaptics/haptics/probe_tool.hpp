@@ -102,9 +102,9 @@ class ProbeTool final : public DynamicForces {
   /// the compliance solves: relative tolerance and CG iterations of a direction's turn (warm-started, the rest
   /// of the convergence comes over the next turns)
   static constexpr double compliance_tolerance = 1e-2;
-  static constexpr int compliance_budget = 10;
+  static constexpr int compliance_budget = 3;
   /// steps between linearisations of the material's tangent (in between it lags; the contact's is made anew)
-  static constexpr int compliance_relinearise = 12;
+  static constexpr int compliance_relinearise = 48;
   NewtonSolver compliance_solver_;
   std::unique_ptr<Workspace> compliance_ws_;  // its own: the step's keeps what the solver carries to the next step
   Points compliance_load_;                   // B e, one direction at a time
