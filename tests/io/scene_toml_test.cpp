@@ -411,8 +411,8 @@ TEST(SceneToml, BadHeldToolIsANamedError) {
 
 TEST(SceneToml, TheLocalModelsStiffnessIsChosen) {
   const std::string probe = "\n[probe]\nkeyframes = [[0.0, 0.0, 0.0, 0.0]]\n";
-  EXPECT_TRUE(parse_scene(std::string(full_scene) + probe, "t.toml", ".").probe.object_stiffness);
-  EXPECT_FALSE(parse_scene(std::string(full_scene) + probe + "local_stiffness = \"contact\"\n", "t.toml", ".").probe.object_stiffness);
+  EXPECT_FALSE(parse_scene(std::string(full_scene) + probe, "t.toml", ".").probe.object_stiffness);
+  EXPECT_TRUE(parse_scene(std::string(full_scene) + probe + "local_stiffness = \"object\"\n", "t.toml", ".").probe.object_stiffness);
   EXPECT_NE(error_of("keyframes = [[0.0, 0.0, 0.0, 0.0]]", "keyframes = [[0.0, 0.0, 0.0, 0.0]]\nlocal_stiffness = \"soft\"",
                      std::string(full_scene) + probe)
                 .find("probe.local_stiffness: unknown value \"soft\""),

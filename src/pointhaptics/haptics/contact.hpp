@@ -24,8 +24,11 @@ struct ProbeParams {
   double length = 0;
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
   /// On the surface: the local model's stiffness is the object's as the tool sees it (ProbeTool::
-  /// compliance_stiffness), else the contact's own (the held object's, stiffer).
-  bool object_stiffness = true;
+  /// compliance_stiffness), not the contact's own. Off by default: its solves cost a tangent product per CG
+  /// iteration on the simulated model, which doubled the step of the level-of-detail half-sphere (1.98
+  /// against 0.97 ms) and took it out of real time, for a local model that strays 1.5 mN from the next
+  /// update where the contact's own strays 2.6 mN (docs/haptics.md).
+  bool object_stiffness = false;
 };
 
 /// The force the object exerts on the probe near p0, linearised: F(p) = f0 + K (p - p0).

@@ -138,7 +138,7 @@ struct ProbeSpec {
   bool capsule = false;                    ///< shape = "capsule" (else "sphere")
   double length = 0;                       ///< capsule: its axis segment, m, along the tool's local z
   double friction = 0;                     ///< Coulomb's coefficient on the surface
-  bool object_stiffness = true;            ///< local_stiffness = "object" (else "contact"): ProbeParams::object_stiffness
+  bool object_stiffness = false;           ///< local_stiffness = "object" (else "contact"): ProbeParams::object_stiffness
   int line = 0;
   bool held() const { return present && position.allFinite(); }
 };

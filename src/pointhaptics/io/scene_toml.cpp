@@ -529,7 +529,7 @@ void read_probe(TableReader& r, ProbeSpec& p, const Context& ctx) {
   if (p.capsule && !(p.length > 0)) r.fail_table("length", "a capsule needs length > 0 (m): its axis segment");
   if (!p.capsule && r.find("length")) r.fail_at(*r.find("length"), "length", "only a capsule has a length (shape = \"capsule\")");
   p.friction = r.number("friction", p.friction, [](double m) { return m >= 0 && m <= 10; }, "must be in [0, 10]");
-  p.object_stiffness = r.choice("local_stiffness", "object", {"contact", "object"}) == "object";
+  p.object_stiffness = r.choice("local_stiffness", "contact", {"contact", "object"}) == "object";
   if (r.find("position")) {
     p.position = r.vec3("position", p.position);
     if (r.find("trajectory") || r.find("keyframes"))
