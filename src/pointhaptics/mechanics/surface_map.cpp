@@ -21,10 +21,11 @@ struct VertexWeights {
   std::vector<index_t> points;
   std::vector<double> weight;
   bool widened = false;
+  bool carried = true;  // false: too few points around it, after every widening
 };
 
 /// The MLS weights of vertex y with support h, widened until the moment matrix is well conditioned.
-VertexWeights vertex_weights(const Model& model, const KdTree& tree, const Vec3& y, double h, index_t vertex) {
+VertexWeights vertex_weights(const Model& model, const KdTree& tree, const Vec3& y, double h, index_t vertex, bool skip_uncarried) {
   std::vector<std::pair<index_t, double>> found;
   nanoflann::SearchParams params;
   params.sorted = false;
@@ -60,14 +61,16 @@ VertexWeights vertex_weights(const Model& model, const KdTree& tree, const Vec3&
     for (std::size_t k = 0; k < out.points.size(); ++k) out.weight[k] *= a.dot(basis[k]);
     return out;
   }
-  throw Error(fmt::format("surface vertex {} at ({:.4g}, {:.4g}, {:.4g}) m: too few points around it to carry it "
-                          "(none or only a flat set within {:.3g} m)",
-                          vertex, y.x(), y.y(), y.z(), h / 1.5));
+  if (!skip_uncarried)
+    throw Error(fmt::format("surface vertex {} at ({:.4g}, {:.4g}, {:.4g}) m: too few points around it to carry it "
+                            "(none or only a flat set within {:.3g} m)",
+                            vertex, y.x(), y.y(), y.z(), h / 1.5));
+  return VertexWeights{{}, {}, true, false};
 }
 
 }  // namespace
 
-SurfaceMap build_surface_map(const Model& model, const Points& Y) {
+SurfaceMap build_surface_map(const Model& model, const Points& Y, std::vector<char>* uncarried) {
   if (model.n_points < 4) throw Error(fmt::format("surface: {} points cannot carry a surface (at least 4)", model.n_points));
   if (!Y.allFinite()) throw Error("surface: a vertex is not finite");
   const index_t m = static_cast<index_t>(Y.cols());
@@ -83,12 +86,14 @@ SurfaceMap build_surface_map(const Model& model, const Points& Y) {
         tree.index().knnSearch(y.data(), 1, &nearest, &d2);
         h = model.support[nearest];
       }
-      rows[static_cast<std::size_t>(v)] = vertex_weights(model, tree, y, h, v);
+      rows[static_cast<std::size_t>(v)] = vertex_weights(model, tree, y, h, v, uncarried != nullptr);
     }
   });
   SurfaceMap map;
   map.points.offset.reserve(static_cast<std::size_t>(m) + 1);
+  if (uncarried) uncarried->assign(static_cast<std::size_t>(m), 0);
   for (const VertexWeights& row : rows) {
+    if (!row.carried) (*uncarried)[static_cast<std::size_t>(&row - rows.data())] = 1;
     map.points.index.insert(map.points.index.end(), row.points.begin(), row.points.end());
     map.weight.insert(map.weight.end(), row.weight.begin(), row.weight.end());
     map.points.offset.push_back(static_cast<index_t>(map.points.index.size()));

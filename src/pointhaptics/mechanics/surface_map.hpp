@@ -23,8 +23,9 @@ struct SurfaceMap {
 /// model's kernel (h: the model's support, or with per-point supports the nearest point's). So W reproduces
 /// every affine displacement exactly, rigid motions among them. A vertex whose points within h are too few
 /// or too flat for M (condition number above 1e8) takes them within 1.5 h, then 2.25 h, ... (counted in
-/// `widened`); after five widenings it is an Error naming the vertex.
-SurfaceMap build_surface_map(const Model& model, const Points& Y);
+/// `widened`); after five widenings it is an Error naming the vertex, unless `uncarried` is given: then such a
+/// vertex gets an empty row and uncarried[v] = 1 (the others 0).
+SurfaceMap build_surface_map(const Model& model, const Points& Y, std::vector<char>* uncarried = nullptr);
 
 /// W f: a field of the points (k x n, e.g. k = 1 von Mises stress, 9 a stress tensor) at the vertices (k x m),
 /// into `out` (resized once).
