@@ -58,7 +58,8 @@ class Simulation {
   /// With levels of detail the active set follows its contact point, re-selected on a worker thread when
   /// `asynchronous_lod` (real time) and in place otherwise (reproducible runs). Throws Error for a static solver.
   /// `surface`: the object's surface, which the probe then pushes on (issue 16) instead of the point
-  /// spheres; with levels of detail the part of it that the active set carries.
+  /// spheres; with levels of detail the part of it that the active set carries (scenes do not ask for it:
+  /// a slow real-time run diverged with it, tests/integration/realtime_lod_soak.py).
   void attach_probe(const ProbeParams& params, double coupling_stiffness, double max_force, bool asynchronous_lod,
                     std::shared_ptr<const ObjectSurface> surface = nullptr);
   void detach_probe();

@@ -480,10 +480,13 @@ std::string probe_error(const std::string& find, const std::string& replace) {
   return error_of(find, replace, std::string(full_scene) + probe_section);
 }
 
-TEST(SceneToml, ADevicesProbeHasFriction) {
+TEST(SceneToml, ADevicesProbeHasFrictionButNotOnThePointSpheresOfLevelsOfDetail) {
   std::string with_friction = std::string(full_scene) + probe_section;
   with_friction.replace(with_friction.find("radius = 0.01"), 13, "radius = 0.01\nfriction = 0.3");
   EXPECT_DOUBLE_EQ(parse_scene(with_friction, "t.toml", ".").probe.friction, 0.3);
+  EXPECT_NE(error_of("[solver]", "[lod]\nk1 = 1.5\n[solver]", with_friction)
+                .find("probe.friction: a device's probe with levels of detail touches the point spheres"),
+            std::string::npos);
 }
 
 TEST(SceneToml, BadProbeOrDeviceIsANamedError) {

@@ -673,6 +673,10 @@ Scene parse_scene(std::string_view text, const std::string& name, const std::str
     throw Error(fmt::format("{}:{}: probe: a virtual device needs trajectory = \"probe.csv\" or keyframes = [[t, x, y, z], ...] "
                             "(or position = [x, y, z] for a tool held there)",
                             name, scene.probe.line));
+  if (scene.probe.present && !scene.probe.held() && scene.probe.friction > 0 && scene.lod.present)
+    throw Error(fmt::format("{}:{}: probe.friction: a device's probe with levels of detail touches the point spheres, which "
+                            "are frictionless",
+                            name, scene.probe.line));
   if (scene.probe.held() && root.get("device"))
     throw Error(fmt::format("{}:{}: probe: a tool held at a position is not driven by a [device]", name, scene.probe.line));
   if (root.get("device") && !scene.probe.present)
