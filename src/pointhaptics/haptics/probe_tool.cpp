@@ -167,8 +167,8 @@ bool ProbeTool::add_stiffness(const Model& model, const State& state, Eigen::Mat
 
 void ProbeTool::remap(const Model& model, const std::vector<index_t>& new_index, std::optional<SurfaceContact> surface) {
   contact_.remap(model, new_index);
-  // the proxy's multipliers carry over to the vertices the new contact has (without them the probe sank by the
-  // penalty's give at every re-selection, and through a soft dome)
+  // the proxy's multipliers carry over to the vertices the new contact has (without them the probe would sink
+  // by the penalty's give at every re-selection)
   if (surface && surface_) surface->take_multipliers(*surface_);
   surface_ = std::move(surface);
   if (surface_ && probe_.allFinite()) surface_->set_pose(ToolPose{probe_, surface_->pose().orientation});
