@@ -36,9 +36,18 @@ box = { min = [-1.0, -1.0, -1.0], max = [1.0, 0.0, 1.0] }
 kind = "explicit"
 dt = 1e-3
 )");
-  s.solver.kind = solver == "implicit" ? SolverKind::IMPLICIT : SolverKind::EXPLICIT;
+  s.solver.kind = solver == "implicit" ? SolverKind::IMPLICIT : solver == "static" ? SolverKind::STATIC : SolverKind::EXPLICIT;
   return s;
 }
+
+// the block simulated on one thread, with its surface
+struct Block {
+  Scene scene;
+  Simulation sim;
+  ObjectSurface surface;
+  explicit Block(const std::string& solver)
+      : scene(block_scene(solver)), sim(build_scene_model(scene), scene.solver, 1), surface(build_object_surface(scene, sim.model())) {}
+};
 
 // a probe of radius R on the block's surface, the device's origin 2 R above its top face, in simulated time
 InteractiveOptions probe_options(const ObjectSurface& surface, double duration) {
@@ -63,9 +72,9 @@ struct Press {
 // the probe's centre starts 2 R above the top face and goes down 2 R + 1.5 mm over 0.4 s, then holds
 // With levels of detail (`lod`) the active set is selected around the top face's centre and follows the probe.
 Press press(const std::string& solver, bool lod = false) {
-  const Scene scene = block_scene(solver);
-  Simulation sim(build_scene_model(scene), scene.solver, 1);
-  const ObjectSurface surface = build_object_surface(scene, sim.model());
+  Block block(solver);
+  Simulation& sim = block.sim;
+  const ObjectSurface& surface = block.surface;
   if (lod) {
     LodParams params;
     params.levels = {{3.0, 6}};
@@ -93,10 +102,9 @@ Press press(const std::string& solver, bool lod = false) {
 
 // the force of the material with the probe held at `probe`, the contact met exactly
 double static_force(const Vec3& probe) {
-  Scene scene = block_scene("explicit");
-  scene.solver.kind = SolverKind::STATIC;
-  Simulation sim(build_scene_model(scene), scene.solver, 1);
-  const ObjectSurface surface = build_object_surface(scene, sim.model());
+  Block block("static");
+  Simulation& sim = block.sim;
+  const ObjectSurface& surface = block.surface;
   sim.hold_tool(ToolShape{ToolKind::SPHERE, R, 0}, ToolPose{probe, Eigen::Quaterniond::Identity()}, surface.mesh, surface.map);
   const StepReport& report = sim.step();
   EXPECT_NE(report.status, StepStatus::FAILED) << report.failure;
@@ -141,9 +149,9 @@ TEST(ProbeOnSurface, WithLevelsOfDetailTheProbeTouchesTheActiveSetsSurface) {
 // by `tilt` (its +x end lower for tilt > 0), pressed in until its lowest point is 1 mm below the top face.
 // The end pressed deeper pushes back harder: the torque about the tool's centre turns it back level.
 ToolSummary press_capsule(double tilt) {
-  const Scene scene = block_scene("explicit");
-  Simulation sim(build_scene_model(scene), scene.solver, 1);
-  const ObjectSurface surface = build_object_surface(scene, sim.model());
+  Block block("explicit");
+  Simulation& sim = block.sim;
+  const ObjectSurface& surface = block.surface;
   const double radius = 0.005, length = 0.02;
   const double centre = 0.02 - 0.001 + radius + 0.5 * length * std::sin(std::abs(tilt));
   VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), false},
@@ -186,9 +194,9 @@ TEST(ProbeOnSurface, ATiltedCapsulePressesWithItsLowerEndAndFeelsTheTorque) {
 // next update's force better than the contact's own stiffness (the held object's) or no stiffness at all.
 TEST(ProbeOnSurface, TheLocalModelsStiffnessIsTheObjectsAndPredictsTheNextUpdate) {
   for (const std::string solver : {"explicit", "implicit"}) {
-    const Scene scene = block_scene(solver);
-    Simulation sim(build_scene_model(scene), scene.solver, 1);
-    const ObjectSurface surface = build_object_surface(scene, sim.model());
+    Block block(solver);
+    Simulation& sim = block.sim;
+    const ObjectSurface& surface = block.surface;
     const double down = -2 * R - 0.0015;
     VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), false},
                                      {0.3, Vec3(0, down, 0), false},
@@ -232,9 +240,9 @@ struct Slide {
 
 // down into the block by 0.3 s, held, then from 0.4 s moved sideways by `sideways` over `over` seconds, held
 Slide slide(const std::string& solver, double friction, double sideways, double over, double duration) {
-  const Scene scene = block_scene(solver);
-  Simulation sim(build_scene_model(scene), scene.solver, 1);
-  const ObjectSurface surface = build_object_surface(scene, sim.model());
+  Block block(solver);
+  Simulation& sim = block.sim;
+  const ObjectSurface& surface = block.surface;
   const double down = -2 * R - 0.0015;
   VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), false},
                                    {0.3, Vec3(0, down, 0), false},

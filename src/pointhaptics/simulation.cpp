@@ -164,11 +164,17 @@ void check_physical(const Model& model, Workspace& ws, const StepDiagnostics& d,
 
 }  // namespace
 
+namespace {
+
+const char* tool_kind_name(const ToolShape& shape) { return shape.kind == ToolKind::CAPSULE ? "capsule" : "sphere"; }
+
+}  // namespace
+
 ToolSummary Simulation::tool_summary() {
   ModelSimulation& sim = core();
   if (HeldTool* tool = sim.held_tool().get()) {
     const ToolLoad load = tool->load(sim.model(), sim.state().u);
-    return {true, tool->shape().kind == ToolKind::CAPSULE ? "capsule" : "sphere", tool->pose().position, load.force, load.torque,
+    return {true, tool_kind_name(tool->shape()), tool->pose().position, load.force, load.torque,
             load.contacts, load.penetration, load.friction};
   }
   if (const ProbeTool* probe = this->probe()) {
@@ -177,7 +183,7 @@ ToolSummary Simulation::tool_summary() {
     const ContactModel& c = probe->contact_model();
     if (const SurfaceContact* surface = probe->surface_contact()) {
       const ToolLoad& load = surface->last_load();
-      return {true, surface->shape().kind == ToolKind::CAPSULE ? "capsule" : "sphere", probe->probe(), c.f0, load.torque, c.contacts,
+      return {true, tool_kind_name(surface->shape()), probe->probe(), c.f0, load.torque, c.contacts,
               load.penetration, load.friction};
     }
     return {true, "sphere", probe->probe(), c.f0, Vec3::Zero(), c.contacts, 0.0, Vec3::Zero()};
