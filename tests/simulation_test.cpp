@@ -165,5 +165,47 @@ TEST(Simulation, CantileverSettlesOnTheCalculixDeflection) {
   RecordProperty("tip_deflection_m", std::to_string(deflection));
 }
 
+TEST(Simulation, AScriptedBladeThroughTheRootDropsTheFreePieceAndLeavesTheStump) {
+  // scenes/cantilever_cut.toml: the blade passes x = 3.375 cm from t = 0.2 s to 0.25 s; damping c = 20 / s
+  const Scene scene = read_scene_file(PH_SCENES "/cantilever_cut.toml");
+  ASSERT_EQ(scene.cuts.size(), 1u);
+  Simulation sim(build_scene_model(scene), scene.solver, 2);
+  for (const CutSpec& cut : scene.cuts) sim.add_scripted_cut(cut);
+  const double stable_before = sim.stable_dt();
+  sim.run(0.2);
+  RunSummary s = sim.summary();
+  ASSERT_TRUE(s.cut.present);
+  EXPECT_EQ(s.cut.cut_pairs, 0);
+  EXPECT_EQ(s.cut.piece_points.size(), 1u);
+  sim.run(0.3);
+  s = sim.summary();
+  EXPECT_TRUE(s.converged) << s.failure;
+  EXPECT_GE(s.cut.sweeps, 50);  // at least one per step while the blade moves
+  EXPECT_GT(s.cut.cut_pairs, 0);
+  ASSERT_EQ(s.cut.piece_points.size(), 2u);
+  // 21 x 5 x 5 points: 5 planes of 25 in the stump, 16 in the free piece
+  EXPECT_EQ(s.cut.piece_points[0], 125);
+  EXPECT_EQ(s.cut.piece_points[1], 400);
+  EXPECT_GT(sim.stable_dt(), 0.3 * stable_before);
+  const Model& model = sim.model();
+  const State& state = sim.state();
+  double stump_max = 0, free_velocity = 0, free_drop = 0;
+  for (index_t i = 0; i < model.n_points; ++i) {
+    if (model.X(0, i) < 0.03375) {
+      stump_max = std::max(stump_max, state.u.col(i).norm());
+    } else {
+      free_velocity += state.velocity(1, i) / 400;
+      free_drop += state.u(1, i) / 400;
+    }
+  }
+  // the stump sags under its own weight only; the free piece falls, at the damping's terminal speed g / c
+  // once e^(-c t) has died out (e^-5 at the end)
+  EXPECT_LT(stump_max, 1e-4);
+  EXPECT_LT(free_drop, -0.05);
+  EXPECT_NEAR(free_velocity, -9.81 / 20.0, 0.02 * 9.81 / 20.0);
+  const std::string json = result_json(model, state, s);
+  EXPECT_NE(json.find("\"pieces\": 2"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace pointhaptics

@@ -94,6 +94,13 @@ void print_summary(ph::Simulation& sim, const ph::RunSummary& s, double setup_s)
                "({:.3g}, {:.3g}, {:.3g}) N m; {} contacts, deepest {:.3g} m inside\n",
                s.tool.kind, s.tool.position.x(), s.tool.position.y(), s.tool.position.z(), s.tool.force.x(), s.tool.force.y(),
                s.tool.force.z(), s.tool.torque.x(), s.tool.torque.y(), s.tool.torque.z(), s.tool.contacts, s.tool.penetration);
+  if (s.cut.present) {
+    std::string sizes;
+    for (size_t p = 0; p < s.cut.piece_points.size(); ++p) sizes += fmt::format("{}{}", p ? ", " : "", s.cut.piece_points[p]);
+    fmt::print("cut             {} blade sweeps severed {} neighbour pairs; {} piece(s) of {} points; the longest sweep took "
+               "{:.2f} ms\n",
+               s.cut.sweeps, s.cut.cut_pairs, s.cut.piece_points.size(), sizes, s.cut.max_update_ms);
+  }
   if (s.lod.enabled) {
     std::string bands;
     for (size_t b = 0; b < s.lod.band_count.size(); ++b)

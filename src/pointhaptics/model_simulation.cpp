@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 
 namespace pointhaptics {
@@ -39,6 +40,20 @@ void ModelSimulation::set_state(const State& state) {
   // a viscoelastic history: the state's when it has one for this model, else at rest
   if (state.viscous.rows() == state_.viscous.rows() && state.viscous.cols() == state_.viscous.cols()) state_.viscous = state.viscous;
   else state_.viscous.setZero();
+}
+
+CutReport ModelSimulation::cut(const BladeSweep& sweep) {
+  const auto start = std::chrono::steady_clock::now();
+  const CutReport report = pointhaptics::cut(model_, model_.X + state_.u, sweep);
+  if (report.severed_pairs > 0) {
+    // implicit and static steps do not depend on it: they keep the uncut model's as their report
+    if (solver_.kind == SolverKind::EXPLICIT) stable_dt_ = stable_time_step(model_, 0.8, 20, n_threads_);
+    solver_impl_ = make_solver(model_, solver_, stable_dt_);
+  }
+  ++diagnostics_.cuts;
+  diagnostics_.max_cut_seconds =
+      std::max(diagnostics_.max_cut_seconds, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  return report;
 }
 
 // ---- the step pipeline below the active set: each stage is one function, in the order step() calls them ----

@@ -7,6 +7,7 @@
 #include <pointhaptics/haptics/held_tool.hpp>
 #include <pointhaptics/haptics/probe_tool.hpp>
 #include <pointhaptics/lod/active_set.hpp>
+#include <pointhaptics/mechanics/cut.hpp>
 #include <pointhaptics/object_surface.hpp>
 #include <pointhaptics/solvers/solver.hpp>
 
@@ -43,6 +44,8 @@ struct StepDiagnostics {
   std::string failure;          ///< why
   double step_seconds = 0;      ///< wall time in steps, s, and in its stages:
   double active_set_seconds = 0, tools_seconds = 0, solve_seconds = 0;
+  long long cuts = 0;           ///< blade sweeps applied (ModelSimulation::cut)
+  double max_cut_seconds = 0;   ///< the longest of them, the stable step and the solver's rebuild included, s
 };
 
 /// The probe's tool and its settings, as a simulation holds them (carried to the next active model).
@@ -74,6 +77,10 @@ class ModelSimulation {
 
   const Model& model() const { return model_; }
   const State& state() const { return state_; }
+  /// Between steps, cut the object where `sweep` crosses it at the current positions (mechanics/cut.hpp).
+  /// When pairs were severed, the explicit stable step is found again (20 Lanczos steps: a one-sided stencil
+  /// can be stiffer than a whole one; explicit solver only) and the solver is rebuilt on the cut model.
+  CutReport cut(const BladeSweep& sweep);
   /// Replace the state (same model). Throws Error for a state of another size.
   void set_state(const State& state);
   StepInputs& inputs() { return inputs_; }

@@ -19,6 +19,7 @@ SceneSession open_scene(Scene scene, const SessionOptions& options) {
   SceneSession s;
   s.simulation = std::make_unique<Simulation>(build_scene_model(scene, options.max_memory), scene.solver, options.threads);
   if (scene.lod.present) s.simulation->enable_lod(scene.lod.params, scene_lod_contact(scene, s.simulation->model()));
+  for (const CutSpec& cut : scene.cuts) s.simulation->add_scripted_cut(cut);
   if (scene.probe.held()) {
     // a tool held at a position, touching the object's surface
     const ObjectSurface surface = build_object_surface(scene, s.simulation->model());

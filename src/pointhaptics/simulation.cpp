@@ -31,10 +31,45 @@ const StepReport& Simulation::step() {
   ModelSimulation& sim = core();
   sim.diagnostics().active_set_seconds += selecting;
   sim.diagnostics().step_seconds += selecting;
+  // the scripted blades cut what they sweep during this step
+  if (!scripted_cuts_.empty()) apply_scripted_cuts();
   // the tools, the solver, the finite check and the diagnostics
   const StepReport& report = sim.step();
   if (lod_) lod_->mark_stale();
   return report;
+}
+
+void Simulation::add_scripted_cut(const CutSpec& cut) {
+  if (lod_) throw Error("cut: not yet with levels of detail (a cut in the active set does not reach the object)");
+  scripted_cuts_.push_back({cut, 0.0});
+}
+
+CutReport Simulation::cut(const BladeSweep& sweep) {
+  if (lod_) throw Error("cut: not yet with levels of detail (a cut in the active set does not reach the object)");
+  return object_->cut(sweep);
+}
+
+void Simulation::apply_scripted_cuts() {
+  const SolverSpec& spec = solver();
+  // the blade reaches, by the end of this step, the share of its sweep its script gives at that time
+  const double t_end = time() + (spec.kind == SolverKind::STATIC ? 0.0 : spec.dt);
+  for (ScriptedCut& c : scripted_cuts_) {
+    const CutSpec& s = c.spec;
+    double share = 1.0;
+    if (spec.kind != SolverKind::STATIC) {
+      if (t_end < s.start) continue;
+      share = s.duration > 0 ? std::min(1.0, (t_end - s.start) / s.duration) : 1.0;
+    }
+    if (share <= c.done) continue;
+    // this step's strip, and the trail before it near the edge: the material moves between steps, and a pair
+    // that crossed back over a strip already passed would escape the blade; far behind the edge the blade's
+    // body would keep the material from crossing, so nothing there is cut (a linear script's trail is one quad)
+    auto at = [&](int end, double u) -> Vec3 { return s.edge[end] + u * (s.to[end] - s.edge[end]); };
+    const Model& model = this->model();
+    if (c.done > 0) cut(BladeSweep{at(0, 0.0), at(1, 0.0), at(0, c.done), at(1, c.done), model.support.size() ? model.support.maxCoeff() : model.h});
+    cut(BladeSweep{at(0, c.done), at(1, c.done), at(0, share), at(1, share)});
+    c.done = share;
+  }
 }
 
 void Simulation::run(double duration, const std::function<bool(long long, long long)>& after_step) {
@@ -230,6 +265,15 @@ RunSummary Simulation::summary() {
   s.solve_s = d.solve_seconds;
   if (lod_) lod_->fill(s.lod);
   s.tool = tool_summary();
+  if (d.cuts > 0 || !scripted_cuts_.empty()) {
+    s.cut.present = true;
+    s.cut.sweeps = d.cuts;
+    s.cut.cut_pairs = model.diagnostics.severed_pairs;
+    s.cut.max_update_ms = 1e3 * d.max_cut_seconds;
+    std::vector<index_t> piece_of;
+    s.cut.piece_points.assign(static_cast<std::size_t>(connected_pieces(model, piece_of)), 0);
+    for (const index_t p : piece_of) ++s.cut.piece_points[p];
+  }
   return s;
 }
 

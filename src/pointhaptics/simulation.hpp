@@ -77,6 +77,14 @@ class Simulation {
   /// The object's points the probe holds (cleared first; allocates only to grow).
   void grabbed_points(std::vector<index_t>& out) const;
 
+  /// A scripted blade from now on (a scene's [[cut]]): every dynamic step first cuts where the trail its edge has
+  /// swept by the end of the step crosses the object (so material that moved back over the trail is cut too);
+  /// a static solve first cuts its whole sweep. Throws Error with levels of detail.
+  void add_scripted_cut(const CutSpec& cut);
+  /// Cut now, between steps, where `sweep` crosses the object at its current positions (ModelSimulation::cut).
+  /// Throws Error with levels of detail (not yet: a cut in the active set would not reach the object).
+  CutReport cut(const BladeSweep& sweep);
+
   /// Levels of detail (seed §3): from now on simulate only the points selected around `contact` (the
   /// reference configuration, m; snapped to the nearest point of the object). Throws Error on bad
   /// parameters, or if they are on already.
@@ -107,6 +115,12 @@ class Simulation {
 
   std::unique_ptr<ModelSimulation> object_;  ///< without levels of detail
   std::unique_ptr<LevelsOfDetail> lod_;      ///< with them (then object_ is empty)
+  struct ScriptedCut {
+    CutSpec spec;
+    double done = 0;  ///< the share of its sweep already cut
+  };
+  std::vector<ScriptedCut> scripted_cuts_;
+  void apply_scripted_cuts();
 };
 
 }  // namespace pointhaptics

@@ -476,6 +476,27 @@ TEST(SceneToml, ReadsRefineRegionsAndNamesTheirErrors) {
             std::string::npos);
 }
 
+TEST(SceneToml, ReadsScriptedCutsAndNamesTheirErrors) {
+  const std::string cut = "\n[[cut]]\nedge = [[0.02, 0.05, -0.01], [0.02, 0.05, 0.05]]\nto = [[0.02, -0.01, -0.01], [0.02, -0.01, 0.05]]\n"
+                          "start = 0.1\nduration = 0.05\n";
+  const std::string text = std::string(full_scene) + cut;
+  const Scene s = parse_scene(text, "t.toml", ".");
+  ASSERT_EQ(s.cuts.size(), 1u);
+  EXPECT_DOUBLE_EQ(s.cuts[0].edge[1].z(), 0.05);
+  EXPECT_DOUBLE_EQ(s.cuts[0].to[0].y(), -0.01);
+  EXPECT_DOUBLE_EQ(s.cuts[0].start, 0.1);
+  EXPECT_DOUBLE_EQ(s.cuts[0].duration, 0.05);
+  EXPECT_NE(error_of("to = [[0.02, -0.01, -0.01], [0.02, -0.01, 0.05]]", "", text).find("cut[0].to: a [[cut]] needs edge"),
+            std::string::npos);
+  EXPECT_NE(error_of("to = [[0.02, -0.01, -0.01], [0.02, -0.01, 0.05]]", "to = [[0.02, -0.01, -0.01]]", text).find("cut[0].to"),
+            std::string::npos);
+  EXPECT_NE(error_of("[0.02, 0.05, 0.05]]", "[0.02, 0.05, -0.01]]", text).find("zero length"), std::string::npos);
+  EXPECT_NE(error_of("duration = 0.05", "duration = -1", text).find("cut[0].duration: -1 is out of range"), std::string::npos);
+  EXPECT_NE(error_of("start = 0.1", "start = 0.1\nspeed = 2", text).find("cut[0].speed: unknown key"), std::string::npos);
+  EXPECT_NE(error_of("[solver]", "[lod]\nk1 = 1.5\ncontact = [0.0, 0.0, 0.0]\n[solver]", text).find("cut: not yet with levels of detail"),
+            std::string::npos);
+}
+
 std::string probe_error(const std::string& find, const std::string& replace) {
   return error_of(find, replace, std::string(full_scene) + probe_section);
 }

@@ -10,6 +10,7 @@ struct ModelDiagnostics {
   double min_neighbours = 0;                    ///< fewest neighbours of any point
   double mean_neighbours = 0;                   ///< average neighbours per point
   double worst_condition = 0;                   ///< largest cond(M_i) before regularisation
+  std::int64_t severed_pairs = 0;               ///< neighbour pairs cut so far (mechanics/cut.hpp)
 };
 
 }  // namespace pointhaptics

@@ -51,6 +51,9 @@ struct Model {
   // per-pair data, aligned with neighbours.index
   Points d;                         ///< d_ij = M_i^-1 X_ij w_ij, 1/m  (3 x n_pairs), seed Eq. 10-11
   Eigen::VectorXd hg_coef;          ///< k_ij = (alpha E / 2) (v_i w^_ij + v_j w^_ji) / |X_ij|^2, symmetric, N/m  (n_pairs)
+  /// 1 where a cut severed the pair (mechanics/cut.hpp): it stays in the lists, with d_ij = 0 and k_ij = 0, so
+  /// it carries nothing; empty while nothing was cut  (n_pairs)
+  std::vector<std::uint8_t> severed;
   // per-point data
   Points d_self;                    ///< d_ii = -sum_j d_ij, 1/m  (3 x n)
   Eigen::VectorXd hg_diagonal;      ///< diagonal of the (constant) hourglass Hessian per point, N/m  (n)

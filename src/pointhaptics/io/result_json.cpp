@@ -76,6 +76,14 @@ std::string result_json(const Model& model, const State& state, const RunSummary
                    {"torque", vec(t.torque)}, {"contacts", t.contacts},       {"penetration", t.penetration},
                    {"friction", vec(t.friction)}};
   }
+  if (s.cut.present) {
+    const CutSummary& c = s.cut;
+    doc["cut"] = {{"sweeps", c.sweeps},
+                  {"cut_pairs", c.cut_pairs},
+                  {"max_update_ms", c.max_update_ms},
+                  {"pieces", c.piece_points.size()},
+                  {"piece_points", c.piece_points}};
+  }
   // without levels of detail every point is simulated
   const LodSummary& l = s.lod;
   doc["lod"] = {{"enabled", l.enabled},
@@ -98,7 +106,8 @@ std::string result_json(const Model& model, const State& state, const RunSummary
                   {"mean_neighbours", d.mean_neighbours},
                   {"min_neighbours", d.min_neighbours},
                   {"regularised_neighbourhoods", d.regularised_neighbourhoods},
-                  {"isolated_points", d.isolated_points}};
+                  {"isolated_points", d.isolated_points},
+                  {"severed_pairs", d.severed_pairs}};
   return doc.dump(1);
 }
 

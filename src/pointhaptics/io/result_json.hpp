@@ -23,6 +23,15 @@ struct LodSummary {
                                         ///< build when made in place, the take-over when built on a worker)
 };
 
+/// Cuts in a run (issue 18): absent without.
+struct CutSummary {
+  bool present = false;
+  long long sweeps = 0;              ///< blade sweeps applied
+  long long cut_pairs = 0;           ///< neighbour pairs severed in all
+  double max_update_ms = 0;          ///< the longest sweep's update (refit, stable step, solver), ms
+  std::vector<index_t> piece_points; ///< points per connected piece, in the order of their lowest point
+};
+
 /// What a run reports besides the points: solver outcome, energies, timing, support reactions.
 /// A run's tool (issue 16): what the object does to it at the end.
 struct ToolSummary {
@@ -79,6 +88,7 @@ struct RunSummary {
   LocalModelSummary local_model;
   LodSummary lod;
   ToolSummary tool;
+  CutSummary cut;
 };
 
 /// The result document as a string (indented JSON).

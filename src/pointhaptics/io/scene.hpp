@@ -160,6 +160,16 @@ struct LodSpec {
   int line = 0;
 };
 
+/// [[cut]]: a scripted blade (issue 18). Its cutting edge, the segment edge[0]-edge[1] at `start`, moves
+/// linearly to to[0]-to[1] over `duration`, and cuts the object where it passes (mechanics/cut.hpp).
+struct CutSpec {
+  std::array<Vec3, 2> edge{Vec3::Zero(), Vec3::Zero()};  ///< m, scene axes
+  std::array<Vec3, 2> to{Vec3::Zero(), Vec3::Zero()};    ///< m, scene axes
+  double start = 0;     ///< s
+  double duration = 0;  ///< s (0: the whole sweep at once, at `start`)
+  int line = 0;
+};
+
 struct Scene {
   std::string path;  ///< the scene file ("<string>" when parsed from text), for messages
   ObjectSpec object;
@@ -169,6 +179,7 @@ struct Scene {
   std::vector<RegionSpec> regions;
   std::vector<RefineSpec> refine;
   std::vector<LoadSpec> loads;
+  std::vector<CutSpec> cuts;
   SolverSpec solver;
   ProbeSpec probe;
   DeviceSpec device;

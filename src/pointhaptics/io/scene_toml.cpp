@@ -474,6 +474,25 @@ RefineSpec read_refine(TableReader& r, const ObjectSpec& object) {
   return f;
 }
 
+CutSpec read_cut(TableReader& r) {
+  CutSpec c;
+  c.line = r.line();
+  auto segment = [&](std::string_view key) {
+    const toml::node* node = r.find(key);
+    const toml::array* ends = node ? node->as_array() : nullptr;
+    if (!ends || ends->size() != 2)
+      r.fail_table(key, "a [[cut]] needs edge = [[x, y, z], [x, y, z]] (the blade's edge, m) and to = [[x, y, z], [x, y, z]] (where it ends)");
+    return std::array<Vec3, 2>{r.as_vec3(*ends->get(0), key), r.as_vec3(*ends->get(1), key)};
+  };
+  c.edge = segment("edge");
+  c.to = segment("to");
+  if ((c.edge[1] - c.edge[0]).norm() == 0 || (c.to[1] - c.to[0]).norm() == 0)
+    r.fail_table("edge", "the blade's edge has zero length (its two ends coincide)");
+  c.start = r.number("start", c.start, [](double t) { return t >= 0; }, "must be >= 0 (s)");
+  c.duration = r.number("duration", c.duration, [](double t) { return t >= 0; }, "must be >= 0 (s)");
+  return c;
+}
+
 LoadSpec read_load(TableReader& r) {
   LoadSpec l;
   l.line = r.line();
@@ -688,6 +707,10 @@ Scene parse_scene(std::string_view text, const std::string& name, const std::str
   read_array_of_tables(top, "fixed", [&](TableReader& r) { scene.fixed.push_back(read_fixed(r)); });
   read_array_of_tables(top, "region", [&](TableReader& r) { scene.regions.push_back(read_region(r)); });
   read_array_of_tables(top, "load", [&](TableReader& r) { scene.loads.push_back(read_load(r)); });
+  read_array_of_tables(top, "cut", [&](TableReader& r) { scene.cuts.push_back(read_cut(r)); });
+  if (!scene.cuts.empty() && scene.lod.present)
+    throw Error(fmt::format("{}:{}: cut: not yet with levels of detail (a cut in the active set does not reach the object)", name,
+                            scene.cuts.front().line));
   read_array_of_tables(top, "refine", [&](TableReader& r) { scene.refine.push_back(read_refine(r, scene.object)); });
   if (!scene.refine.empty() && scene.lod.present)
     throw Error(fmt::format("{}:{}: refine: not yet with levels of detail ([lod] thins a uniform sampling)", name, scene.refine.front().line));

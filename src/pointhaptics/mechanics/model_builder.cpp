@@ -4,8 +4,8 @@
 #include <pointhaptics/geometry/neighbour_search.hpp>
 #include <pointhaptics/mechanics/energies/hourglass.hpp>
 #include <pointhaptics/mechanics/kernels.hpp>
+#include <pointhaptics/mechanics/stencil.hpp>
 
-#include <Eigen/Eigenvalues>
 #include <fmt/format.h>
 #include <oneapi/tbb/parallel_for.h>
 
@@ -109,10 +109,9 @@ Model build_model(const PointCloud& cloud, const MaterialParams& material, const
   std::atomic<std::int64_t> coincident{-1};
   tbb::parallel_for(index_t{0}, n, [&](index_t i) {
     for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
-      const double r = (model.X.col(nbr.index[e]) - model.X.col(i)).norm();
-      if (r <= 1e-9 * h) coincident = i;
+      if ((model.X.col(nbr.index[e]) - model.X.col(i)).norm() <= 1e-9 * h) coincident = i;
       // with per-point supports the stencil of i uses its own h_i (zero weight for the pairs only j reaches)
-      w[e] = kernel_value(kernel.type, r, per_point ? cloud.support[i] : h);
+      w[e] = pair_weight(model, i, e);
     }
   });
   if (coincident >= 0) {
@@ -164,41 +163,12 @@ Model build_model(const PointCloud& cloud, const MaterialParams& material, const
   std::vector<double> condition(n, 0.0), weight_sum(n, 0.0);
   std::vector<unsigned char> regularised(n, 0);
   tbb::parallel_for(index_t{0}, n, [&](index_t i) {
-    Mat3 M = Mat3::Zero();
-    double w_sum = 0;
-    for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
-      const Vec3 xij = model.X.col(nbr.index[e]) - model.X.col(i);
-      M.noalias() += w[e] * xij * xij.transpose();
-      w_sum += w[e];
-    }
-    Mat3 M_inv = Mat3::Zero();
-    const double trace = M.trace();
-    if (trace > 0) {
-      Eigen::SelfAdjointEigenSolver<Mat3> eig;
-      eig.computeDirect(M, Eigen::EigenvaluesOnly);
-      const double lo = std::max(eig.eigenvalues()[0], 0.0), hi = eig.eigenvalues()[2];
-      condition[i] = lo > 0 ? hi / lo : std::numeric_limits<double>::infinity();
-      if (condition[i] > max_moment_condition) {
-        // too few or coplanar neighbours: regularise so that cond(M) stays near 1e3
-        M += 1e-3 * trace * Mat3::Identity();
-        regularised[i] = 1;
-      }
-      M_inv = M.inverse();
-    } else {
-      regularised[i] = 1;  // isolated: G_i = 0, the point feels no elastic force
-      condition[i] = std::numeric_limits<double>::infinity();
-    }
-    Vec3 d_sum = Vec3::Zero();
-    for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
-      const Vec3 xij = model.X.col(nbr.index[e]) - model.X.col(i);
-      const Vec3 dij = M_inv * xij * w[e];
-      model.d.col(e) = dij;
-      d_sum += dij;
-    }
-    model.d_self.col(i) = -d_sum;
-    weight_sum[i] = w_sum;
+    const StencilFit fit = fit_stencil(model, i, w.data() + nbr.begin(i));
+    condition[i] = fit.condition;
+    weight_sum[i] = fit.weight_sum;
+    regularised[i] = fit.regularised;
   });
-  build_hourglass(model, w, weight_sum);
+  build_hourglass(model, weight_sum);
 
   // diagnostics
   ModelDiagnostics& diag = model.diagnostics;
@@ -206,7 +176,7 @@ Model build_model(const PointCloud& cloud, const MaterialParams& material, const
   for (index_t i = 0; i < n; ++i) {
     min_nbr = std::min(min_nbr, nbr.row_size(i));
     diag.regularised_neighbourhoods += regularised[i];
-    diag.isolated_points += nbr.row_size(i) == 0;
+    diag.isolated_points += weight_sum[i] == 0;  // no neighbour that weighs: G_i = 0
     if (std::isfinite(condition[i])) diag.worst_condition = std::max(diag.worst_condition, condition[i]);
     else diag.worst_condition = std::numeric_limits<double>::infinity();
   }

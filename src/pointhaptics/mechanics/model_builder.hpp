@@ -2,14 +2,13 @@
 /// @file Building the static Model from a sampled body, a material and a kernel.
 #include <pointhaptics/core/model.hpp>
 #include <pointhaptics/core/point_cloud.hpp>
+#include <pointhaptics/mechanics/stencil.hpp>  // max_moment_condition
 
 #include <cstdint>
 #include <vector>
 
 namespace pointhaptics {
 
-/// Condition number of M_i above which the neighbourhood is regularised (M + eps tr(M) I).
-inline constexpr double max_moment_condition = 1e6;
 
 /// Build the model: h, neighbours, volumes and masses, M_i (seed Eq. 11) with its conditioning check,
 /// d_ij and d_ii (Eq. 10), and the hourglass coefficients. All points are free and unloaded; the

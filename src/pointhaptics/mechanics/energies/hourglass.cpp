@@ -1,6 +1,6 @@
 #include <pointhaptics/mechanics/energies/hourglass.hpp>
 
-#include <pointhaptics/mechanics/kernels.hpp>
+#include <pointhaptics/mechanics/stencil.hpp>
 
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/enumerable_thread_specific.h>
@@ -10,58 +10,78 @@
 
 namespace pointhaptics {
 
-void build_hourglass(Model& model, const Eigen::VectorXd& w, const std::vector<double>& weight_sum) {
+namespace {
+
+/// Scratch for one pair's weights over the points of its two stencils.
+struct PairWeights {
+  std::vector<double> weight;
+  std::vector<index_t> touched;
+};
+
+/// Adds sign x k_e (weight of u_m in r_e)^2 to diagonal[m] for every m pair e = (i, j) reaches (hourglass.hpp).
+void add_pair_diagonal(const Model& model, index_t i, index_t e, double sign, PairWeights& scratch, double* diagonal) {
+  const Csr& nbr = model.neighbours;
+  const index_t j = nbr.index[e];
+  const Vec3 xij = model.X.col(j) - model.X.col(i);
+  auto add = [&](index_t m, double value) {
+    if (scratch.weight[m] == 0.0) scratch.touched.push_back(m);
+    scratch.weight[m] += value;
+  };
+  add(j, 1.0);
+  add(i, -1.0);
+  for (index_t s : {i, j}) {  // the two gradients G_i and G_j
+    add(s, -0.5 * model.d_self.col(s).dot(xij));
+    for (index_t f = nbr.begin(s); f < nbr.end(s); ++f) add(nbr.index[f], -0.5 * model.d.col(f).dot(xij));
+  }
+  for (index_t m : scratch.touched) {
+    diagonal[m] += sign * model.hg_coef[e] * scratch.weight[m] * scratch.weight[m];
+    scratch.weight[m] = 0.0;
+  }
+  scratch.touched.clear();
+}
+
+}  // namespace
+
+double hourglass_coefficient(const Model& model, index_t i, index_t e, double weight_sum_i, double weight_sum_j) {
+  const index_t j = model.neighbours.index[e];
+  // each end's share carries its own Young's modulus (per-point materials): a stiff inclusion's pairs are stiff
+  auto share = [&](index_t p, double weight_sum) { return weight_sum > 0 ? model.young_at(p) * model.volume[p] / weight_sum : 0.0; };
+  const double r2 = (model.X.col(j) - model.X.col(i)).squaredNorm();
+  // w_ji from j's own support (equal to w_ij with one support for all), so that k_ij = k_ji
+  return 0.5 * model.material.hourglass *
+         (pair_weight(model, i, e) * share(i, weight_sum_i) + pair_weight(model, j, model.reverse_pair[e]) * share(j, weight_sum_j)) / r2;
+}
+
+void build_hourglass(Model& model, const std::vector<double>& weight_sum) {
   const Csr& nbr = model.neighbours;
   const index_t n = model.n_points;
-  // each end's share carries its own Young's modulus (per-point materials): a stiff inclusion's pairs are stiff
-  const double scale = 0.5 * model.material.hourglass;
-  auto share = [&](index_t i) { return weight_sum[i] > 0 ? model.young_at(i) * model.volume[i] / weight_sum[i] : 0.0; };
-  const bool per_point = model.support.size() == n;
-  for (index_t i = 0; i < n; ++i)
-    for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
-      const index_t j = nbr.index[e];
-      const double r2 = (model.X.col(j) - model.X.col(i)).squaredNorm();
-      // w_ji from j's own support (equal to w_ij with one support for all), so that k_ij = k_ji
-      const double w_ji = per_point ? kernel_value(model.kernel.type, std::sqrt(r2), model.support[j]) : w[e];
-      model.hg_coef[e] = scale * (w[e] * share(i) + w_ji * share(j)) / r2;
-    }
+  tbb::parallel_for(index_t{0}, n, [&](index_t i) {
+    for (index_t e = nbr.begin(i); e < nbr.end(i); ++e)
+      model.hg_coef[e] = hourglass_coefficient(model, i, e, weight_sum[i], weight_sum[nbr.index[e]]);
+  });
   model.hg_diagonal = Eigen::VectorXd::Zero(n);
   if (!(model.material.hourglass > 0)) return;
   // in parallel over stencils (it took a sixth of a 10^6-point set-up serially): each thread accumulates its
   // own diagonal, summed at the end (no atomics)
   struct Scratch {
-    std::vector<double> weight, diagonal;
-    std::vector<index_t> touched;
+    PairWeights pair;
+    std::vector<double> diagonal;
   };
-  tbb::enumerable_thread_specific<Scratch> scratch([n] { return Scratch{std::vector<double>(n, 0.0), std::vector<double>(n, 0.0), {}}; });
+  tbb::enumerable_thread_specific<Scratch> scratch([n] { return Scratch{{std::vector<double>(n, 0.0), {}}, std::vector<double>(n, 0.0)}; });
   tbb::parallel_for(tbb::blocked_range<index_t>(0, n, 2048), [&](const tbb::blocked_range<index_t>& range) {
     Scratch& local = scratch.local();
-    std::vector<double>& weight = local.weight;
-    std::vector<index_t>& touched = local.touched;
     for (index_t i = range.begin(); i != range.end(); ++i)
-      for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
-        const index_t j = nbr.index[e];
-        const Vec3 xij = model.X.col(j) - model.X.col(i);
-        auto add = [&](index_t m, double value) {
-          if (weight[m] == 0.0) touched.push_back(m);
-          weight[m] += value;
-        };
-        add(j, 1.0);
-        add(i, -1.0);
-        for (index_t s : {i, j}) {  // the two gradients G_i and G_j
-          add(s, -0.5 * model.d_self.col(s).dot(xij));
-          for (index_t f = nbr.begin(s); f < nbr.end(s); ++f) add(nbr.index[f], -0.5 * model.d.col(f).dot(xij));
-        }
-        for (index_t m : touched) {
-          local.diagonal[m] += model.hg_coef[e] * weight[m] * weight[m];
-          weight[m] = 0.0;
-        }
-        touched.clear();
-      }
+      for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) add_pair_diagonal(model, i, e, 1.0, local.pair, local.diagonal.data());
   });
   for (const Scratch& local : scratch)
     model.hg_diagonal += Eigen::Map<const Eigen::VectorXd>(local.diagonal.data(), n);
 }
 
+void add_hourglass_diagonal(const Model& model, const std::vector<std::pair<index_t, index_t>>& pairs, double sign,
+                            Eigen::VectorXd& diagonal) {
+  if (!(model.material.hourglass > 0)) return;
+  PairWeights scratch{std::vector<double>(model.n_points, 0.0), {}};
+  for (const auto& [i, e] : pairs) add_pair_diagonal(model, i, e, sign, scratch, diagonal.data());
+}
 
 }  // namespace pointhaptics

@@ -12,6 +12,7 @@
 /// -Q_i = -sum_j k_ij r_ij X_ij^T (then scattered through d_ij like the material's stress).
 #include <pointhaptics/core/model.hpp>
 
+#include <utility>
 #include <vector>
 
 namespace pointhaptics {
@@ -35,11 +36,21 @@ PH_ALWAYS_INLINE inline V hourglass_pair_force(double k, const V& du, const V& g
   return k * du - (g0 * (kh * x0) + g1 * (kh * x1) + g2 * (kh * x2));
 }
 
-/// The pair coefficients k_ij (model.hg_coef) from the kernel weights w (per pair) and their sums per point,
-/// and the exact diagonal of the constant Hessian (model.hg_diagonal). The weight of u_m in r_ij is
+/// k_ij of pair e = (i, j) (the formula above) from the kernel weights' sums of stencils i and j; zero for a
+/// severed pair.
+double hourglass_coefficient(const Model& model, index_t i, index_t e, double weight_sum_i, double weight_sum_j);
+
+/// The pair coefficients k_ij (model.hg_coef) from the sums of the stencils' kernel weights, and the exact
+/// diagonal of the constant Hessian (model.hg_diagonal). The weight of u_m in r_ij is
 ///   [m = j] - [m = i] - (a_im + a_jm) / 2,  a_im = d_im . X_ij (m in N(i)), a_ii = d_ii . X_ij,
 /// so diag_m = sum over pairs of k_ij (weight)^2, over the two stencils of each pair (O(pairs x stencil), in
-/// parallel on TBB's threads). Needs model.d, d_self, volume, X, kernel and material.
-void build_hourglass(Model& model, const Eigen::VectorXd& w, const std::vector<double>& weight_sum);
+/// parallel on TBB's threads). Needs model.d, d_self, volume, X, reverse_pair, kernel and material.
+void build_hourglass(Model& model, const std::vector<double>& weight_sum);
+
+/// Adds `sign` times the diagonal's terms of the given pairs (each (i, e), e = (i, j) in i's row) to `diagonal`,
+/// from the model's current d and k: a cut takes its changed pairs' terms out before it refits them and puts
+/// them back after.
+void add_hourglass_diagonal(const Model& model, const std::vector<std::pair<index_t, index_t>>& pairs, double sign,
+                            Eigen::VectorXd& diagonal);
 
 }  // namespace pointhaptics

@@ -1,0 +1,171 @@
+#include <pointhaptics/mechanics/cut.hpp>
+
+#include <pointhaptics/mechanics/energies/hourglass.hpp>
+#include <pointhaptics/mechanics/stencil.hpp>
+
+#include <algorithm>
+#include <array>
+#include <limits>
+#include <numeric>
+#include <optional>
+#include <utility>
+
+namespace pointhaptics {
+
+namespace {
+
+/// Where the segment p-q crosses triangle (a, b, c), if it does: p and q on different sides of its plane (a
+/// point on the plane is on the normal's side) and the crossing point inside the triangle or on its edges.
+std::optional<Vec3> segment_crossing(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 normal = (b - a).cross(c - a);
+  if (normal.squaredNorm() == 0) return std::nullopt;  // the blade moved along its own edge here: it sweeps nothing
+  const double sp = normal.dot(p - a), sq = normal.dot(q - a);
+  if ((sp >= 0) == (sq >= 0)) return std::nullopt;
+  const Vec3 crossing = p + (sp / (sp - sq)) * (q - p);
+  // inside: on the inner side of each edge (barycentric coordinates all non-negative), with a relative
+  // tolerance so that a crossing on the edge two triangles share, rounded either way, is in at least one
+  const double slack = -1e-9 * normal.squaredNorm();
+  if (normal.dot((b - a).cross(crossing - a)) >= slack && normal.dot((c - b).cross(crossing - b)) >= slack &&
+      normal.dot((a - c).cross(crossing - c)) >= slack)
+    return crossing;
+  return std::nullopt;
+}
+
+double distance_to_segment(const Vec3& p, const Vec3& a, const Vec3& b) {
+  const Vec3 ab = b - a;
+  const double t = ab.squaredNorm() > 0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
+  return (p - (a + t * ab)).norm();
+}
+
+/// The row (point i) pair e belongs to.
+index_t row_of(const Csr& nbr, index_t e) {
+  return static_cast<index_t>(std::upper_bound(nbr.offset.begin(), nbr.offset.end(), e) - nbr.offset.begin()) - 1;
+}
+
+double weight_sum_of(const Model& model, index_t i) {
+  double sum = 0;
+  for (index_t e = model.neighbours.begin(i); e < model.neighbours.end(i); ++e) sum += pair_weight(model, i, e);
+  return sum;
+}
+
+}  // namespace
+
+std::vector<index_t> pairs_crossing(const Model& model, const Points& x, const BladeSweep& sweep) {
+  const std::array<Vec3, 4> corners{sweep.a0, sweep.b0, sweep.a1, sweep.b1};
+  Vec3 lo = corners[0], hi = corners[0];
+  for (const Vec3& c : corners) {
+    lo = lo.cwiseMin(c);
+    hi = hi.cwiseMax(c);
+  }
+  // a crossing pair has both ends within its length of the sweep: twice the largest support covers pairs
+  // stretched to twice their reference length
+  const double reach = 2.0 * (model.support.size() ? model.support.maxCoeff() : model.h);
+  lo.array() -= reach;
+  hi.array() += reach;
+  auto inside = [&](index_t i) { return (x.col(i).array() >= lo.array()).all() && (x.col(i).array() <= hi.array()).all(); };
+  const Csr& nbr = model.neighbours;
+  std::vector<index_t> crossing;
+  for (index_t i = 0; i < model.n_points; ++i) {
+    if (!inside(i)) continue;
+    for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
+      const index_t j = nbr.index[e];
+      if (j < i || (!model.severed.empty() && model.severed[e])) continue;
+      const Vec3 p = x.col(i), q = x.col(j);
+      std::optional<Vec3> at = segment_crossing(p, q, sweep.a0, sweep.b0, sweep.b1);
+      if (!at) at = segment_crossing(p, q, sweep.a0, sweep.b1, sweep.a1);
+      if (at && (sweep.edge_reach == std::numeric_limits<double>::infinity() ||
+                 distance_to_segment(*at, sweep.a1, sweep.b1) <= sweep.edge_reach))
+        crossing.push_back(e);
+    }
+  }
+  return crossing;
+}
+
+CutReport sever_pairs(Model& model, const std::vector<index_t>& pairs) {
+  const Csr& nbr = model.neighbours;
+  if (model.severed.empty()) model.severed.assign(static_cast<std::size_t>(model.n_pairs()), 0);
+  CutReport report;
+  // the pairs to sever (both directions) and the stencils that lose them
+  std::vector<index_t> newly, stencils;
+  for (const index_t e : pairs) {
+    if (model.severed[e]) continue;
+    const index_t i = row_of(nbr, e), j = nbr.index[e];
+    newly.push_back(e);
+    newly.push_back(model.reverse_pair[e]);
+    stencils.push_back(i);
+    stencils.push_back(j);
+  }
+  std::sort(newly.begin(), newly.end());
+  newly.erase(std::unique(newly.begin(), newly.end()), newly.end());
+  if (newly.empty()) return report;
+  std::sort(stencils.begin(), stencils.end());
+  stencils.erase(std::unique(stencils.begin(), stencils.end()), stencils.end());
+  // the pairs whose hourglass terms change: those of the refitted stencils (d changes) and their reverses (k
+  // changes with the stencil's weight sum)
+  std::vector<std::pair<index_t, index_t>> changed;
+  for (const index_t i : stencils)
+    for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
+      changed.emplace_back(i, e);
+      changed.emplace_back(nbr.index[e], model.reverse_pair[e]);
+    }
+  std::sort(changed.begin(), changed.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
+  changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
+
+  add_hourglass_diagonal(model, changed, -1.0, model.hg_diagonal);
+  ModelDiagnostics& diag = model.diagnostics;
+  std::vector<double> w;
+  auto row_weights = [&](index_t i) {
+    w.resize(static_cast<std::size_t>(nbr.row_size(i)));
+    for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) w[e - nbr.begin(i)] = pair_weight(model, i, e);
+    return w.data();
+  };
+  for (const index_t i : stencils) {
+    const StencilFit before = assess_stencil(model, i, row_weights(i));
+    diag.regularised_neighbourhoods -= before.regularised;
+    diag.isolated_points -= before.weight_sum == 0;
+  }
+  for (const index_t e : newly) model.severed[e] = 1;
+  report.severed_pairs = static_cast<index_t>(newly.size() / 2);
+  diag.severed_pairs += report.severed_pairs;
+  for (const index_t i : stencils) {
+    const StencilFit after = fit_stencil(model, i, row_weights(i));
+    diag.regularised_neighbourhoods += after.regularised;
+    diag.isolated_points += after.weight_sum == 0;
+    report.regularised += after.regularised;
+  }
+  report.refitted_stencils = static_cast<index_t>(stencils.size());
+  for (const auto& [i, e] : changed)
+    model.hg_coef[e] = hourglass_coefficient(model, i, e, weight_sum_of(model, i), weight_sum_of(model, nbr.index[e]));
+  add_hourglass_diagonal(model, changed, 1.0, model.hg_diagonal);
+  return report;
+}
+
+CutReport cut(Model& model, const Points& x, const BladeSweep& sweep) { return sever_pairs(model, pairs_crossing(model, x, sweep)); }
+
+index_t connected_pieces(const Model& model, std::vector<index_t>& piece_of) {
+  const Csr& nbr = model.neighbours;
+  const index_t n = model.n_points;
+  // union-find over the unsevered pairs, the smaller root kept so that pieces number by their lowest point
+  std::vector<index_t> parent(static_cast<std::size_t>(n));
+  std::iota(parent.begin(), parent.end(), index_t{0});
+  auto find = [&](index_t i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  for (index_t i = 0; i < n; ++i)
+    for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
+      if (!model.severed.empty() && model.severed[e]) continue;
+      const index_t a = find(i), b = find(nbr.index[e]);
+      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    }
+  piece_of.assign(static_cast<std::size_t>(n), -1);
+  index_t count = 0;
+  for (index_t i = 0; i < n; ++i) {
+    const index_t root = find(i);
+    if (piece_of[root] < 0) piece_of[root] = count++;
+    piece_of[i] = piece_of[root];
+  }
+  return count;
+}
+
+}  // namespace pointhaptics

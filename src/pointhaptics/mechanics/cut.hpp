@@ -1,0 +1,52 @@
+#pragma once
+/// @file Cutting without a mesh (issue 18): a blade's swept surface severs the neighbour pairs whose segment it
+/// crosses (the visibility criterion of Pauly et al. 2005, as Mueller et al. 2004 cut point-based objects), and
+/// only the stencils that lost pairs are refitted.
+///
+/// A severed pair stays in the neighbour lists with w_ij = 0, hence d_ij = 0 and k_ij = 0: it carries no force
+/// and no stiffness, every sparsity pattern built on the lists (the tangent, its factorisation's analysis)
+/// stays valid, and the forces remain the exact gradient of the cut object's energy. A cut removes no
+/// material: volumes and masses stay.
+#include <pointhaptics/core/model.hpp>
+
+#include <limits>
+#include <vector>
+
+namespace pointhaptics {
+
+/// A blade's cutting edge, the segment a0-b0, moved to a1-b1: it sweeps the triangles (a0, b0, b1) and
+/// (a0, b1, a1).
+struct BladeSweep {
+  Vec3 a0 = Vec3::Zero(), b0 = Vec3::Zero(), a1 = Vec3::Zero(), b1 = Vec3::Zero();
+  /// Only crossings within this distance of the edge's last pose a1-b1 cut, m (infinity: anywhere on the
+  /// sweep). A blade cuts at its edge: with a trail swept over many steps, material that later moves across
+  /// the trail far behind the edge (where the blade's body would stand in its way) is not cut.
+  double edge_reach = std::numeric_limits<double>::infinity();
+};
+
+/// The pairs e = (i, j), i < j, not yet severed, whose segment between the points' positions `x` (3 x n: the
+/// current positions, X + u) crosses the swept surface. A point exactly on it counts as on the side its normal
+/// points to, so a blade through a lattice plane severs each pair once.
+std::vector<index_t> pairs_crossing(const Model& model, const Points& x, const BladeSweep& sweep);
+
+/// What one cut changed.
+struct CutReport {
+  index_t severed_pairs = 0;      ///< pairs newly severed (a pair and its reverse count once)
+  index_t refitted_stencils = 0;  ///< stencils that lost pairs and were refitted
+  index_t regularised = 0;        ///< of those, the ones left one-sided or too thin, hence regularised
+};
+
+/// Sever the pairs `pairs` (each given in either direction; severed ones are skipped) and refit what depends
+/// on them: the stencils that lost pairs (M_i, d_ij, d_ii), the hourglass coefficients of their pairs and of
+/// the pairs' reverses, the hourglass diagonal's terms of those pairs, and the diagnostics
+/// (regularised_neighbourhoods, isolated_points, severed_pairs). Cost: the affected rows, not the model.
+CutReport sever_pairs(Model& model, const std::vector<index_t>& pairs);
+
+/// sever_pairs(model, pairs_crossing(model, x, sweep)).
+CutReport cut(Model& model, const Points& x, const BladeSweep& sweep);
+
+/// The object's connected pieces over its unsevered pairs: piece_of[i] in [0, count), numbered in the order of
+/// their lowest point. Returns count. A cut all the way through makes more than one.
+index_t connected_pieces(const Model& model, std::vector<index_t>& piece_of);
+
+}  // namespace pointhaptics
