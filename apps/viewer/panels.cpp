@@ -102,10 +102,24 @@ bool parameter_panels(Scene& s) {
       s.probe.radius = r_mm * 1e-3;
       changed = true;
     }
-    int mode = s.probe.grab ? 1 : 0;
-    if (ImGui::Combo("mode", &mode, "push (button grabs)\0grab only\0")) {
+    int mode = s.probe.cut ? 2 : s.probe.grab ? 1 : 0;
+    if (ImGui::Combo("mode", &mode, "push (button grabs)\0grab only\0blade (button cuts)\0")) {
       s.probe.grab = mode == 1;
+      s.probe.cut = mode == 2;
+      // a blade is a capsule whose axis is its edge: four radii long unless the scene gave one
+      if (s.probe.cut && !s.probe.capsule) {
+        s.probe.capsule = true;
+        s.probe.length = 4 * s.probe.radius;
+      }
       changed = true;
+    }
+    if (s.probe.cut) {
+      double length_mm = s.probe.length * 1e3;
+      if (slider("blade length (mm)", length_mm, 1.0, 200.0, "%.3g", true)) {
+        s.probe.length = length_mm * 1e-3;
+        changed = true;
+      }
+      if (slider("cut resistance (J/m^2)", s.probe.cut_resistance, 0.0, 5000.0, "%.0f", false)) changed = true;
     }
   }
   return changed;

@@ -113,8 +113,9 @@ std::unique_ptr<Prepared> prepare(const Scene& scene_in, ProbeSource source, int
       p->surface_point[static_cast<std::size_t>(v)] = map.points.index[heaviest];
     }
   }
-  // the mouse pushes, and grabs while its button is held; a scene's grab mode grabs only
-  if (!scene.probe.grab) p->options.probe.mode = ProbeMode::PUSH_GRAB;
+  // the mouse pushes, and grabs while its button is held; a scene's grab mode grabs only, its blade cuts while
+  // the button is held
+  if (!scene.probe.grab && !scene.probe.cut) p->options.probe.mode = ProbeMode::PUSH_GRAB;
   p->options.duration = std::numeric_limits<double>::infinity();
   p->options.log = false;
   p->options.real_time = true;

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 namespace pointhaptics {
 
@@ -46,8 +47,11 @@ CutReport ModelSimulation::cut(const BladeSweep& sweep) {
   const auto start = std::chrono::steady_clock::now();
   const CutReport report = pointhaptics::cut(model_, model_.X + state_.u, sweep);
   if (report.severed_pairs > 0) {
-    // implicit and static steps do not depend on it: they keep the uncut model's as their report
-    if (solver_.kind == SolverKind::EXPLICIT) stable_dt_ = stable_time_step(model_, 0.8, 20, n_threads_);
+    // a one-sided or thin stencil can be stiffer than a whole one: Lanczos started on the cut's points finds
+    // the modes the cut made in a few steps (elsewhere the model is as it was); implicit and static steps do
+    // not depend on the stable step
+    if (solver_.kind == SolverKind::EXPLICIT)
+      stable_dt_ = std::min(stable_dt_, stable_time_step(model_, 0.8, cut_lanczos_steps, n_threads_, report.cut_points));
     solver_impl_ = make_solver(model_, solver_, stable_dt_);
   }
   ++diagnostics_.cuts;
@@ -82,7 +86,23 @@ const StepReport& ModelSimulation::step() {
 }
 
 void ModelSimulation::place_tools() {
-  if (probe_) probe_->tool.place(model_, state_, inputs_.device, inputs_.button, inputs_.orientation);
+  if (!probe_) return;
+  ProbeTool& tool = probe_->tool;
+  tool.place(model_, state_, inputs_.device, inputs_.button, inputs_.orientation);
+  // a blade with its button held cuts the strips its edge swept over its last steps (ProbeTool::blade_trail;
+  // nothing on the step a cut starts)
+  if (tool.cutting()) {
+    const std::vector<std::array<Vec3, 2>>& trail = tool.blade_trail();
+    const std::array<Vec3, 2> edge = tool.blade_edge();
+    CutReport report;
+    for (std::size_t k = 0; k < trail.size(); ++k) {
+      const std::array<Vec3, 2>& to = k + 1 < trail.size() ? trail[k + 1] : edge;
+      CutReport strip = cut(BladeSweep{trail[k][0], trail[k][1], to[0], to[1]});
+      report.severed_pairs += strip.severed_pairs;
+      report.cut_points.insert(report.cut_points.end(), strip.cut_points.begin(), strip.cut_points.end());
+    }
+    tool.resist_cut(model_, report, solver_.dt);
+  }
 }
 
 void ModelSimulation::check_finite(StepReport& report) const {

@@ -81,7 +81,8 @@ std::unique_ptr<Device> make_scene_device(const Scene& scene) {
 InteractiveOptions scene_interactive_options(const Scene& scene, const Model& model) {
   InteractiveOptions o;
   o.probe.radius = scene.probe.radius;
-  o.probe.mode = scene.probe.grab ? ProbeMode::GRAB : ProbeMode::PUSH;
+  o.probe.mode = scene.probe.grab ? ProbeMode::GRAB : scene.probe.cut ? ProbeMode::CUT : ProbeMode::PUSH;
+  o.probe.cut_resistance = scene.probe.cut_resistance;
   o.probe.stiffness = scene.probe.stiffness;
   o.probe.object_stiffness = scene.probe.object_stiffness;
   o.probe.friction = scene.probe.friction;

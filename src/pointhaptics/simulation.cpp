@@ -94,6 +94,10 @@ void Simulation::attach_probe(const ProbeParams& params, double coupling_stiffne
                               std::shared_ptr<const ObjectSurface> surface) {
   ModelSimulation& sim = core();
   if (sim.solver().kind == SolverKind::STATIC) throw Error("probe: needs a dynamic solver (explicit or implicit)");
+  if (params.mode == ProbeMode::CUT && lod_)
+    throw Error("probe: a blade does not cut with levels of detail yet (a cut in the active set does not reach the object)");
+  if (params.mode == ProbeMode::CUT && !(params.length > 0))
+    throw Error("probe: a blade is a capsule whose axis is its edge: give it a length");
   if (sim.held_tool()) throw Error("probe: the simulation already holds a tool (one tool at a time)");
   SurfaceContactParams contact;
   // the contact no stiffer on a point than the point spheres' springs were (E x spacing): explicit steps keep

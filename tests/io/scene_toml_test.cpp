@@ -501,6 +501,22 @@ std::string probe_error(const std::string& find, const std::string& replace) {
   return error_of(find, replace, std::string(full_scene) + probe_section);
 }
 
+TEST(SceneToml, ABladeIsACapsuleThatCutsAndNamesItsErrors) {
+  std::string blade = std::string(full_scene) + probe_section;
+  blade.replace(blade.find("mode = \"grab\""), 13, "mode = \"cut\"\nshape = \"capsule\"\nlength = 0.04\ncut_resistance = 200");
+  const Scene s = parse_scene(blade, "t.toml", ".");
+  EXPECT_TRUE(s.probe.cut);
+  EXPECT_FALSE(s.probe.grab);
+  EXPECT_DOUBLE_EQ(s.probe.cut_resistance, 200);
+  EXPECT_NE(error_of("shape = \"capsule\"\nlength = 0.04\n", "", blade).find("probe.shape: a blade (mode = \"cut\") is a capsule"),
+            std::string::npos);
+  EXPECT_NE(error_of("cut_resistance = 200", "cut_resistance = -1", blade).find("probe.cut_resistance: -1 is out of range"),
+            std::string::npos);
+  EXPECT_NE(probe_error("mode = \"grab\"", "mode = \"grab\"\ncut_resistance = 5").find("only a blade cuts"), std::string::npos);
+  EXPECT_NE(error_of("[solver]", "[lod]\nk1 = 1.5\n[solver]", blade).find("a blade does not cut with levels of detail"),
+            std::string::npos);
+}
+
 TEST(SceneToml, ADevicesProbeHasFrictionButNotOnThePointSpheresOfLevelsOfDetail) {
   std::string with_friction = std::string(full_scene) + probe_section;
   with_friction.replace(with_friction.find("radius = 0.01"), 13, "radius = 0.01\nfriction = 0.3");

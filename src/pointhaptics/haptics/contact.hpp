@@ -11,7 +11,10 @@
 namespace pointhaptics {
 
 /// PUSH_GRAB: pushes while the button is up and grabs while it is held (a viewer's mouse probe).
-enum class ProbeMode { PUSH, GRAB, PUSH_GRAB };
+/// CUT: the tool is a blade, its capsule axis the cutting edge: while the button is held it passes through the
+/// object and cuts where its edge sweeps (mechanics/cut.hpp), and the hand feels the cutting resistance; while
+/// it is up it pushes.
+enum class ProbeMode { PUSH, GRAB, PUSH_GRAB, CUT };
 
 struct ProbeParams {
   double radius = 0.005;        ///< probe sphere, m
@@ -29,6 +32,9 @@ struct ProbeParams {
   /// against 0.97 ms) and took it out of real time, for a local model that strays 1.5 mN from the next
   /// update where the contact's own strays 2.6 mN (docs/haptics.md).
   bool object_stiffness = false;
+  /// CUT: the work of cutting per unit of new cut area, J/m^2 (N/m): the hand feels it as a force against the
+  /// edge's motion, this times the new area over the distance moved (0: the blade cuts freely)
+  double cut_resistance = 0;
 };
 
 /// The force the object exerts on the probe near p0, linearised: F(p) = f0 + K (p - p0).

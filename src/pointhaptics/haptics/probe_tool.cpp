@@ -9,11 +9,45 @@ namespace pointhaptics {
 ProbeTool::ProbeTool(const Model& model, const ProbeParams& params, double coupling_stiffness, double max_force,
                      std::optional<SurfaceContact> surface)
     : contact_(model, params), surface_(std::move(surface)), k_(coupling_stiffness), max_force_(max_force),
-      scratch_(Points::Zero(3, model.n_points)), compliance_solver_(model) {}
+      scratch_(Points::Zero(3, model.n_points)), compliance_solver_(model) {
+  trail_.reserve(blade_trail_steps);
+}
 
 bool ProbeTool::pushing_surface() const {
   const ProbeMode mode = contact_.params().mode;
-  return surface_ && (mode == ProbeMode::PUSH || (mode == ProbeMode::PUSH_GRAB && !button_));
+  return surface_ && (mode == ProbeMode::PUSH || ((mode == ProbeMode::PUSH_GRAB || mode == ProbeMode::CUT) && !button_));
+}
+
+std::array<Vec3, 2> ProbeTool::blade_edge() const {
+  const Vec3 half = orientation_ * Vec3(0, 0, 0.5 * contact_.params().length);
+  return {probe_ - half, probe_ + half};
+}
+
+void ProbeTool::resist_cut(const Model& model, const CutReport& report, double dt) {
+  const std::array<Vec3, 2> edge = blade_edge();
+  Vec3 target = Vec3::Zero();
+  if (!trail_.empty()) {
+    const std::array<Vec3, 2>& last = trail_.back();
+    const Vec3 move = 0.5 * ((edge[0] - last[0]) + (edge[1] - last[1]));
+    // the new area per distance over the last spacing of travel (the oldest step dropped once the rest cover it)
+    cut_history_.push_back({move.norm(), cut_area(model, report.severed_pairs)});
+    double travel = 0, area = 0;
+    for (const auto& [d, a] : cut_history_) {
+      travel += d;
+      area += a;
+    }
+    while (cut_history_.size() > 1 && travel - cut_history_.front()[0] >= model.spacing) {
+      travel -= cut_history_.front()[0];
+      area -= cut_history_.front()[1];
+      cut_history_.erase(cut_history_.begin());
+    }
+    // the work G dA done over the move: a force G dA / ds against it
+    if (move.norm() > 1e-12 && travel > 0) target = -contact_.params().cut_resistance * area / travel * move.normalized();
+  }
+  cut_force_ += std::min(1.0, dt / cut_smoothing) * (target - cut_force_);
+  if (!report.cut_points.empty()) cut_points_ = report.cut_points;
+  if (trail_.size() == blade_trail_steps) trail_.erase(trail_.begin());
+  trail_.push_back(edge);
 }
 
 double ProbeTool::max_point_stiffness() const {
@@ -48,9 +82,18 @@ Vec3 ProbeTool::stop_at_surface(const Model& model, const State& state, const Ve
 void ProbeTool::place(const Model& model, const State& state, const Vec3& device, bool button, const Eigen::Quaterniond& orientation) {
   device_ = device;
   button_ = button;
-  if (surface_) surface_->set_pose(ToolPose{surface_->pose().position, (orientation * contact_.params().orientation).normalized()});
+  orientation_ = (orientation * contact_.params().orientation).normalized();
+  if (surface_) surface_->set_pose(ToolPose{surface_->pose().position, orientation_});
   contacts_before_ = last_.contacts;
-  if (!device.allFinite()) {
+  if (!cutting()) {
+    // a cut ends when the button is let go: the next one sweeps from where it starts
+    trail_.clear();
+    cut_history_.clear();
+    cut_force_.setZero();
+    cut_points_.clear();
+  }
+  if (!device.allFinite() || (contact_.params().mode == ProbeMode::CUT && button)) {
+    // a blade cutting goes where the hand takes it (the resistance is what it feels)
     probe_ = device;
     return;
   }
@@ -76,6 +119,13 @@ void ProbeTool::place(const Model& model, const State& state, const Vec3& device
 }
 
 void ProbeTool::add(const Model& model, const State& state, Points& f) {
+  if (cutting()) {
+    // the blade pushes the points it parts along its move as hard as they resist it
+    for (const index_t p : cut_points_) f.col(p) -= cut_force_ / static_cast<double>(cut_points_.size());
+    last_ = ContactModel{state.time, probe_, cut_force_, Mat3::Zero(), static_cast<int>(cut_points_.size()), false};
+    held_K_.setZero();
+    return;
+  }
   if (!pushing_surface() || !probe_.allFinite()) {
     last_ = contact_.apply(model, state.u, probe_, button_, state.time, f);
     held_K_ = last_.K;

@@ -3,6 +3,7 @@
 /// contact forces act on the points at every (sub-)step the solver takes.
 #include <pointhaptics/haptics/contact.hpp>
 #include <pointhaptics/haptics/surface_contact.hpp>
+#include <pointhaptics/mechanics/cut.hpp>
 #include <pointhaptics/solvers/solver.hpp>
 
 #include <array>
@@ -39,6 +40,23 @@ class ProbeTool final : public DynamicForces {
   /// Pushing on the surface: the local contact model at the step's end state, for the haptic side, its
   /// stiffness through the object's compliance (compliance_stiffness()).
   void after_step(const Model& model, const State& state, Workspace& ws) override;
+
+  /// A blade (ProbeMode::CUT) with the button held: this step it cuts instead of touching.
+  bool cutting() const { return contact_.params().mode == ProbeMode::CUT && button_ && probe_.allFinite(); }
+  /// The blade's edge at the probe's pose (its capsule axis).
+  std::array<Vec3, 2> blade_edge() const;
+  /// Where the edge was at the last blade_trail_steps steps of this cut, oldest first (empty on its first
+  /// step). The step cuts the strips between them and blade_edge(): the material moves between steps, and a
+  /// pair that moved back over a strip the edge had passed would escape a blade that cut only its last strip
+  /// (a device's blade through the cantilever missed 6 of 169 pairs and left it whole).
+  const std::vector<std::array<Vec3, 2>>& blade_trail() const { return trail_; }
+  static constexpr std::size_t blade_trail_steps = 8;
+  /// This step's cut (ModelSimulation::place_tools): the hand feels cut_resistance times the new area
+  /// (cut_area()) per distance the edge moved, against its move. The area comes in whole pairs, a plane of
+  /// them at a time as the edge passes a plane of points, so it is taken over the last spacing of the edge's
+  /// travel, and the force low-passed over cut_smoothing seconds. The points of the severed pairs take the
+  /// opposite force. Remembers the edge.
+  void resist_cut(const Model& model, const CutReport& report, double dt);
 
   /// Whether the probe touches the object's surface (else the point spheres).
   bool on_surface() const { return surface_.has_value(); }
@@ -88,8 +106,15 @@ class ProbeTool final : public DynamicForces {
   /// penalty is E x spacing per point), and through; held back, the probe presses with the multipliers,
   /// which catch up with the coupling's force over the next steps.
   static constexpr double allowed_penetration = 0.1;
+  /// The time constant of the cutting resistance's low-pass, s (ten haptic ticks).
+  static constexpr double cut_smoothing = 0.01;
   ProbeContact contact_;
   std::optional<SurfaceContact> surface_;
+  Eigen::Quaterniond orientation_ = Eigen::Quaterniond::Identity();  ///< the tool's, the device's turn included
+  std::vector<std::array<Vec3, 2>> trail_;  ///< blade_trail()
+  Vec3 cut_force_ = Vec3::Zero();        ///< on the blade, N
+  std::vector<index_t> cut_points_;      ///< the points that take its opposite
+  std::vector<std::array<double, 2>> cut_history_;  ///< per step of this cut: the edge's travel, m, and the new area, m^2
   double k_, max_force_;
   Vec3 device_ = Vec3::Constant(NAN);
   Vec3 probe_ = Vec3::Constant(NAN);

@@ -123,6 +123,8 @@ struct ProbeSpec {
   bool present = false;
   double radius = 0.005;                   ///< m
   bool grab = false;                       ///< mode = "grab" (else push)
+  bool cut = false;                        ///< mode = "cut": a blade, its capsule axis the edge (ProbeMode::CUT)
+  double cut_resistance = 0;               ///< J/m^2: the work of cutting per unit of new cut area
   std::string trajectory;                  ///< virtual device: CSV of t, x, y, z[, button] (resolved path)
   std::vector<std::array<double, 5>> keyframes;  ///< or keyframes t, x, y, z, button
   Vec3 origin = Vec3::Constant(NAN);       ///< scene position of the device origin, m (NaN: above the object's centre)

@@ -523,7 +523,12 @@ void read_probe(TableReader& r, ProbeSpec& p, const Context& ctx) {
   p.present = true;
   p.line = r.line();
   p.radius = r.number("radius", p.radius, positive, "must be > 0 (m)");
-  p.grab = r.choice("mode", "push", {"push", "grab"}) == "grab";
+  const std::string mode = r.choice("mode", "push", {"push", "grab", "cut"});
+  p.grab = mode == "grab";
+  p.cut = mode == "cut";
+  p.cut_resistance = r.number("cut_resistance", p.cut_resistance, non_negative, "must be >= 0 (J/m^2)");
+  if (!p.cut && r.find("cut_resistance"))
+    r.fail_at(*r.find("cut_resistance"), "cut_resistance", "only a blade cuts (mode = \"cut\")");
   if (r.find("trajectory") && r.find("keyframes"))
     r.fail_at(*r.find("keyframes"), "keyframes", "give either trajectory (a CSV file) or keyframes, not both");
   if (r.find("trajectory")) p.trajectory = resolve(ctx, r.string("trajectory", ""));
@@ -547,6 +552,7 @@ void read_probe(TableReader& r, ProbeSpec& p, const Context& ctx) {
   p.length = r.number("length", p.length, non_negative, "must be >= 0 (m)");
   if (p.capsule && !(p.length > 0)) r.fail_table("length", "a capsule needs length > 0 (m): its axis segment");
   if (!p.capsule && r.find("length")) r.fail_at(*r.find("length"), "length", "only a capsule has a length (shape = \"capsule\")");
+  if (p.cut && !p.capsule) r.fail_table("shape", "a blade (mode = \"cut\") is a capsule whose axis is its edge: give shape = \"capsule\" and length");
   p.friction = r.number("friction", p.friction, [](double m) { return m >= 0 && m <= 10; }, "must be in [0, 10]");
   p.object_stiffness = r.choice("local_stiffness", "contact", {"contact", "object"}) == "object";
   if (r.find("position")) {
@@ -708,6 +714,11 @@ Scene parse_scene(std::string_view text, const std::string& name, const std::str
   read_array_of_tables(top, "region", [&](TableReader& r) { scene.regions.push_back(read_region(r)); });
   read_array_of_tables(top, "load", [&](TableReader& r) { scene.loads.push_back(read_load(r)); });
   read_array_of_tables(top, "cut", [&](TableReader& r) { scene.cuts.push_back(read_cut(r)); });
+  if (scene.probe.cut && scene.lod.present)
+    throw Error(fmt::format("{}:{}: probe.mode: a blade does not cut with levels of detail yet (a cut in the active set does not reach the object)",
+                            name, scene.probe.line));
+  if (scene.probe.cut && scene.probe.held())
+    throw Error(fmt::format("{}:{}: probe.mode: a blade cuts as the device moves it, not held at a position", name, scene.probe.line));
   if (!scene.cuts.empty() && scene.lod.present)
     throw Error(fmt::format("{}:{}: cut: not yet with levels of detail (a cut in the active set does not reach the object)", name,
                             scene.cuts.front().line));

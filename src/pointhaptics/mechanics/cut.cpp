@@ -5,7 +5,9 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <limits>
+#include <numbers>
 #include <numeric>
 #include <optional>
 #include <utility>
@@ -100,6 +102,7 @@ CutReport sever_pairs(Model& model, const std::vector<index_t>& pairs) {
   if (newly.empty()) return report;
   std::sort(stencils.begin(), stencils.end());
   stencils.erase(std::unique(stencils.begin(), stencils.end()), stencils.end());
+  report.cut_points = stencils;
   // the pairs whose hourglass terms change: those of the refitted stencils (d changes) and their reverses (k
   // changes with the stencil's weight sum)
   std::vector<std::pair<index_t, index_t>> changed;
@@ -138,6 +141,11 @@ CutReport sever_pairs(Model& model, const std::vector<index_t>& pairs) {
     model.hg_coef[e] = hourglass_coefficient(model, i, e, weight_sum_of(model, i), weight_sum_of(model, nbr.index[e]));
   add_hourglass_diagonal(model, changed, 1.0, model.hg_diagonal);
   return report;
+}
+
+double cut_area(const Model& model, index_t severed_pairs) {
+  const double s = model.spacing > 0 ? model.spacing : std::cbrt(model.volume.mean());
+  return static_cast<double>(severed_pairs) * 4.0 * std::pow(s, 6) / (std::numbers::pi * std::pow(model.h, 4));
 }
 
 CutReport cut(Model& model, const Points& x, const BladeSweep& sweep) { return sever_pairs(model, pairs_crossing(model, x, sweep)); }

@@ -29,12 +29,20 @@ struct BladeSweep {
 /// points to, so a blade through a lattice plane severs each pair once.
 std::vector<index_t> pairs_crossing(const Model& model, const Points& x, const BladeSweep& sweep);
 
+/// The area a number of severed pairs stands for, m^2: in a body of uniform point density rho = 1 / spacing^3
+/// and support h, a plane of area A is crossed by rho^2 A pi h^4 / 4 pairs (a point at distance z from it has
+/// rho pi (h - z)^2 (2h + z) / 3 neighbours beyond it; integrated over z in [0, h]). Counted from the pairs,
+/// the area steps by one pair's share (4 spacing^6 / (pi h^4)), fine against the blade's.
+double cut_area(const Model& model, index_t severed_pairs);
+
 /// What one cut changed.
 struct CutReport {
   index_t severed_pairs = 0;      ///< pairs newly severed (a pair and its reverse count once)
   index_t refitted_stencils = 0;  ///< stencils that lost pairs and were refitted
   index_t regularised = 0;        ///< of those, the ones left one-sided or too thin, hence regularised
+  std::vector<index_t> cut_points;  ///< the ends of the newly severed pairs, each once
 };
+
 
 /// Sever the pairs `pairs` (each given in either direction; severed ones are skipped) and refit what depends
 /// on them: the stencils that lost pairs (M_i, d_ij, d_ii), the hourglass coefficients of their pairs and of

@@ -32,22 +32,27 @@ double estimated_stable_time_step(const Model& model, double safety) {
   return safety * a / std::sqrt(modulus / rho);
 }
 
-double stable_time_step(const Model& model, double safety, int lanczos_steps, int n_threads) {
+double stable_time_step(const Model& model, double safety, int lanczos_steps, int n_threads, const std::vector<index_t>& focus) {
   // Lanczos on M^-1/2 K M^-1/2 over the free points at rest: its largest Ritz value approaches the
   // largest omega^2 from below, and symplectic Euler is stable for h < 2 / omega_max
   const Eigen::Index n = 3 * static_cast<Eigen::Index>(model.n_points);
   Eigen::VectorXd scale(n);
   for (index_t i = 0; i < model.n_points; ++i)
     for (int a = 0; a < 3; ++a) scale[3 * i + a] = model.fixed[i] || !(model.mass[i] > 0) ? 0.0 : 1.0 / std::sqrt(model.mass[i]);
-  const double fallback = estimated_stable_time_step(model, 0.7);
-  if (scale.squaredNorm() == 0) return fallback;
+  // (a neighbour search: made only when Lanczos cannot answer)
+  auto fallback = [&] { return estimated_stable_time_step(model, 0.7); };
+  if (scale.squaredNorm() == 0) return fallback();
   Workspace ws(model, n_threads);
   Tangent K;
   K.linearise(model, Points::Zero(3, model.n_points), TangentMode::EXACT, &ws);
   std::mt19937 rng(12345);
   std::normal_distribution<double> noise;
   Eigen::VectorXd q(n), q_prev = Eigen::VectorXd::Zero(n);
-  for (Eigen::Index k = 0; k < n; ++k) q[k] = scale[k] > 0 ? noise(rng) : 0.0;
+  q.setZero();
+  for (const index_t i : focus)
+    for (int a = 0; a < 3; ++a) q[3 * i + a] = scale[3 * i + a] > 0 ? noise(rng) : 0.0;
+  if (q.squaredNorm() == 0)
+    for (Eigen::Index k = 0; k < n; ++k) q[k] = scale[k] > 0 ? noise(rng) : 0.0;
   q.normalize();
   Points in(3, model.n_points), out(3, model.n_points);
   const int steps = static_cast<int>(std::min<Eigen::Index>(std::max(2, lanczos_steps), n));
@@ -75,7 +80,7 @@ double stable_time_step(const Model& model, double safety, int lanczos_steps, in
     if (k + 1 < done) T(k, k + 1) = T(k + 1, k) = beta[k];
   }
   const double omega2 = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(T, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
-  if (!(omega2 > 0) || !std::isfinite(omega2)) return fallback;
+  if (!(omega2 > 0) || !std::isfinite(omega2)) return fallback();
   return safety * 2.0 / std::sqrt(omega2);
 }
 

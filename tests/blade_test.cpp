@@ -1,0 +1,85 @@
+// Tests for the blade (ProbeMode::CUT, haptics/probe_tool.cpp with mechanics/cut.cpp): a device's blade passed
+// through the cantilever near its root with the button held cuts it in two, the hand feels the cutting
+// resistance against the blade's move, the work it does is the resistance times the cut area, and the force
+// felt is continuous, bounded and finite.
+#include <pointhaptics/haptics/devices/virtual_device.hpp>
+#include <pointhaptics/interactive.hpp>
+#include <pointhaptics/io/scene_toml.hpp>
+#include <pointhaptics/scene_builder.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+namespace pointhaptics {
+namespace {
+
+constexpr double resistance = 50.0;  // J/m^2
+
+TEST(Blade, ADevicesBladeCutsTheCantileverThroughAndTheHandFeelsTheResistance) {
+  // scenes/cantilever_cut.toml's beam (0.15 x 0.03 x 0.03 m, E = 1e6 Pa, under its weight) without its script
+  Scene scene = read_scene_file(PH_SCENES "/cantilever_cut.toml");
+  scene.cuts.clear();
+  Simulation sim(build_scene_model(scene), scene.solver, 2);
+  const Model& model = sim.model();
+  // a blade 5 cm long along z (identity orientation: the capsule's axis), its centre in the plane x = 3.375 cm,
+  // moved from 2 cm above the beam to 2 cm below it between t = 0.05 s and 0.25 s (0.35 m/s), button held
+  const Vec3 above(0.03375, 0.05, 0.015), below(0.03375, -0.02, 0.015);
+  VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), true}, {0.05, Vec3::Zero(), true}, {0.25, below - above, true}, {0.4, below - above, true}}),
+                       known_device_specs("touch"));
+  InteractiveOptions o;
+  o.probe.radius = 0.001;
+  o.probe.length = 0.05;
+  o.probe.mode = ProbeMode::CUT;
+  o.probe.cut_resistance = resistance;
+  o.mapping.origin = above;
+  o.duration = 0.4;
+  o.real_time = false;
+  double work = 0, largest = 0, largest_step = 0;
+  Vec3 last_probe = Vec3::Constant(NAN), last_force = Vec3::Zero();
+  o.after_step = [&](long long) {
+    const ProbeTool* tool = sim.probe();
+    if (std::getenv("PH_DEBUG")) std::printf("t %.3f dt %.3g cut %lld pieces\n", sim.time(), sim.stable_dt(), sim.model().diagnostics.severed_pairs);
+    ASSERT_TRUE(tool->cutting());
+    const Vec3 f = tool->contact_model().f0;
+    ASSERT_TRUE(f.allFinite());
+    if (last_probe.allFinite()) work -= f.dot(tool->probe() - last_probe);  // the hand's work against it
+    largest = std::max(largest, f.norm());
+    largest_step = std::max(largest_step, (f - last_force).norm());
+    last_probe = tool->probe();
+    last_force = f;
+  };
+  const InteractiveResult r = run_interactive(sim, device, o);
+  ASSERT_FALSE(sim.diagnostics().failed) << sim.diagnostics().failure;
+  const RunSummary s = sim.summary();
+  ASSERT_TRUE(s.cut.present);
+  ASSERT_EQ(s.cut.piece_points.size(), 2u);
+  EXPECT_EQ(s.cut.piece_points[0], 125);
+  EXPECT_EQ(s.cut.piece_points[1], 400);
+  // the area the severed pairs stand for, against the section's 9 cm^2: the pairs near the faces are fewer
+  // (a point on a face has no neighbours beyond it)
+  const double area = cut_area(model, s.cut.cut_pairs);
+  EXPECT_NEAR(area, 9e-4, 0.25 * 9e-4);
+  // the hand's work against the resistance is G times that area (the low-pass delays the force, and the
+  // blade still moves while it dies out)
+  EXPECT_NEAR(work, resistance * area, 0.1 * resistance * area);
+  // through the section's 3 cm the blade is held back by about G x 3 cm; the force rises and falls smoothly
+  EXPECT_GT(largest, 0.6 * resistance * 0.03);
+  EXPECT_LT(largest, 1.6 * resistance * 0.03);
+  EXPECT_LT(largest_step, 0.25 * largest);
+  // what the device was sent stays finite and within its limit
+  double sent = 0;
+  for (const auto& tick : r.log) {
+    ASSERT_TRUE(tick.force.allFinite());
+    sent = std::max(sent, tick.force.norm());
+  }
+  EXPECT_LE(sent, known_device_specs("touch").max_force + 1e-9);
+  std::printf("cut pairs %lld, area %.4g m^2, work %.4g J (G A = %.4g J), largest force %.3g N (G x 3 cm = %.3g N), "
+              "largest step-to-step change %.3g N, longest sweep %.3g ms\n",
+              s.cut.cut_pairs, area, work, resistance * area, largest, resistance * 0.03, largest_step, s.cut.max_update_ms);
+}
+
+}  // namespace
+}  // namespace pointhaptics
