@@ -55,8 +55,9 @@ CutReport ModelSimulation::cut(const BladeSweep& sweep) {
     solver_impl_ = make_solver(model_, solver_, stable_dt_);
   }
   ++diagnostics_.cuts;
-  diagnostics_.max_cut_seconds =
-      std::max(diagnostics_.max_cut_seconds, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  diagnostics_.max_cut_seconds = std::max(diagnostics_.max_cut_seconds, seconds);
+  diagnostics_.cut_seconds += seconds;
   return report;
 }
 

@@ -46,6 +46,7 @@ struct StepDiagnostics {
   double active_set_seconds = 0, tools_seconds = 0, solve_seconds = 0;
   long long cuts = 0;           ///< blade sweeps applied (ModelSimulation::cut)
   double max_cut_seconds = 0;   ///< the longest of them, the stable step and the solver's rebuild included, s
+  double cut_seconds = 0;       ///< all of them, s
 };
 
 /// The probe's tool and its settings, as a simulation holds them (carried to the next active model).

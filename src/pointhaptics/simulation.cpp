@@ -274,6 +274,7 @@ RunSummary Simulation::summary() {
     s.cut.sweeps = d.cuts;
     s.cut.cut_pairs = model.diagnostics.severed_pairs;
     s.cut.max_update_ms = 1e3 * d.max_cut_seconds;
+    s.cut.mean_update_ms = d.cuts > 0 ? 1e3 * d.cut_seconds / static_cast<double>(d.cuts) : 0.0;
     std::vector<index_t> piece_of;
     s.cut.piece_points.assign(static_cast<std::size_t>(connected_pieces(model, piece_of)), 0);
     for (const index_t p : piece_of) ++s.cut.piece_points[p];

@@ -81,6 +81,7 @@ std::string result_json(const Model& model, const State& state, const RunSummary
     doc["cut"] = {{"sweeps", c.sweeps},
                   {"cut_pairs", c.cut_pairs},
                   {"max_update_ms", c.max_update_ms},
+                  {"mean_update_ms", c.mean_update_ms},
                   {"pieces", c.piece_points.size()},
                   {"piece_points", c.piece_points}};
   }

@@ -29,6 +29,7 @@ struct CutSummary {
   long long sweeps = 0;              ///< blade sweeps applied
   long long cut_pairs = 0;           ///< neighbour pairs severed in all
   double max_update_ms = 0;          ///< the longest sweep's update (refit, stable step, solver), ms
+  double mean_update_ms = 0;         ///< the sweeps' mean, ms
   std::vector<index_t> piece_points; ///< points per connected piece, in the order of their lowest point
 };
 
