@@ -11,7 +11,6 @@
 
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 
 namespace pointhaptics {
 namespace {
@@ -41,7 +40,6 @@ TEST(Blade, ADevicesBladeCutsTheCantileverThroughAndTheHandFeelsTheResistance) {
   Vec3 last_probe = Vec3::Constant(NAN), last_force = Vec3::Zero();
   o.after_step = [&](long long) {
     const ProbeTool* tool = sim.probe();
-    if (std::getenv("PH_DEBUG")) std::printf("t %.3f dt %.3g cut %lld pieces\n", sim.time(), sim.stable_dt(), sim.model().diagnostics.severed_pairs);
     ASSERT_TRUE(tool->cutting());
     const Vec3 f = tool->contact_model().f0;
     ASSERT_TRUE(f.allFinite());

@@ -2,6 +2,7 @@
 #include "experiment_beam.hpp"
 #include "experiment_cantilever.hpp"
 #include "experiment_contact.hpp"
+#include "experiment_cut.hpp"
 #include "experiment_force_profile.hpp"
 #include "experiment_lod.hpp"
 #include "experiment_materials.hpp"
@@ -398,6 +399,12 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(2, 200));
   contact_cmd->add_option("--plot-script", contact.plot_script, "plot_contact.py to use");
 
+  ph::experiments::CutOptions cut_experiment;
+  CLI::App* cut_cmd = experiment_cmd->add_subcommand(
+      "cut", "Cutting: a device's blade cuts the cantilever through near its root, a scripted one cuts a slit that opens under load");
+  cut_cmd->add_option("--out", cut_experiment.out, "Output folder")->required();
+  cut_cmd->add_option("--threads", cut_experiment.threads, "Threads (0: all)")->check(CLI::NonNegativeNumber);
+
   ph::experiments::ForceProfileOptions profile;
   CLI::App* profile_cmd = experiment_cmd->add_subcommand(
       "force-profile", "Seed Fig. 2c: the force felt while dragging a point of the beam and letting it go");
@@ -455,6 +462,7 @@ int main(int argc, char** argv) {
     if (*beam_cmd) return ph::experiments::run_beam_experiment(beam);
     if (*contact_cmd) return ph::experiments::run_contact_experiment(contact);
     if (*profile_cmd) return ph::experiments::run_force_profile_experiment(profile);
+    if (*cut_cmd) return ph::experiments::run_cut_experiment(cut_experiment);
     if (*lod_table_cmd) return ph::experiments::run_lod_table_experiment(lod_table);
     if (*propagation_cmd) return ph::experiments::run_propagation_experiment(propagation);
     if (*lod_error_cmd) return ph::experiments::run_lod_error_experiment(lod_error);
