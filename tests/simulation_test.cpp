@@ -229,6 +229,17 @@ TEST(Simulation, AScriptedBladeThroughTheRootDropsTheFreePieceAndLeavesTheStump)
   EXPECT_NEAR(free_velocity, -9.81 / 20.0, 0.02 * 9.81 / 20.0);
   const std::string json = result_json(model, state, s);
   EXPECT_NE(json.find("\"pieces\": 2"), std::string::npos);
+  // solved statically, the free piece has no equilibrium: a named error before the solve, not a failed one
+  Scene statics = scene;
+  statics.solver.kind = SolverKind::STATIC;
+  Simulation held(build_scene_model(statics), statics.solver, 2);
+  for (const CutSpec& cut : statics.cuts) held.add_scripted_cut(cut);
+  try {
+    held.step();
+    ADD_FAILURE() << "a static solve with a piece held nowhere did not stop";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("piece 2 of 2 (400 points) held nowhere"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -70,6 +70,23 @@ void Simulation::apply_scripted_cuts() {
     cut(BladeSweep{at(0, c.done), at(1, c.done), at(0, share), at(1, share)});
     c.done = share;
   }
+  // a piece the cuts set free has no equilibrium: say so before the static solve fails on it
+  if (spec.kind == SolverKind::STATIC) {
+    const Model& model = this->model();
+    std::vector<index_t> piece_of;
+    const index_t pieces = connected_pieces(model, piece_of);
+    std::vector<char> held(static_cast<std::size_t>(pieces), 0);
+    std::vector<index_t> size(static_cast<std::size_t>(pieces), 0);
+    for (index_t i = 0; i < model.n_points; ++i) {
+      held[piece_of[i]] |= model.fixed[i];
+      ++size[piece_of[i]];
+    }
+    for (index_t p = 0; p < pieces; ++p)
+      if (!held[p])
+        throw Error(fmt::format("cut: the cuts leave piece {} of {} ({} points) held nowhere: a static solve has no equilibrium "
+                                "for it (use solver.kind = \"explicit\" or \"implicit\", or hold it)",
+                                p + 1, pieces, size[p]));
+  }
 }
 
 void Simulation::run(double duration, const std::function<bool(long long, long long)>& after_step) {
