@@ -1,6 +1,7 @@
 // Tests for mechanics/cut.hpp: a blade severs exactly the pairs its swept surface crosses, the cut object's
 // forces are the exact gradient of its energy, the incremental refit equals one made in one go, the hourglass
 // diagonal stays the exact second difference of the energy, and a cut through makes two pieces.
+#include <pointhaptics/core/error.hpp>
 #include <pointhaptics/mechanics/cut.hpp>
 #include <pointhaptics/mechanics/energy.hpp>
 #include <pointhaptics/mechanics/forces.hpp>
@@ -165,6 +166,8 @@ TEST(Cut, AThousandRandomCutsNeverMakeNaNNorGrowTheModel) {
   EXPECT_TRUE(model.d.allFinite());
   EXPECT_TRUE(model.hg_coef.allFinite());
   EXPECT_TRUE(forces(model, test::random_field(model.n_points, 0.1 * spacing)).allFinite());
+  EXPECT_THROW(sever_pairs(model, {model.n_pairs()}), Error);
+  EXPECT_THROW(sever_pairs(model, {-1}), Error);
 }
 
 }  // namespace

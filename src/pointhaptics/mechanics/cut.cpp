@@ -1,7 +1,10 @@
 #include <pointhaptics/mechanics/cut.hpp>
 
+#include <pointhaptics/core/error.hpp>
 #include <pointhaptics/mechanics/energies/hourglass.hpp>
 #include <pointhaptics/mechanics/stencil.hpp>
+
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <array>
@@ -85,11 +88,13 @@ std::vector<index_t> pairs_crossing(const Model& model, const Points& x, const B
 
 CutReport sever_pairs(Model& model, const std::vector<index_t>& pairs) {
   const Csr& nbr = model.neighbours;
+  if (model.n_passive > 0) throw Error("cut: not on a level-of-detail active set (its cut would not reach the object)");
   if (model.severed.empty()) model.severed.assign(static_cast<std::size_t>(model.n_pairs()), 0);
   CutReport report;
   // the pairs to sever (both directions) and the stencils that lose them
   std::vector<index_t> newly, stencils;
   for (const index_t e : pairs) {
+    if (e < 0 || e >= model.n_pairs()) throw Error(fmt::format("cut: pair {} does not exist (the model has {})", e, model.n_pairs()));
     if (model.severed[e]) continue;
     const index_t i = row_of(nbr, e), j = nbr.index[e];
     newly.push_back(e);

@@ -48,6 +48,7 @@ struct CutReport {
 /// on them: the stencils that lost pairs (M_i, d_ij, d_ii), the hourglass coefficients of their pairs and of
 /// the pairs' reverses, the hourglass diagonal's terms of those pairs, and the diagnostics
 /// (regularised_neighbourhoods, isolated_points, severed_pairs). Cost: the affected rows, not the model.
+/// Throws Error for a pair that does not exist, and on a level-of-detail active set (passive points).
 CutReport sever_pairs(Model& model, const std::vector<index_t>& pairs);
 
 /// sever_pairs(model, pairs_crossing(model, x, sweep)).
