@@ -292,3 +292,15 @@ def test_bad_input_is_a_named_error():
     sim = ph.Simulation.from_scene(scene("beam_fixed_both_ends.toml"), threads=1)
     with pytest.raises(ph.Error, match="duration"):
         sim.run(-1)
+
+
+def test_a_scripted_cut_parts_the_beam_and_the_summary_says_so():
+    sim = ph.Simulation.from_scene(scene("cantilever_cut.toml"), threads=1)
+    sim.run_scene()
+    cut = sim.summary()["cut"]
+    assert cut["pieces"] == 2 and cut["piece_points"] == [125, 400]
+    assert cut["cut_pairs"] > 0 and cut["max_update_ms"] > 0
+    # the free piece has fallen; the stump has not
+    free = sim.reference[:, 0] > 0.034
+    assert sim.displacement[free, 1].mean() < -0.05
+    assert np.abs(sim.displacement[~free]).max() < 1e-4
