@@ -79,5 +79,45 @@ TEST(Blade, ADevicesBladeCutsTheCantileverThroughAndTheHandFeelsTheResistance) {
               s.cut.cut_pairs, area, work, resistance * area, largest, resistance * 0.03, largest_step, s.cut.max_update_ms);
 }
 
+TEST(Blade, SawingForASecondStaysFiniteBoundedAndWithinTheDevice) {
+  // the blade sawed back and forth along the beam's root region while it sinks, a thousand steps: every step
+  // cuts; nothing non-finite, the simulation never fails, the device's force stays within its limit
+  Scene scene = read_scene_file(PH_SCENES "/cantilever_cut.toml");
+  scene.cuts.clear();
+  Simulation sim(build_scene_model(scene), scene.solver, 2);
+  const Vec3 origin(0.03375, 0.04, 0.015);
+  std::vector<Keyframe> saw;
+  for (int k = 0; k <= 20; ++k)  // 20 strokes of 5 cm in x, 3 mm deeper each
+    saw.push_back({0.05 * k, Vec3((k % 2 ? 0.05 : 0.0), -0.003 * k, 0.0), true});
+  VirtualDevice device{Trajectory(std::move(saw)), known_device_specs("touch")};
+  InteractiveOptions o;
+  o.probe.radius = 0.001;
+  o.probe.length = 0.05;
+  o.probe.mode = ProbeMode::CUT;
+  o.probe.cut_resistance = resistance;
+  o.mapping.origin = origin;
+  o.duration = 1.0;
+  o.real_time = false;
+  long long steps = 0;
+  o.after_step = [&](long long) {
+    ++steps;
+    ASSERT_TRUE(sim.probe()->contact_model().f0.allFinite());
+    ASSERT_TRUE(sim.probe()->blade_trail().size() <= ProbeTool::blade_trail_steps);
+  };
+  const InteractiveResult r = run_interactive(sim, device, o);
+  ASSERT_FALSE(sim.diagnostics().failed) << sim.diagnostics().failure;
+  EXPECT_EQ(steps, 1000);
+  EXPECT_TRUE(sim.state().u.allFinite());
+  const RunSummary s = sim.summary();
+  EXPECT_GT(s.cut.cut_pairs, 100);
+  EXPECT_EQ(static_cast<index_t>(sim.model().severed.size()), sim.model().n_pairs());
+  for (const auto& tick : r.log) {
+    ASSERT_TRUE(tick.force.allFinite());
+    ASSERT_LE(tick.force.norm(), known_device_specs("touch").max_force + 1e-9);
+  }
+  std::printf("sawing: %lld pairs cut, %zu pieces, a sweep %.3f ms on average, %.3f ms at most\n", s.cut.cut_pairs,
+              s.cut.piece_points.size(), s.cut.mean_update_ms, s.cut.max_update_ms);
+}
+
 }  // namespace
 }  // namespace pointhaptics
