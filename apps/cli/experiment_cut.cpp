@@ -215,7 +215,7 @@ int run_cut_experiment(const CutOptions& options) {
            "| pieces | {} ({} points) |\n| pairs cut | {} |\n| their area | {:.3g} m^2 (the section: 9e-4 m^2) |\n"
            "| the hand's work against the resistance | {:.4g} J (resistance x area: {:.4g} J) |\n"
            "| largest resistance | {:.3g} N |\n| largest change of the commanded force per tick | {:.3g} N (bound {:.3g} N) |\n"
-           "| sweeps, update mean / max | {}, {:.2f} / {:.2f} ms |\n| the free piece's fall | {:.3f} m/s (terminal {:.3f} m/s) |\n"
+           "| steps that cut, update mean / max | {}, {:.2f} / {:.2f} ms |\n| the free piece's fall | {:.3f} m/s (terminal {:.3f} m/s) |\n"
            "| non-finite values | {} |\n\n"
            "## A slit that opens under load\n\n"
            "A block 6 x 3 x 3 cm ({} points, neo-Hookean, E = 1e5 Pa), bottom held, its end faces pulled apart by 0.5 N each, "

@@ -98,7 +98,7 @@ void print_summary(ph::Simulation& sim, const ph::RunSummary& s, double setup_s)
   if (s.cut.present) {
     std::string sizes;
     for (size_t p = 0; p < s.cut.piece_points.size(); ++p) sizes += fmt::format("{}{}", p ? ", " : "", s.cut.piece_points[p]);
-    fmt::print("cut             {} blade sweeps severed {} neighbour pairs; {} piece(s) of {} points; a sweep took {:.2f} ms "
+    fmt::print("cut             {} steps cut, severing {} neighbour pairs; {} piece(s) of {} points; an update took {:.2f} ms "
                "on average, {:.2f} ms at most\n",
                s.cut.sweeps, s.cut.cut_pairs, s.cut.piece_points.size(), sizes, s.cut.mean_update_ms, s.cut.max_update_ms);
   }

@@ -43,9 +43,17 @@ void ModelSimulation::set_state(const State& state) {
   else state_.viscous.setZero();
 }
 
-CutReport ModelSimulation::cut(const BladeSweep& sweep) {
+CutReport ModelSimulation::cut(std::span<const BladeSweep> sweeps) {
   const auto start = std::chrono::steady_clock::now();
-  const CutReport report = pointhaptics::cut(model_, model_.X + state_.u, sweep);
+  cut_positions_ = model_.X + state_.u;  // allocates only the first time
+  CutReport report;
+  for (const BladeSweep& sweep : sweeps) {
+    const CutReport strip = pointhaptics::cut(model_, cut_positions_, sweep);
+    report.severed_pairs += strip.severed_pairs;
+    report.refitted_stencils += strip.refitted_stencils;
+    report.regularised += strip.regularised;
+    report.cut_points.insert(report.cut_points.end(), strip.cut_points.begin(), strip.cut_points.end());
+  }
   if (report.severed_pairs > 0) {
     // a one-sided or thin stencil can be stiffer than a whole one: Lanczos started on the cut's points finds
     // the modes the cut made in a few steps (elsewhere the model is as it was); implicit and static steps do
@@ -95,14 +103,12 @@ void ModelSimulation::place_tools() {
   if (tool.cutting()) {
     const std::vector<std::array<Vec3, 2>>& trail = tool.blade_trail();
     const std::array<Vec3, 2> edge = tool.blade_edge();
-    CutReport report;
+    blade_strips_.clear();  // allocates only to grow
     for (std::size_t k = 0; k < trail.size(); ++k) {
       const std::array<Vec3, 2>& to = k + 1 < trail.size() ? trail[k + 1] : edge;
-      CutReport strip = cut(BladeSweep{trail[k][0], trail[k][1], to[0], to[1]});
-      report.severed_pairs += strip.severed_pairs;
-      report.cut_points.insert(report.cut_points.end(), strip.cut_points.begin(), strip.cut_points.end());
+      blade_strips_.push_back(BladeSweep{trail[k][0], trail[k][1], to[0], to[1]});
     }
-    tool.resist_cut(model_, report, solver_.dt);
+    tool.resist_cut(model_, blade_strips_.empty() ? CutReport{} : cut(blade_strips_), solver_.dt);
   }
 }
 

@@ -13,6 +13,7 @@
 
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -44,7 +45,7 @@ struct StepDiagnostics {
   std::string failure;          ///< why
   double step_seconds = 0;      ///< wall time in steps, s, and in its stages:
   double active_set_seconds = 0, tools_seconds = 0, solve_seconds = 0;
-  long long cuts = 0;           ///< blade sweeps applied (ModelSimulation::cut)
+  long long cuts = 0;           ///< cut updates (ModelSimulation::cut: a blade step's sweeps)
   double max_cut_seconds = 0;   ///< the longest of them, the stable step and the solver's rebuild included, s
   double cut_seconds = 0;       ///< all of them, s
 };
@@ -82,7 +83,10 @@ class ModelSimulation {
   /// When pairs were severed, the solver is rebuilt on the cut model, and the explicit stable step shortens to
   /// what cut_lanczos_steps Lanczos steps started on the cut's points find, if that is shorter (a one-sided or
   /// thin stencil can be stiffer than a whole one; tests/simulation_test.cpp checks it against 40 steps).
-  CutReport cut(const BladeSweep& sweep);
+  /// Several sweeps (a blade's strips) cut in turn at the same positions, with one check of the stable step;
+  /// their reports summed; one update in the diagnostics.
+  CutReport cut(std::span<const BladeSweep> sweeps);
+  CutReport cut(const BladeSweep& sweep) { return cut(std::span<const BladeSweep>(&sweep, 1)); }
   /// Replace the state (same model). Throws Error for a state of another size.
   void set_state(const State& state);
   StepInputs& inputs() { return inputs_; }
@@ -113,6 +117,8 @@ class ModelSimulation {
   int n_threads_ = 0;
   double stable_dt_ = 0;
   static constexpr int cut_lanczos_steps = 12;
+  Points cut_positions_;                 ///< X + u at a cut (kept: no allocation per blade step)
+  std::vector<BladeSweep> blade_strips_;  ///< a blade's strips this step
   std::unique_ptr<Solver> solver_impl_;
   StepInputs inputs_;
   StepReport report_;

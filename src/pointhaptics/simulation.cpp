@@ -9,6 +9,7 @@
 
 #include <fmt/format.h>
 
+#include <array>
 #include <chrono>
 #include <cmath>
 
@@ -66,8 +67,15 @@ void Simulation::apply_scripted_cuts() {
     // body would keep the material from crossing, so nothing there is cut (a linear script's trail is one quad)
     auto at = [&](int end, double u) -> Vec3 { return s.edge[end] + u * (s.to[end] - s.edge[end]); };
     const Model& model = this->model();
-    if (c.done > 0) cut(BladeSweep{at(0, 0.0), at(1, 0.0), at(0, c.done), at(1, c.done), model.support.size() ? model.support.maxCoeff() : model.h});
-    cut(BladeSweep{at(0, c.done), at(1, c.done), at(0, share), at(1, share)});
+    const double reach = model.support.size() ? model.support.maxCoeff() : model.h;
+    const BladeSweep trail{at(0, 0.0), at(1, 0.0), at(0, c.done), at(1, c.done), reach};
+    const BladeSweep strip{at(0, c.done), at(1, c.done), at(0, share), at(1, share)};
+    if (c.done > 0) {
+      const std::array<BladeSweep, 2> both{trail, strip};
+      object_->cut(both);
+    } else {
+      cut(strip);
+    }
     c.done = share;
   }
   // a piece the cuts set free has no equilibrium: say so before the static solve fails on it

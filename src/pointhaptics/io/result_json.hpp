@@ -26,10 +26,10 @@ struct LodSummary {
 /// Cuts in a run (issue 18): absent without.
 struct CutSummary {
   bool present = false;
-  long long sweeps = 0;              ///< blade sweeps applied
+  long long sweeps = 0;              ///< cut updates: the steps a blade cut in (a step's strips are one)
   long long cut_pairs = 0;           ///< neighbour pairs severed in all
-  double max_update_ms = 0;          ///< the longest sweep's update (refit, stable step, solver), ms
-  double mean_update_ms = 0;         ///< the sweeps' mean, ms
+  double max_update_ms = 0;          ///< the longest update (refits, stable step, solver), ms
+  double mean_update_ms = 0;         ///< the updates' mean, ms
   std::vector<index_t> piece_points; ///< points per connected piece, in the order of their lowest point
 };
 
