@@ -17,25 +17,37 @@ namespace {
 
 constexpr double resistance = 50.0;  // J/m^2
 
-TEST(Blade, ADevicesBladeCutsTheCantileverThroughAndTheHandFeelsTheResistance) {
-  // scenes/cantilever_cut.toml's beam (0.15 x 0.03 x 0.03 m, E = 1e6 Pa, under its weight) without its script
+// scenes/cantilever_cut.toml's beam (0.15 x 0.03 x 0.03 m, E = 1e6 Pa, under its weight) without its script
+Scene beam() {
   Scene scene = read_scene_file(PH_SCENES "/cantilever_cut.toml");
   scene.cuts.clear();
-  Simulation sim(build_scene_model(scene), scene.solver, 2);
-  const Model& model = sim.model();
-  // a blade 5 cm long along z (identity orientation: the capsule's axis), its centre in the plane x = 3.375 cm,
-  // moved from 2 cm above the beam to 2 cm below it between t = 0.05 s and 0.25 s (0.35 m/s), button held
-  const Vec3 above(0.03375, 0.05, 0.015), below(0.03375, -0.02, 0.015);
-  VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), true}, {0.05, Vec3::Zero(), true}, {0.25, below - above, true}, {0.4, below - above, true}}),
-                       known_device_specs("touch"));
+  return scene;
+}
+
+// a blade 5 cm long along z (identity orientation: the capsule's axis) with the device's origin at `origin`, in
+// simulated time
+InteractiveOptions blade(const Vec3& origin, double duration) {
   InteractiveOptions o;
   o.probe.radius = 0.001;
   o.probe.length = 0.05;
   o.probe.mode = ProbeMode::CUT;
   o.probe.cut_resistance = resistance;
-  o.mapping.origin = above;
-  o.duration = 0.4;
+  o.mapping.origin = origin;
+  o.duration = duration;
   o.real_time = false;
+  return o;
+}
+
+TEST(Blade, ADevicesBladeCutsTheCantileverThroughAndTheHandFeelsTheResistance) {
+  const Scene scene = beam();
+  Simulation sim(build_scene_model(scene), scene.solver, 2);
+  const Model& model = sim.model();
+  // the blade's centre in the plane x = 3.375 cm, moved from 2 cm above the beam to 2 cm below it between
+  // t = 0.05 s and 0.25 s (0.35 m/s), button held
+  const Vec3 above(0.03375, 0.05, 0.015), below(0.03375, -0.02, 0.015);
+  VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), true}, {0.05, Vec3::Zero(), true}, {0.25, below - above, true}, {0.4, below - above, true}}),
+                       known_device_specs("touch"));
+  InteractiveOptions o = blade(above, 0.4);
   double work = 0, largest = 0, largest_step = 0;
   Vec3 last_probe = Vec3::Constant(NAN), last_force = Vec3::Zero();
   o.after_step = [&](long long) {
@@ -82,22 +94,14 @@ TEST(Blade, ADevicesBladeCutsTheCantileverThroughAndTheHandFeelsTheResistance) {
 TEST(Blade, SawingForASecondStaysFiniteBoundedAndWithinTheDevice) {
   // the blade sawed back and forth along the beam's root region while it sinks, a thousand steps: every step
   // cuts; nothing non-finite, the simulation never fails, the device's force stays within its limit
-  Scene scene = read_scene_file(PH_SCENES "/cantilever_cut.toml");
-  scene.cuts.clear();
+  const Scene scene = beam();
   Simulation sim(build_scene_model(scene), scene.solver, 2);
   const Vec3 origin(0.03375, 0.04, 0.015);
   std::vector<Keyframe> saw;
   for (int k = 0; k <= 20; ++k)  // 20 strokes of 5 cm in x, 3 mm deeper each
     saw.push_back({0.05 * k, Vec3((k % 2 ? 0.05 : 0.0), -0.003 * k, 0.0), true});
   VirtualDevice device{Trajectory(std::move(saw)), known_device_specs("touch")};
-  InteractiveOptions o;
-  o.probe.radius = 0.001;
-  o.probe.length = 0.05;
-  o.probe.mode = ProbeMode::CUT;
-  o.probe.cut_resistance = resistance;
-  o.mapping.origin = origin;
-  o.duration = 1.0;
-  o.real_time = false;
+  InteractiveOptions o = blade(origin, 1.0);
   long long steps = 0;
   o.after_step = [&](long long) {
     ++steps;

@@ -7,6 +7,7 @@
 #include <pointhaptics/mechanics/forces.hpp>
 #include <pointhaptics/mechanics/model_builder.hpp>
 
+#include "support/energy_differences.hpp"
 #include "support/test_models.hpp"
 
 #include <gtest/gtest.h>
@@ -102,20 +103,10 @@ TEST(Cut, ForcesAfterCutsAreTheExactGradientOfTheCutObjectsEnergy) {
   oblique.b1 = Vec3(0.06, 0.022, 0.025);
   EXPECT_GT(cut(model, model.X, oblique).severed_pairs, 0);
   for (double scale : {0.02, 0.2}) {
-    Points u = test::random_field(model.n_points, scale * spacing, 17);
+    const Points u = test::random_field(model.n_points, scale * spacing, 17);
     const Points f = forces(model, u);
     ASSERT_TRUE(f.allFinite());
-    Points f_fd(3, model.n_points);
-    const double eps = 1e-5 * scale * spacing;
-    for (Eigen::Index k = 0; k < u.size(); ++k) {
-      const double keep = u.data()[k];
-      u.data()[k] = keep + eps;
-      const double plus = strain_energy(model, u).total();
-      u.data()[k] = keep - eps;
-      const double minus = strain_energy(model, u).total();
-      u.data()[k] = keep;
-      f_fd.data()[k] = -(plus - minus) / (2 * eps);
-    }
+    const Points f_fd = test::forces_by_differences(model, u, 1e-5 * scale * spacing);
     EXPECT_LT((f - f_fd).norm() / f.norm(), 1e-6) << "displacement scale " << scale << " x spacing";
   }
 }

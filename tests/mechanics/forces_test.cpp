@@ -5,6 +5,7 @@
 #include <pointhaptics/mechanics/energy.hpp>
 #include <pointhaptics/mechanics/forces.hpp>
 
+#include "support/energy_differences.hpp"
 #include "support/test_models.hpp"
 
 #include <gtest/gtest.h>
@@ -51,19 +52,9 @@ class ForcesTest : public ::testing::TestWithParam<Config> {};
 TEST_P(ForcesTest, EqualMinusCentralDifferencesOfTheEnergy) {
   const Model model = make_model(GetParam());
   for (double scale : {0.02, 0.2}) {  // small and large deformation (strain up to ~50%)
-    Points u = test::random_field(model.n_points, scale * spacing, 17);
+    const Points u = test::random_field(model.n_points, scale * spacing, 17);
     const Points f = forces(model, u);
-    Points f_fd(3, model.n_points);
-    const double eps = 1e-5 * scale * spacing;
-    for (Eigen::Index k = 0; k < u.size(); ++k) {
-      const double keep = u.data()[k];
-      u.data()[k] = keep + eps;
-      const double plus = strain_energy(model, u).total();
-      u.data()[k] = keep - eps;
-      const double minus = strain_energy(model, u).total();
-      u.data()[k] = keep;
-      f_fd.data()[k] = -(plus - minus) / (2 * eps);
-    }
+    const Points f_fd = test::forces_by_differences(model, u, 1e-5 * scale * spacing);
     const double error = (f - f_fd).norm() / f.norm();
     EXPECT_LT(error, 1e-6) << "displacement scale " << scale << " x spacing";
     EXPECT_GT(f.norm(), 0);
