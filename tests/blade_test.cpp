@@ -107,6 +107,7 @@ TEST(Blade, SawingForASecondStaysFiniteBoundedAndWithinTheDevice) {
     ++steps;
     ASSERT_TRUE(sim.probe()->contact_model().f0.allFinite());
     ASSERT_TRUE(sim.probe()->blade_trail().size() <= ProbeTool::blade_trail_steps);
+    ASSERT_TRUE(sim.probe()->cut_history_size() <= ProbeTool::cut_history_steps);
   };
   const InteractiveResult r = run_interactive(sim, device, o);
   ASSERT_FALSE(sim.diagnostics().failed) << sim.diagnostics().failure;

@@ -30,7 +30,9 @@ void ProbeTool::resist_cut(const Model& model, const CutReport& report, double d
     const std::array<Vec3, 2>& last = trail_.back();
     const Vec3 move = 0.5 * ((edge[0] - last[0]) + (edge[1] - last[1]));
     // the new area per distance over the last spacing of travel (the oldest step dropped once the rest cover it)
-    cut_history_.push_back({move.norm(), cut_area(model, report.severed_pairs)});
+    // a blade held still adds nothing, and the history keeps at most cut_history_steps (bounded memory)
+    if (move.norm() > 1e-12 || report.severed_pairs > 0) cut_history_.push_back({move.norm(), cut_area(model, report.severed_pairs)});
+    if (cut_history_.size() > cut_history_steps) cut_history_.erase(cut_history_.begin());
     double travel = 0, area = 0;
     for (const auto& [d, a] : cut_history_) {
       travel += d;

@@ -50,6 +50,10 @@ class ProbeTool final : public DynamicForces {
   /// pair that moved back over a strip the edge had passed would escape a blade that cut only its last strip
   /// (a device's blade through the cantilever missed 6 of 169 pairs and left it whole).
   const std::vector<std::array<Vec3, 2>>& blade_trail() const { return trail_; }
+  /// Steps in the cutting resistance's history, at most cut_history_steps (a second at 1 kHz: a blade crawling
+  /// slower than a spacing a second feels the area over its last second).
+  std::size_t cut_history_size() const { return cut_history_.size(); }
+  static constexpr std::size_t cut_history_steps = 1000;
   static constexpr std::size_t blade_trail_steps = 8;
   /// This step's cut (ModelSimulation::place_tools): the hand feels cut_resistance times the new area
   /// (cut_area()) per distance the edge moved, against its move. The area comes in whole pairs, a plane of
