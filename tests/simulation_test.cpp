@@ -229,6 +229,9 @@ TEST(Simulation, AScriptedBladeThroughTheRootDropsTheFreePieceAndLeavesTheStump)
   EXPECT_NEAR(free_velocity, -9.81 / 20.0, 0.02 * 9.81 / 20.0);
   const std::string json = result_json(model, state, s);
   EXPECT_NE(json.find("\"pieces\": 2"), std::string::npos);
+  // levels of detail do not take cuts yet: a named error, the simulation untouched
+  EXPECT_THROW(sim.enable_lod(LodParams{}, Vec3(0.1, 0.03, 0.015)), Error);
+  EXPECT_FALSE(sim.lod_enabled());
   // solved statically, the free piece has no equilibrium: a named error before the solve, not a failed one
   Scene statics = scene;
   statics.solver.kind = SolverKind::STATIC;

@@ -82,18 +82,14 @@ void Simulation::apply_scripted_cuts() {
   if (spec.kind == SolverKind::STATIC) {
     const Model& model = this->model();
     std::vector<index_t> piece_of;
-    const index_t pieces = connected_pieces(model, piece_of);
-    std::vector<char> held(static_cast<std::size_t>(pieces), 0);
-    std::vector<index_t> size(static_cast<std::size_t>(pieces), 0);
-    for (index_t i = 0; i < model.n_points; ++i) {
-      held[piece_of[i]] |= model.fixed[i];
-      ++size[piece_of[i]];
-    }
-    for (index_t p = 0; p < pieces; ++p)
+    const std::vector<index_t> size = piece_sizes(model, piece_of);
+    std::vector<char> held(size.size(), 0);
+    for (index_t i = 0; i < model.n_points; ++i) held[piece_of[i]] |= model.fixed[i];
+    for (std::size_t p = 0; p < size.size(); ++p)
       if (!held[p])
         throw Error(fmt::format("cut: the cuts leave piece {} of {} ({} points) held nowhere: a static solve has no equilibrium "
                                 "for it (use solver.kind = \"explicit\" or \"implicit\", or hold it)",
-                                p + 1, pieces, size[p]));
+                                p + 1, size.size(), size[p]));
   }
 }
 
@@ -182,6 +178,9 @@ void Simulation::grabbed_points(std::vector<index_t>& out) const {
 
 void Simulation::enable_lod(const LodParams& params, const Vec3& contact) {
   if (lod_) throw Error("lod: levels of detail are already on");
+  const bool blade = object_->probe() && object_->probe()->tool.blade();
+  if (!scripted_cuts_.empty() || !object_->model().severed.empty() || blade)
+    throw Error("lod: not yet with cuts (a cut in the active set does not reach the object)");
   lod_ = std::make_unique<LevelsOfDetail>(std::move(*object_), params, contact);
   object_.reset();
 }
@@ -301,8 +300,7 @@ RunSummary Simulation::summary() {
     s.cut.max_update_ms = 1e3 * d.max_cut_seconds;
     s.cut.mean_update_ms = d.cuts > 0 ? 1e3 * d.cut_seconds / static_cast<double>(d.cuts) : 0.0;
     std::vector<index_t> piece_of;
-    s.cut.piece_points.assign(static_cast<std::size_t>(connected_pieces(model, piece_of)), 0);
-    for (const index_t p : piece_of) ++s.cut.piece_points[p];
+    s.cut.piece_points = piece_sizes(model, piece_of);
   }
   return s;
 }

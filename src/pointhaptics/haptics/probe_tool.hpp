@@ -41,8 +41,10 @@ class ProbeTool final : public DynamicForces {
   /// stiffness through the object's compliance (compliance_stiffness()).
   void after_step(const Model& model, const State& state, Workspace& ws) override;
 
-  /// A blade (ProbeMode::CUT) with the button held: this step it cuts instead of touching.
-  bool cutting() const { return contact_.params().mode == ProbeMode::CUT && button_ && probe_.allFinite(); }
+  /// A blade (ProbeMode::CUT).
+  bool blade() const { return contact_.params().mode == ProbeMode::CUT; }
+  /// A blade with the button held: this step it cuts instead of touching.
+  bool cutting() const { return blade() && button_ && probe_.allFinite(); }
   /// The blade's edge at the probe's pose (its capsule axis).
   std::array<Vec3, 2> blade_edge() const;
   /// Where the edge was at the last blade_trail_steps steps of this cut, oldest first (empty on its first

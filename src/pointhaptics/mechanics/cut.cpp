@@ -181,4 +181,10 @@ index_t connected_pieces(const Model& model, std::vector<index_t>& piece_of) {
   return count;
 }
 
+std::vector<index_t> piece_sizes(const Model& model, std::vector<index_t>& piece_of) {
+  std::vector<index_t> size(static_cast<std::size_t>(connected_pieces(model, piece_of)), 0);
+  for (const index_t p : piece_of) ++size[static_cast<std::size_t>(p)];
+  return size;
+}
+
 }  // namespace pointhaptics

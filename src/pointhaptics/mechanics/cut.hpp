@@ -58,4 +58,7 @@ CutReport cut(Model& model, const Points& x, const BladeSweep& sweep);
 /// their lowest point. Returns count. A cut all the way through makes more than one.
 index_t connected_pieces(const Model& model, std::vector<index_t>& piece_of);
 
+/// connected_pieces(), and the number of points in each piece.
+std::vector<index_t> piece_sizes(const Model& model, std::vector<index_t>& piece_of);
+
 }  // namespace pointhaptics
