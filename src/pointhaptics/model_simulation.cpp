@@ -46,14 +46,7 @@ void ModelSimulation::set_state(const State& state) {
 CutReport ModelSimulation::cut(std::span<const BladeSweep> sweeps) {
   const auto start = std::chrono::steady_clock::now();
   cut_positions_ = model_.X + state_.u;  // allocates only the first time
-  CutReport report;
-  for (const BladeSweep& sweep : sweeps) {
-    const CutReport strip = pointhaptics::cut(model_, cut_positions_, sweep);
-    report.severed_pairs += strip.severed_pairs;
-    report.refitted_stencils += strip.refitted_stencils;
-    report.regularised += strip.regularised;
-    report.cut_points.insert(report.cut_points.end(), strip.cut_points.begin(), strip.cut_points.end());
-  }
+  const CutReport report = pointhaptics::cut(model_, cut_positions_, sweeps);
   if (report.severed_pairs > 0) {
     // a one-sided or thin stencil can be stiffer than a whole one: Lanczos started on the cut's points finds
     // the modes the cut made in a few steps (elsewhere the model is as it was); implicit and static steps do

@@ -83,8 +83,8 @@ class ModelSimulation {
   /// When pairs were severed, the solver is rebuilt on the cut model, and the explicit stable step shortens to
   /// what cut_lanczos_steps Lanczos steps started on the cut's points find, if that is shorter (a one-sided or
   /// thin stencil can be stiffer than a whole one; tests/simulation_test.cpp checks it against 40 steps).
-  /// Several sweeps (a blade's strips) cut in turn at the same positions, with one check of the stable step;
-  /// their reports summed; one update in the diagnostics.
+  /// Several sweeps (a blade's strips) cut together at the same positions, with one check of the stable step;
+  /// one update in the diagnostics.
   CutReport cut(std::span<const BladeSweep> sweeps);
   CutReport cut(const BladeSweep& sweep) { return cut(std::span<const BladeSweep>(&sweep, 1)); }
   /// Replace the state (same model). Throws Error for a state of another size.

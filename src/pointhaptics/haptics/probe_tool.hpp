@@ -60,8 +60,8 @@ class ProbeTool final : public DynamicForces {
   /// This step's cut (ModelSimulation::place_tools): the hand feels cut_resistance times the new area
   /// (cut_area()) per distance the edge moved, against its move. The area comes in whole pairs, a plane of
   /// them at a time as the edge passes a plane of points, so it is taken over the last spacing of the edge's
-  /// travel (divided by a spacing at least), and the force low-passed over cut_smoothing seconds. The points of the severed pairs take the
-  /// opposite force. Remembers the edge.
+  /// travel (divided by a spacing at least), and the force low-passed over cut_smoothing seconds. The points
+  /// of the severed pairs take the opposite force. Remembers the edge.
   void resist_cut(const Model& model, const CutReport& report, double dt);
 
   /// Whether the probe touches the object's surface (else the point spheres).

@@ -47,11 +47,6 @@ index_t row_of(const Csr& nbr, index_t e) {
   return static_cast<index_t>(std::upper_bound(nbr.offset.begin(), nbr.offset.end(), e) - nbr.offset.begin()) - 1;
 }
 
-double weight_sum_of(const Model& model, index_t i) {
-  double sum = 0;
-  for (index_t e = model.neighbours.begin(i); e < model.neighbours.end(i); ++e) sum += pair_weight(model, i, e);
-  return sum;
-}
 
 }  // namespace
 
@@ -142,8 +137,18 @@ CutReport sever_pairs(Model& model, const std::vector<index_t>& pairs) {
     report.regularised += after.regularised;
   }
   report.refitted_stencils = static_cast<index_t>(stencils.size());
-  for (const auto& [i, e] : changed)
-    model.hg_coef[e] = hourglass_coefficient(model, i, e, weight_sum_of(model, i), weight_sum_of(model, nbr.index[e]));
+  // the weight sums of the changed pairs' ends (every end is the first of some changed pair), each once
+  std::vector<std::pair<index_t, double>> weight_sum;
+  for (const auto& [i, e] : changed) weight_sum.emplace_back(i, 0.0);
+  std::sort(weight_sum.begin(), weight_sum.end());
+  weight_sum.erase(std::unique(weight_sum.begin(), weight_sum.end(), [](const auto& a, const auto& b) { return a.first == b.first; }),
+                   weight_sum.end());
+  for (auto& [i, sum] : weight_sum)
+    for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) sum += pair_weight(model, i, e);
+  auto sum_of = [&](index_t i) {
+    return std::lower_bound(weight_sum.begin(), weight_sum.end(), i, [](const auto& a, index_t b) { return a.first < b; })->second;
+  };
+  for (const auto& [i, e] : changed) model.hg_coef[e] = hourglass_coefficient(model, i, e, sum_of(i), sum_of(nbr.index[e]));
   add_hourglass_diagonal(model, changed, 1.0, model.hg_diagonal);
   return report;
 }
@@ -153,7 +158,14 @@ double cut_area(const Model& model, index_t severed_pairs) {
   return static_cast<double>(severed_pairs) * 4.0 * std::pow(s, 6) / (std::numbers::pi * std::pow(model.h, 4));
 }
 
-CutReport cut(Model& model, const Points& x, const BladeSweep& sweep) { return sever_pairs(model, pairs_crossing(model, x, sweep)); }
+CutReport cut(Model& model, const Points& x, std::span<const BladeSweep> sweeps) {
+  std::vector<index_t> pairs;
+  for (const BladeSweep& sweep : sweeps) {
+    const std::vector<index_t> crossing = pairs_crossing(model, x, sweep);
+    pairs.insert(pairs.end(), crossing.begin(), crossing.end());  // a pair two strips cross is severed once
+  }
+  return sever_pairs(model, pairs);
+}
 
 index_t connected_pieces(const Model& model, std::vector<index_t>& piece_of) {
   const Csr& nbr = model.neighbours;

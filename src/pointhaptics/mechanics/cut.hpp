@@ -10,6 +10,7 @@
 #include <pointhaptics/core/model.hpp>
 
 #include <limits>
+#include <span>
 #include <vector>
 
 namespace pointhaptics {
@@ -51,8 +52,12 @@ struct CutReport {
 /// Throws Error for a pair that does not exist, and on a level-of-detail active set (passive points).
 CutReport sever_pairs(Model& model, const std::vector<index_t>& pairs);
 
-/// sever_pairs(model, pairs_crossing(model, x, sweep)).
-CutReport cut(Model& model, const Points& x, const BladeSweep& sweep);
+/// sever_pairs() of the pairs_crossing() of every sweep (a blade step's strips), all at the positions x: the
+/// stencils they touch are refitted once.
+CutReport cut(Model& model, const Points& x, std::span<const BladeSweep> sweeps);
+inline CutReport cut(Model& model, const Points& x, const BladeSweep& sweep) {
+  return cut(model, x, std::span<const BladeSweep>(&sweep, 1));
+}
 
 /// The object's connected pieces over its unsevered pairs: piece_of[i] in [0, count), numbered in the order of
 /// their lowest point. Returns count. A cut all the way through makes more than one.
