@@ -1,6 +1,7 @@
 #include <pointhaptics/mechanics/cut.hpp>
 
 #include <pointhaptics/core/error.hpp>
+#include <pointhaptics/geometry/segment_crossing.hpp>
 #include <pointhaptics/mechanics/energies/hourglass.hpp>
 #include <pointhaptics/mechanics/stencil.hpp>
 
@@ -18,29 +19,6 @@
 namespace pointhaptics {
 
 namespace {
-
-/// Where the segment p-q crosses triangle (a, b, c), if it does: p and q on different sides of its plane (a
-/// point on the plane is on the normal's side) and the crossing point inside the triangle or on its edges.
-std::optional<Vec3> segment_crossing(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c) {
-  const Vec3 normal = (b - a).cross(c - a);
-  if (normal.squaredNorm() == 0) return std::nullopt;  // the blade moved along its own edge here: it sweeps nothing
-  const double sp = normal.dot(p - a), sq = normal.dot(q - a);
-  if ((sp >= 0) == (sq >= 0)) return std::nullopt;
-  const Vec3 crossing = p + (sp / (sp - sq)) * (q - p);
-  // inside: on the inner side of each edge (barycentric coordinates all non-negative), with a relative
-  // tolerance so that a crossing on the edge two triangles share, rounded either way, is in at least one
-  const double slack = -1e-9 * normal.squaredNorm();
-  if (normal.dot((b - a).cross(crossing - a)) >= slack && normal.dot((c - b).cross(crossing - b)) >= slack &&
-      normal.dot((a - c).cross(crossing - c)) >= slack)
-    return crossing;
-  return std::nullopt;
-}
-
-double distance_to_segment(const Vec3& p, const Vec3& a, const Vec3& b) {
-  const Vec3 ab = b - a;
-  const double t = ab.squaredNorm() > 0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
-  return (p - (a + t * ab)).norm();
-}
 
 /// The row (point i) pair e belongs to.
 index_t row_of(const Csr& nbr, index_t e) {

@@ -25,7 +25,8 @@ struct VertexWeights {
 };
 
 /// The MLS weights of vertex y with support h, widened until the moment matrix is well conditioned.
-VertexWeights vertex_weights(const Model& model, const KdTree& tree, const Vec3& y, double h, index_t vertex, bool skip_uncarried) {
+VertexWeights vertex_weights(const Model& model, const KdTree& tree, const Vec3& y, double h, index_t vertex, bool skip_uncarried,
+                             const VertexSees& sees) {
   std::vector<std::pair<index_t, double>> found;
   nanoflann::SearchParams params;
   params.sorted = false;
@@ -33,6 +34,7 @@ VertexWeights vertex_weights(const Model& model, const KdTree& tree, const Vec3&
   for (int widening = 0; widening <= 5; ++widening, h *= 1.5) {
     found.clear();
     tree.index().radiusSearch(y.data(), h * h, found, params);
+    if (sees) std::erase_if(found, [&](const std::pair<index_t, double>& f) { return !sees(vertex, f.first); });
     if (found.size() < 4) {
       out.widened = true;
       continue;
@@ -70,7 +72,7 @@ VertexWeights vertex_weights(const Model& model, const KdTree& tree, const Vec3&
 
 }  // namespace
 
-SurfaceMap build_surface_map(const Model& model, const Points& Y, std::vector<char>* uncarried) {
+SurfaceMap build_surface_map(const Model& model, const Points& Y, std::vector<char>* uncarried, const VertexSees& sees) {
   if (model.n_points < 4) throw Error(fmt::format("surface: {} points cannot carry a surface (at least 4)", model.n_points));
   if (!Y.allFinite()) throw Error("surface: a vertex is not finite");
   const index_t m = static_cast<index_t>(Y.cols());
@@ -86,7 +88,7 @@ SurfaceMap build_surface_map(const Model& model, const Points& Y, std::vector<ch
         tree.index().knnSearch(y.data(), 1, &nearest, &d2);
         h = model.support[nearest];
       }
-      rows[static_cast<std::size_t>(v)] = vertex_weights(model, tree, y, h, v, uncarried != nullptr);
+      rows[static_cast<std::size_t>(v)] = vertex_weights(model, tree, y, h, v, uncarried != nullptr, sees);
     }
   });
   SurfaceMap map;

@@ -6,6 +6,7 @@
 #include <pointhaptics/core/csr.hpp>
 #include <pointhaptics/core/model.hpp>
 
+#include <functional>
 #include <vector>
 
 namespace pointhaptics {
@@ -25,7 +26,10 @@ struct SurfaceMap {
 /// or too flat for M (condition number above 1e8) takes them within 1.5 h, then 2.25 h, ... (counted in
 /// `widened`); after five widenings it is an Error naming the vertex, unless `uncarried` is given: then such a
 /// vertex gets an empty row and uncarried[v] = 1 (the others 0).
-SurfaceMap build_surface_map(const Model& model, const Points& Y, std::vector<char>* uncarried = nullptr);
+/// With `sees`, a vertex is carried only by the points it sees: sees(v, j) false leaves point j out of vertex
+/// v's neighbourhood (a cut object's vertex, carried by the points on its side of the cuts: cut_surface.hpp).
+using VertexSees = std::function<bool(index_t vertex, index_t point)>;
+SurfaceMap build_surface_map(const Model& model, const Points& Y, std::vector<char>* uncarried = nullptr, const VertexSees& sees = {});
 
 /// W f: a field of the points (k x n, e.g. k = 1 von Mises stress, 9 a stress tensor) at the vertices (k x m),
 /// into `out` (resized once).

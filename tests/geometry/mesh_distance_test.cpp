@@ -1,0 +1,57 @@
+// Tests for geometry/mesh_distance: the signed distance to a box's surface mesh equals the box's exact signed
+// distance everywhere (inside, outside, beside faces, edges and corners), and a sphere's mesh is signed right.
+#include <pointhaptics/geometry/mesh_distance.hpp>
+#include <pointhaptics/geometry/shape_surfaces.hpp>
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+namespace pointhaptics {
+namespace {
+
+double box_signed_distance(const Vec3& p, const Vec3& lo, const Vec3& hi) {
+  const Vec3 centre = 0.5 * (lo + hi), half = 0.5 * (hi - lo);
+  const Vec3 q = (p - centre).cwiseAbs() - half;
+  return q.cwiseMax(0.0).norm() + std::min(q.maxCoeff(), 0.0);
+}
+
+TEST(MeshDistance, EqualsABoxsExactSignedDistanceInsideOutsideAndNearEdgesAndCorners) {
+  const Vec3 origin(-0.02, 0.0, 0.01), size(0.08, 0.04, 0.05);
+  const TriangleMesh mesh = box_surface(origin, size, 0.007);
+  const MeshDistance distance(mesh);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> unit(-0.3, 1.3);
+  int inside = 0;
+  for (int k = 0; k < 3000; ++k) {
+    const Vec3 p = origin + Vec3(unit(rng), unit(rng), unit(rng)).cwiseProduct(size);
+    const double exact = box_signed_distance(p, origin, origin + size);
+    ASSERT_NEAR(distance.signed_distance(p), exact, 1e-12) << p.transpose();
+    inside += exact < 0;
+  }
+  EXPECT_GT(inside, 500);
+  // on a vertex, an edge's middle and a corner, just inside and just outside
+  for (const Vec3& on : {origin, Vec3(origin + Vec3(0.5 * size.x(), 0, 0)), Vec3(origin + size)}) {
+    const Vec3 centre = origin + 0.5 * size;
+    EXPECT_LT(distance.signed_distance(on + 1e-6 * (centre - on).normalized()), 0);
+    EXPECT_GT(distance.signed_distance(on - 1e-6 * (centre - on).normalized()), 0);
+  }
+}
+
+TEST(MeshDistance, SignsASpheresMeshRight) {
+  const TriangleMesh mesh = sphere_surface(Vec3(0.01, 0.02, 0.03), 0.05, 0.004);
+  const MeshDistance distance(mesh);
+  std::mt19937 rng(3);
+  std::normal_distribution<double> normal;
+  for (int k = 0; k < 1000; ++k) {
+    const Vec3 direction = Vec3(normal(rng), normal(rng), normal(rng)).normalized();
+    for (const double r : {0.0, 0.02, 0.045, 0.055, 0.08}) {
+      const double d = distance.signed_distance(Vec3(0.01, 0.02, 0.03) + r * direction);
+      EXPECT_EQ(d < 0, r < 0.05) << r;
+      EXPECT_NEAR(d, r - 0.05, 0.05 * 0.02) << r;  // the mesh's chords lie within a small part of the radius
+    }
+  }
+}
+
+}  // namespace
+}  // namespace pointhaptics
