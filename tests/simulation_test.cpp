@@ -1,6 +1,7 @@
 // Tests for simulation and scene_builder: scenes to models, loads and supports, and the seed's
 // cantilever against CalculiX (docs/cantilever-calculix.md).
 #include <pointhaptics/pointhaptics.hpp>
+#include <pointhaptics/geometry/shape_surfaces.hpp>
 #include <pointhaptics/solvers/explicit_solver.hpp>
 
 #include "support/test_scenes.hpp"
@@ -229,6 +230,22 @@ TEST(Simulation, AScriptedBladeThroughTheRootDropsTheFreePieceAndLeavesTheStump)
   EXPECT_NEAR(free_velocity, -9.81 / 20.0, 0.02 * 9.81 / 20.0);
   const std::string json = result_json(model, state, s);
   EXPECT_NE(json.find("\"pieces\": 2"), std::string::npos);
+  // the surface split along the cut's sheets: closed (the volume of the two pieces), and no triangle spans the
+  // gap (the unsplit surface stretches across it)
+  const ObjectSurface whole = build_object_surface(scene, model);
+  ASSERT_FALSE(sim.cut_sheets().empty());
+  const ObjectSurface split = split_surface(whole, model, sim.cut_sheets());
+  EXPECT_GT(split.cut_faces, 0);
+  auto longest_edge = [](const TriangleMesh& mesh) {
+    double longest = 0;
+    for (const auto& f : mesh.F)
+      for (int k = 0; k < 3; ++k) longest = std::max(longest, (mesh.V.col(f[k]) - mesh.V.col(f[(k + 1) % 3])).norm());
+    return longest;
+  };
+  const TriangleMesh deformed{deformed_surface(split, state.u), split.mesh.F};
+  EXPECT_LT(longest_edge(deformed), 2 * longest_edge(whole.mesh));
+  EXPECT_GT(longest_edge(TriangleMesh{deformed_surface(whole, state.u), whole.mesh.F}), 0.02);
+  EXPECT_NEAR(enclosed_volume(deformed), enclosed_volume(whole.mesh), 0.01 * enclosed_volume(whole.mesh));
   // levels of detail do not take cuts yet: a named error, the simulation untouched
   EXPECT_THROW(sim.enable_lod(LodParams{}, Vec3(0.1, 0.03, 0.015)), Error);
   EXPECT_FALSE(sim.lod_enabled());

@@ -154,10 +154,11 @@ int run_command(const RunOptions& opt) {
   const double setup_s = session.setup_seconds;
   // the object's surface, for --surface and the ParaView frames, built before the run (a reconstruction
   // too fine for the machine is refused at once)
-  std::optional<ph::ObjectSurface> surface;
-  if (!opt.surface.empty() || vtk) surface = ph::build_object_surface(scene, sim.model());
-  const ph::ObjectSurface* vtk_surface = vtk && surface ? &*surface : nullptr;
-  if (vtk) ph::add_vtk_frame(*vtk, sim, vtk_surface);  // the initial state
+  // (after cuts, split along them: cut_surface.hpp)
+  std::optional<ph::CutSurface> surface;
+  if (!opt.surface.empty() || vtk) surface.emplace(ph::build_object_surface(scene, sim.model()));
+  auto vtk_surface = [&]() -> const ph::ObjectSurface* { return surface ? &surface->at(sim.model(), sim.cut_sheets()) : nullptr; };
+  if (vtk) ph::add_vtk_frame(*vtk, sim, vtk_surface());  // the initial state
   const double start_time = sim.time();
   const bool options_real_time = !opt.deterministic;
   interrupted.store(false);
@@ -184,7 +185,7 @@ int run_command(const RunOptions& opt) {
     // run's step count is not known in advance)
     if (vtk && opt.vtk_every > 0)
       options.after_step = [&](long long step) {
-        if (step % opt.vtk_every == 0) errors.attempt([&] { ph::add_vtk_frame(*vtk, sim, vtk_surface); });
+        if (step % opt.vtk_every == 0) errors.attempt([&] { ph::add_vtk_frame(*vtk, sim, vtk_surface()); });
       };
     interactive = ph::run_interactive(sim, *session.device, options);
     if (force_log) errors.attempt([&] { force_log->commit(); });
@@ -219,17 +220,20 @@ int run_command(const RunOptions& opt) {
       }
       // frames: every vtk_every steps (default: about 50 over the run), and the last state below
       const long long every = opt.vtk_every > 0 ? opt.vtk_every : std::max<long long>(1, n_steps / 50);
-      if (vtk && step % every == 0 && step < n_steps) errors.attempt([&] { ph::add_vtk_frame(*vtk, sim, vtk_surface); });
+      if (vtk && step % every == 0 && step < n_steps) errors.attempt([&] { ph::add_vtk_frame(*vtk, sim, vtk_surface()); });
       return !interrupted.load();
     });
   }
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);
   // the last state (an interactive run writes only the first and the last)
-  if (vtk) errors.attempt([&] { ph::add_vtk_frame(*vtk, sim, vtk_surface); });
+  if (vtk) errors.attempt([&] { ph::add_vtk_frame(*vtk, sim, vtk_surface()); });
   if (!opt.csv.empty()) errors.attempt([&] { ph::write_points_csv(opt.csv, sim); });
   if (!opt.surface.empty())
-    errors.attempt([&] { ph::write_mesh(opt.surface, ph::TriangleMesh{ph::deformed_surface(*surface, sim.state().u), surface->mesh.F}, "--surface"); });
+    errors.attempt([&] {
+      const ph::ObjectSurface& cut = surface->at(sim.model(), sim.cut_sheets());
+      ph::write_mesh(opt.surface, ph::TriangleMesh{ph::deformed_surface(cut, sim.state().u), cut.mesh.F}, "--surface");
+    });
   ph::RunSummary summary = sim.summary();
   summary.interrupted = interrupted.load();
   if (haptic) ph::add_interactive_summary(summary, interactive);

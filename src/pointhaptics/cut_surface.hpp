@@ -10,6 +10,7 @@
 #include <pointhaptics/object_surface.hpp>
 
 #include <array>
+#include <optional>
 #include <span>
 
 namespace pointhaptics {
@@ -29,5 +30,27 @@ using SheetTriangle = std::array<Vec3, 3>;
 ///   be carried is dropped with its triangles.
 /// Without sheets, `whole` itself. The sheets need not be closed, disjoint or inside the object.
 ObjectSurface split_surface(const ObjectSurface& whole, const Model& model, std::span<const SheetTriangle> sheets);
+
+/// An object's surface as its cuts so far leave it: split_surface() again only when the cuts have added sheets
+/// since the last call (they only add).
+class CutSurface {
+ public:
+  explicit CutSurface(ObjectSurface whole) : whole_(std::move(whole)) {}
+  /// The surface split along `sheets` (the whole one without).
+  const ObjectSurface& at(const Model& model, std::span<const SheetTriangle> sheets) {
+    if (sheets.empty()) return whole_;
+    if (!split_ || sheets.size() != split_sheets_) {
+      split_ = split_surface(whole_, model, sheets);
+      split_sheets_ = sheets.size();
+    }
+    return *split_;
+  }
+  const ObjectSurface& whole() const { return whole_; }
+
+ private:
+  ObjectSurface whole_;
+  std::optional<ObjectSurface> split_;
+  std::size_t split_sheets_ = 0;
+};
 
 }  // namespace pointhaptics

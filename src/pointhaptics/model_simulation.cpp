@@ -11,6 +11,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
+#include <numeric>
 
 namespace pointhaptics {
 
@@ -55,11 +57,58 @@ CutReport ModelSimulation::cut(std::span<const BladeSweep> sweeps) {
       stable_dt_ = std::min(stable_dt_, stable_time_step(model_, 0.8, cut_lanczos_steps, n_threads_, report.cut_points));
     solver_impl_ = make_solver(model_, solver_, stable_dt_);
   }
+  // (also when this sweep severed nothing: pairs cross a blade's path unevenly, and a strip left out would
+  // leave the surface whole across it)
+  if (!sweeps.empty()) record_cut_sheet(sweeps.back());
   ++diagnostics_.cuts;
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   diagnostics_.max_cut_seconds = std::max(diagnostics_.max_cut_seconds, seconds);
   diagnostics_.cut_seconds += seconds;
   return report;
+}
+
+void ModelSimulation::record_cut_sheet(const BladeSweep& sweep) {
+  // the points within two supports of the sweep's box (none: it passed beside the object, nothing to record)
+  const double radius = 2.0 * (model_.support.size() ? model_.support.maxCoeff() : model_.h);
+  Vec3 lo = sweep.a0.cwiseMin(sweep.b0).cwiseMin(sweep.a1).cwiseMin(sweep.b1).array() - radius;
+  Vec3 hi = sweep.a0.cwiseMax(sweep.b0).cwiseMax(sweep.a1).cwiseMax(sweep.b1).array() + radius;
+  sheet_points_.clear();  // allocates only to grow
+  for (index_t j = 0; j < model_.n_points; ++j)
+    if ((cut_positions_.col(j).array() >= lo.array()).all() && (cut_positions_.col(j).array() <= hi.array()).all()) sheet_points_.push_back(j);
+  if (sheet_points_.empty()) return;
+  // where the material at current position x was: x less the displacement of the points around it (weighted
+  // by (1 - r / R)^2 within two supports), or of the nearest one (a corner of the sweep outside the object)
+  auto reference = [&](const Vec3& x) -> Vec3 {
+    Vec3 sum = Vec3::Zero(), nearest = Vec3::Zero();
+    double weight = 0, closest = std::numeric_limits<double>::infinity();
+    for (const index_t j : sheet_points_) {
+      const double r = (cut_positions_.col(j) - x).norm();
+      if (r < closest) closest = r, nearest = state_.u.col(j);
+      if (r < radius) {
+        const double w = (1 - r / radius) * (1 - r / radius);
+        sum += w * state_.u.col(j);
+        weight += w;
+      }
+    }
+    return x - (weight > 0 ? Vec3(sum / weight) : nearest);
+  };
+  // a strip that starts where the last one ended starts on its mapped edge: mapped again at another time (by
+  // another displacement) the two would not meet, and the gap or step between them would show
+  const bool continues = sheet_edge_.has_value() && (*sheet_edge_)[0] == sweep.a0 && (*sheet_edge_)[1] == sweep.b0;
+  const Vec3 a0 = continues ? (*sheet_edge_)[2] : reference(sweep.a0), b0 = continues ? (*sheet_edge_)[3] : reference(sweep.b0);
+  const Vec3 a1 = reference(sweep.a1), b1 = reference(sweep.b1);
+  cut_sheets_.push_back({a0, b0, b1});
+  cut_sheets_.push_back({a0, b1, a1});
+  sheet_edge_ = {sweep.a1, sweep.b1, a1, b1};
+}
+
+void ModelSimulation::split_probe_surface() {
+  ProbeAttachment& probe = *probe_;
+  const ObjectSurface split = split_surface(*probe.surface, model_, cut_sheets_);
+  std::vector<index_t> same(static_cast<std::size_t>(model_.n_points));
+  std::iota(same.begin(), same.end(), index_t{0});
+  probe.tool.remap(model_, same, probe_surface_contact(split, probe.contact, probe_shape(probe.tool.contact().params()), model_, nullptr));
+  probe.surface_sheets = cut_sheets_.size();
 }
 
 // ---- the step pipeline below the active set: each stage is one function, in the order step() calls them ----
@@ -102,6 +151,9 @@ void ModelSimulation::place_tools() {
       blade_strips_.push_back(BladeSweep{trail[k][0], trail[k][1], to[0], to[1]});
     }
     tool.resist_cut(model_, blade_strips_.empty() ? CutReport{} : cut(blade_strips_), solver_.dt);
+  } else if (probe_->surface && probe_->surface_sheets != cut_sheets_.size()) {
+    // the blade lifted (or a scripted cut went on): the probe pushes on the split surface from now on
+    split_probe_surface();
   }
 }
 

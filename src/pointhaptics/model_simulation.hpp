@@ -8,6 +8,7 @@
 #include <pointhaptics/haptics/probe_tool.hpp>
 #include <pointhaptics/lod/active_set.hpp>
 #include <pointhaptics/mechanics/cut.hpp>
+#include <pointhaptics/cut_surface.hpp>
 #include <pointhaptics/object_surface.hpp>
 #include <pointhaptics/solvers/solver.hpp>
 
@@ -58,6 +59,7 @@ struct ProbeAttachment {
   /// levels of detail every new active set gets the part of it that it carries (probe_surface_contact()).
   std::shared_ptr<const ObjectSurface> surface;
   SurfaceContactParams contact;
+  std::size_t surface_sheets = 0;  ///< the cut sheets the contact's surface is split along (ModelSimulation::cut_sheets)
 };
 
 /// The probe's contact with `surface` (of the object) over `model`'s points: the whole surface, or with
@@ -87,6 +89,11 @@ class ModelSimulation {
   /// one update in the diagnostics.
   CutReport cut(std::span<const BladeSweep> sweeps);
   CutReport cut(const BladeSweep& sweep) { return cut(std::span<const BladeSweep>(&sweep, 1)); }
+  /// The sheets the cuts swept, in the reference configuration: of each cut near the object, its last sweep
+  /// (a blade step's new strip; the others are the trail behind it), mapped back by the displacement of the
+  /// points around it. split_surface() splits the object's surface along them; a probe that
+  /// pushes on the surface gets the split surface when it is not cutting (one split per stroke of the blade).
+  const std::vector<SheetTriangle>& cut_sheets() const { return cut_sheets_; }
   /// Replace the state (same model). Throws Error for a state of another size.
   void set_state(const State& state);
   StepInputs& inputs() { return inputs_; }
@@ -106,6 +113,8 @@ class ModelSimulation {
  private:
   friend class LevelsOfDetail;  // takes the object's model, state, diagnostics and probe over
   void place_tools();
+  void record_cut_sheet(const BladeSweep& sweep);
+  void split_probe_surface();
   void check_finite(StepReport& report) const;
   void count_inverted_neighbourhoods();
   void record(const StepReport& report, double seconds);
@@ -119,6 +128,9 @@ class ModelSimulation {
   static constexpr int cut_lanczos_steps = 12;
   Points cut_positions_;                 ///< X + u at a cut (kept: no allocation per blade step)
   std::vector<BladeSweep> blade_strips_;  ///< a blade's strips this step
+  std::vector<SheetTriangle> cut_sheets_;
+  std::vector<index_t> sheet_points_;     ///< the points near a sheet being recorded (kept: no allocation per step)
+  std::optional<std::array<Vec3, 4>> sheet_edge_;  ///< the last sheet's end edge: where it is now, and mapped back
   std::unique_ptr<Solver> solver_impl_;
   StepInputs inputs_;
   StepReport report_;

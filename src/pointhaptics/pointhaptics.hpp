@@ -14,4 +14,5 @@
 #include <pointhaptics/simulation.hpp>
 #include <pointhaptics/vtk_output.hpp>
 #include <pointhaptics/csv_output.hpp>
+#include <pointhaptics/cut_surface.hpp>
 #include <pointhaptics/object_surface.hpp>

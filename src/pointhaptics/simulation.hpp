@@ -84,6 +84,9 @@ class Simulation {
   /// Cut now, between steps, where `sweep` crosses the object at its current positions (ModelSimulation::cut).
   /// Throws Error with levels of detail (not yet: a cut in the active set would not reach the object).
   CutReport cut(const BladeSweep& sweep);
+  /// The sheets the cuts swept so far, in the reference configuration (ModelSimulation::cut_sheets): the
+  /// object's surface split along them (split_surface()) is the cut object's.
+  const std::vector<SheetTriangle>& cut_sheets() const { return core().cut_sheets(); }
 
   /// Levels of detail (seed §3): from now on simulate only the points selected around `contact` (the
   /// reference configuration, m; snapped to the nearest point of the object). Throws Error on bad
