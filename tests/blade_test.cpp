@@ -5,6 +5,7 @@
 #include <pointhaptics/haptics/devices/virtual_device.hpp>
 #include <pointhaptics/interactive.hpp>
 #include <pointhaptics/io/scene_toml.hpp>
+#include <pointhaptics/object_surface.hpp>
 #include <pointhaptics/scene_builder.hpp>
 
 #include <gtest/gtest.h>
@@ -89,6 +90,51 @@ TEST(Blade, ADevicesBladeCutsTheCantileverThroughAndTheHandFeelsTheResistance) {
   std::printf("cut pairs %lld, area %.4g m^2, work %.4g J (G A = %.4g J), largest force %.3g N (G x 3 cm = %.3g N), "
               "largest step-to-step change %.3g N, longest sweep %.3g ms\n",
               s.cut.cut_pairs, area, work, resistance * area, largest, resistance * 0.03, largest_step, s.cut.max_update_ms);
+}
+
+TEST(Blade, LiftedAfterAStrokeTheBladePushesOnTheSplitSurfaceAndStopsAtTheCutFace) {
+  // the blade cuts through as above with the probe on the object's surface; the button let go below the beam,
+  // it goes round (beside the beam in z), waits in the gap the falling piece leaves, and is pushed 1.4 cm into
+  // the stump's cut face at x = 3.375 cm
+  const Scene scene = beam();
+  Simulation sim(build_scene_model(scene), scene.solver, 2);
+  const auto whole = std::make_shared<const ObjectSurface>(build_object_surface(scene, sim.model()));
+  const Vec3 above(0.03375, 0.05, 0.015);
+  VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), true},
+                                   {0.05, Vec3::Zero(), true},
+                                   {0.25, Vec3(0, -0.07, 0), true},
+                                   {0.27, Vec3(0, -0.07, 0), false},
+                                   {0.30, Vec3(0, -0.07, 0.045), false},
+                                   {0.35, Vec3(0.0165, -0.07, 0.045), false},
+                                   {0.40, Vec3(0.0165, -0.035, 0.045), false},
+                                   {0.55, Vec3(0.0165, -0.035, 0), false},
+                                   {0.75, Vec3(-0.0135, -0.035, 0), false},
+                                   {0.85, Vec3(-0.0135, -0.035, 0), false}}),
+                       known_device_specs("touch"));
+  InteractiveOptions o = blade(above, 0.85);
+  o.surface = whole;
+  Vec3 probe = Vec3::Constant(NAN), force = Vec3::Constant(NAN);
+  index_t vertices = 0;
+  o.after_step = [&](long long) {  // (the probe is detached when the run ends)
+    const ProbeTool* tool = sim.probe();
+    probe = tool->probe();
+    force = tool->contact_model().f0;
+    vertices = tool->on_surface() ? tool->surface_contact()->map().n_vertices() : 0;
+  };
+  run_interactive(sim, device, o);
+  ASSERT_FALSE(sim.diagnostics().failed) << sim.diagnostics().failure;
+  const RunSummary s = sim.summary();
+  ASSERT_EQ(s.cut.piece_points.size(), 2u);
+  // once the button was let go the probe's surface was split along the stroke's sheets, once
+  EXPECT_EQ(s.cut.surface_splits, 1);
+  EXPECT_GT(vertices, whole->map.n_vertices());
+  // the blade (radius 1 mm) stands on the stump's cut face, pushed back along +x; the hand is 1.4 cm beyond
+  const double face = 0.03375 + 0.001;
+  EXPECT_NEAR(probe.x(), face, 0.0015) << probe.transpose();
+  EXPECT_GT(force.x(), 0.5);
+  EXPECT_LT(std::abs(force.y()), 0.2 * force.x());
+  std::printf("lifted blade: at (%.5f, %.5f, %.5f) m against the face at x = %.5f m, force (%.3g, %.3g, %.3g) N, split in %.2f ms\n",
+              probe.x(), probe.y(), probe.z(), face, force.x(), force.y(), force.z(), s.cut.max_split_ms);
 }
 
 TEST(Blade, SawingForASecondStaysFiniteBoundedAndWithinTheDevice) {

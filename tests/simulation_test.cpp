@@ -233,8 +233,10 @@ TEST(Simulation, AScriptedBladeThroughTheRootDropsTheFreePieceAndLeavesTheStump)
   // the surface split along the cut's sheets: closed (the volume of the two pieces), and no triangle spans the
   // gap (the unsplit surface stretches across it)
   const ObjectSurface whole = build_object_surface(scene, model);
-  ASSERT_FALSE(sim.cut_sheets().empty());
-  const ObjectSurface split = split_surface(whole, model, sim.cut_sheets());
+  // a straight cut through a sagging beam: its 50 strips mapped back make a few quads, one per bend of a
+  // hundredth of the spacing
+  EXPECT_LE(sim.cut_sheets().triangles.size(), 10u);
+  const ObjectSurface split = split_surface(whole, model, sim.cut_sheets().triangles);
   EXPECT_GT(split.cut_faces, 0);
   auto longest_edge = [](const TriangleMesh& mesh) {
     double longest = 0;

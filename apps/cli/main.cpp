@@ -99,8 +99,10 @@ void print_summary(ph::Simulation& sim, const ph::RunSummary& s, double setup_s)
     std::string sizes;
     for (size_t p = 0; p < s.cut.piece_points.size(); ++p) sizes += fmt::format("{}{}", p ? ", " : "", s.cut.piece_points[p]);
     fmt::print("cut             {} steps cut, severing {} neighbour pairs; {} piece(s) of {} points; an update took {:.2f} ms "
-               "on average, {:.2f} ms at most\n",
-               s.cut.sweeps, s.cut.cut_pairs, s.cut.piece_points.size(), sizes, s.cut.mean_update_ms, s.cut.max_update_ms);
+               "on average, {:.2f} ms at most; {} sheet triangles{}\n",
+               s.cut.sweeps, s.cut.cut_pairs, s.cut.piece_points.size(), sizes, s.cut.mean_update_ms, s.cut.max_update_ms,
+               s.cut.sheet_triangles,
+               s.cut.surface_splits ? fmt::format(", the probe's surface split {} times (at most {:.1f} ms)", s.cut.surface_splits, s.cut.max_split_ms) : "");
   }
   if (s.lod.enabled) {
     std::string bands;

@@ -215,6 +215,25 @@ void add_sheet_faces(const TriangleMesh& mesh, std::span<const SheetTriangle> sh
 
 }  // namespace
 
+void CutSheets::add_strip(const Vec3& A0, const Vec3& B0, const Vec3& A1, const Vec3& B1, bool continues, double tolerance) {
+  ++revision;
+  const std::size_t n = triangles.size();
+  if (continues && n >= 2) {
+    // the last strip: (P0, Q0, Q1), (P0, Q1, P1), ending on P1-Q1, where this one starts
+    const Vec3 P0 = triangles[n - 2][0], Q0 = triangles[n - 2][1], P1 = triangles[n - 1][2], Q1 = triangles[n - 2][2];
+    const Vec3 normal = (Q0 - P0).cross(B1 - P0);
+    const bool straight = distance_to_segment(P1, P0, A1) <= tolerance && distance_to_segment(Q1, Q0, B1) <= tolerance &&
+                          normal.norm() > 0 && std::abs(normal.normalized().dot(A1 - P0)) <= tolerance;
+    if (straight) {
+      triangles[n - 2] = {P0, Q0, B1};
+      triangles[n - 1] = {P0, B1, A1};
+      return;
+    }
+  }
+  triangles.push_back({A0, B0, B1});
+  triangles.push_back({A0, B1, A1});
+}
+
 ObjectSurface split_surface(const ObjectSurface& whole, const Model& model, std::span<const SheetTriangle> sheets) {
   if (sheets.empty()) return whole;
   const TriangleMesh& mesh = whole.mesh;

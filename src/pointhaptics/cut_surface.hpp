@@ -18,6 +18,18 @@ namespace pointhaptics {
 /// A triangle of a blade's swept surface, in the reference configuration, m.
 using SheetTriangle = std::array<Vec3, 3>;
 
+/// The sheets a blade's cuts swept, in the reference configuration.
+struct CutSheets {
+  std::vector<SheetTriangle> triangles;
+  long long revision = 0;  ///< counts the changes: a strip added or extended
+
+  /// Add the strip the edge A0-B0 swept moving to A1-B1, as the triangles (A0, B0, B1) and (A0, B1, A1). With
+  /// `continues` (it starts on the last strip's end edge), a strip that goes on straight from the last one,
+  /// within `tolerance` (m), extends it instead: a straight cut stays one quad however many steps it took, and
+  /// a curved one takes a quad per bend of that size.
+  void add_strip(const Vec3& A0, const Vec3& B0, const Vec3& A1, const Vec3& B1, bool continues, double tolerance);
+};
+
 /// `whole`, the uncut object's surface (closed), split by `sheets` over the cut `model`:
 /// - an edge of the surface that crosses a sheet gets a vertex where it crosses, once for each side; a
 ///   triangle with two such edges is split into the part on its lone corner's side and the part on the
@@ -37,11 +49,11 @@ class CutSurface {
  public:
   explicit CutSurface(ObjectSurface whole) : whole_(std::move(whole)) {}
   /// The surface split along `sheets` (the whole one without).
-  const ObjectSurface& at(const Model& model, std::span<const SheetTriangle> sheets) {
-    if (sheets.empty()) return whole_;
-    if (!split_ || sheets.size() != split_sheets_) {
-      split_ = split_surface(whole_, model, sheets);
-      split_sheets_ = sheets.size();
+  const ObjectSurface& at(const Model& model, const CutSheets& sheets) {
+    if (sheets.triangles.empty()) return whole_;
+    if (!split_ || sheets.revision != split_revision_) {
+      split_ = split_surface(whole_, model, sheets.triangles);
+      split_revision_ = sheets.revision;
     }
     return *split_;
   }
@@ -50,7 +62,7 @@ class CutSurface {
  private:
   ObjectSurface whole_;
   std::optional<ObjectSurface> split_;
-  std::size_t split_sheets_ = 0;
+  long long split_revision_ = 0;
 };
 
 }  // namespace pointhaptics

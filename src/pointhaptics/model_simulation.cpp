@@ -7,6 +7,7 @@
 #include <pointhaptics/solvers/explicit_solver.hpp>
 
 #include <fmt/format.h>
+#include <oneapi/tbb/task_arena.h>
 
 #include <algorithm>
 #include <chrono>
@@ -97,18 +98,45 @@ void ModelSimulation::record_cut_sheet(const BladeSweep& sweep) {
   const bool continues = sheet_edge_.has_value() && (*sheet_edge_)[0] == sweep.a0 && (*sheet_edge_)[1] == sweep.b0;
   const Vec3 a0 = continues ? (*sheet_edge_)[2] : reference(sweep.a0), b0 = continues ? (*sheet_edge_)[3] : reference(sweep.b0);
   const Vec3 a1 = reference(sweep.a1), b1 = reference(sweep.b1);
-  cut_sheets_.push_back({a0, b0, b1});
-  cut_sheets_.push_back({a0, b1, a1});
+  // (a straight run of strips is kept as one quad, to within a hundredth of the spacing)
+  cut_sheets_.add_strip(a0, b0, a1, b1, continues, 0.01 * (model_.spacing > 0 ? model_.spacing : 0.5 * model_.h));
   sheet_edge_ = {sweep.a1, sweep.b1, a1, b1};
 }
 
-void ModelSimulation::split_probe_surface() {
+void ModelSimulation::refresh_probe_surface() {
   ProbeAttachment& probe = *probe_;
-  const ObjectSurface split = split_surface(*probe.surface, model_, cut_sheets_);
-  std::vector<index_t> same(static_cast<std::size_t>(model_.n_points));
-  std::iota(same.begin(), same.end(), index_t{0});
-  probe.tool.remap(model_, same, probe_surface_contact(split, probe.contact, probe_shape(probe.tool.contact().params()), model_, nullptr));
-  probe.surface_sheets = cut_sheets_.size();
+  if (split_.valid()) {
+    if (split_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;  // the worker is at it
+    SplitContact done = split_.get();
+    std::vector<index_t> same(static_cast<std::size_t>(model_.n_points));
+    std::iota(same.begin(), same.end(), index_t{0});
+    probe.tool.remap(model_, same, std::move(done.contact));
+    probe.surface_revision = done.revision;
+    ++diagnostics_.surface_splits;
+    diagnostics_.max_split_seconds = std::max(diagnostics_.max_split_seconds, done.seconds);
+  }
+  if (probe.surface_revision == cut_sheets_.revision) return;
+  // on one thread: in real time the other core runs the haptic loop
+  auto split = [surface = probe.surface, sheets = cut_sheets_, params = probe.contact,
+                shape = probe_shape(probe.tool.contact().params()), &model = model_]() {
+    const auto start = std::chrono::steady_clock::now();
+    tbb::task_arena one_thread(1);
+    SplitContact made = one_thread.execute([&] {
+      return SplitContact{probe_surface_contact(split_surface(*surface, model, sheets.triangles), params, shape, model, nullptr),
+                          sheets.revision};
+    });
+    made.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return made;
+  };
+  // in real time on a worker, taken over at a later step; otherwise now (reproducible runs)
+  if (probe.asynchronous_lod) {
+    split_ = std::async(std::launch::async, std::move(split));
+  } else {
+    std::promise<SplitContact> now;
+    now.set_value(split());
+    split_ = now.get_future();
+    refresh_probe_surface();
+  }
 }
 
 // ---- the step pipeline below the active set: each stage is one function, in the order step() calls them ----
@@ -151,9 +179,9 @@ void ModelSimulation::place_tools() {
       blade_strips_.push_back(BladeSweep{trail[k][0], trail[k][1], to[0], to[1]});
     }
     tool.resist_cut(model_, blade_strips_.empty() ? CutReport{} : cut(blade_strips_), solver_.dt);
-  } else if (probe_->surface && probe_->surface_sheets != cut_sheets_.size()) {
+  } else if (probe_->surface && (split_.valid() || probe_->surface_revision != cut_sheets_.revision)) {
     // the blade lifted (or a scripted cut went on): the probe pushes on the split surface from now on
-    split_probe_surface();
+    refresh_probe_surface();
   }
 }
 

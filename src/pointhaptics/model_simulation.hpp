@@ -10,6 +10,8 @@
 #include <pointhaptics/mechanics/cut.hpp>
 #include <pointhaptics/cut_surface.hpp>
 #include <pointhaptics/object_surface.hpp>
+
+#include <future>
 #include <pointhaptics/solvers/solver.hpp>
 
 #include <memory>
@@ -49,6 +51,8 @@ struct StepDiagnostics {
   long long cuts = 0;           ///< cut updates (ModelSimulation::cut: a blade step's sweeps)
   double max_cut_seconds = 0;   ///< the longest of them, the stable step and the solver's rebuild included, s
   double cut_seconds = 0;       ///< all of them, s
+  long long surface_splits = 0; ///< a probe's surface split along the cuts' sheets (when it stops cutting)
+  double max_split_seconds = 0; ///< the longest split, s (off the simulation's thread in real time)
 };
 
 /// The probe's tool and its settings, as a simulation holds them (carried to the next active model).
@@ -59,7 +63,7 @@ struct ProbeAttachment {
   /// levels of detail every new active set gets the part of it that it carries (probe_surface_contact()).
   std::shared_ptr<const ObjectSurface> surface;
   SurfaceContactParams contact;
-  std::size_t surface_sheets = 0;  ///< the cut sheets the contact's surface is split along (ModelSimulation::cut_sheets)
+  long long surface_revision = 0;  ///< of the cut sheets the contact's surface is split along (ModelSimulation::cut_sheets)
 };
 
 /// The probe's contact with `surface` (of the object) over `model`'s points: the whole surface, or with
@@ -93,7 +97,7 @@ class ModelSimulation {
   /// (a blade step's new strip; the others are the trail behind it), mapped back by the displacement of the
   /// points around it. split_surface() splits the object's surface along them; a probe that
   /// pushes on the surface gets the split surface when it is not cutting (one split per stroke of the blade).
-  const std::vector<SheetTriangle>& cut_sheets() const { return cut_sheets_; }
+  const CutSheets& cut_sheets() const { return cut_sheets_; }
   /// Replace the state (same model). Throws Error for a state of another size.
   void set_state(const State& state);
   StepInputs& inputs() { return inputs_; }
@@ -114,7 +118,7 @@ class ModelSimulation {
   friend class LevelsOfDetail;  // takes the object's model, state, diagnostics and probe over
   void place_tools();
   void record_cut_sheet(const BladeSweep& sweep);
-  void split_probe_surface();
+  void refresh_probe_surface();
   void check_finite(StepReport& report) const;
   void count_inverted_neighbourhoods();
   void record(const StepReport& report, double seconds);
@@ -128,7 +132,7 @@ class ModelSimulation {
   static constexpr int cut_lanczos_steps = 12;
   Points cut_positions_;                 ///< X + u at a cut (kept: no allocation per blade step)
   std::vector<BladeSweep> blade_strips_;  ///< a blade's strips this step
-  std::vector<SheetTriangle> cut_sheets_;
+  CutSheets cut_sheets_;
   std::vector<index_t> sheet_points_;     ///< the points near a sheet being recorded (kept: no allocation per step)
   std::optional<std::array<Vec3, 4>> sheet_edge_;  ///< the last sheet's end edge: where it is now, and mapped back
   std::unique_ptr<Solver> solver_impl_;
@@ -137,6 +141,14 @@ class ModelSimulation {
   StepDiagnostics diagnostics_;
   std::optional<ProbeAttachment> probe_;
   std::unique_ptr<HeldTool> held_tool_;
+  /// The probe's contact with the surface split along the sheets of a revision, being made on a worker
+  /// thread in real time (declared last: destroyed first, it waits for the worker, which reads model_).
+  struct SplitContact {
+    SurfaceContact contact;
+    long long revision = 0;
+    double seconds = 0;
+  };
+  std::future<SplitContact> split_;
 };
 
 }  // namespace pointhaptics

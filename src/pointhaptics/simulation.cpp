@@ -299,6 +299,9 @@ RunSummary Simulation::summary() {
     s.cut.cut_pairs = model.diagnostics.severed_pairs;
     s.cut.max_update_ms = 1e3 * d.max_cut_seconds;
     s.cut.mean_update_ms = d.cuts > 0 ? 1e3 * d.cut_seconds / static_cast<double>(d.cuts) : 0.0;
+    s.cut.sheet_triangles = static_cast<long long>(cut_sheets().triangles.size());
+    s.cut.surface_splits = d.surface_splits;
+    s.cut.max_split_ms = 1e3 * d.max_split_seconds;
     std::vector<index_t> piece_of;
     s.cut.piece_points = piece_sizes(model, piece_of);
   }

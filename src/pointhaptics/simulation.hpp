@@ -86,7 +86,7 @@ class Simulation {
   CutReport cut(const BladeSweep& sweep);
   /// The sheets the cuts swept so far, in the reference configuration (ModelSimulation::cut_sheets): the
   /// object's surface split along them (split_surface()) is the cut object's.
-  const std::vector<SheetTriangle>& cut_sheets() const { return core().cut_sheets(); }
+  const CutSheets& cut_sheets() const { return core().cut_sheets(); }
 
   /// Levels of detail (seed §3): from now on simulate only the points selected around `contact` (the
   /// reference configuration, m; snapped to the nearest point of the object). Throws Error on bad

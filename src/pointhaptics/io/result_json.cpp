@@ -83,7 +83,10 @@ std::string result_json(const Model& model, const State& state, const RunSummary
                   {"max_update_ms", c.max_update_ms},
                   {"mean_update_ms", c.mean_update_ms},
                   {"pieces", c.piece_points.size()},
-                  {"piece_points", c.piece_points}};
+                  {"piece_points", c.piece_points},
+                  {"sheet_triangles", c.sheet_triangles},
+                  {"surface_splits", c.surface_splits},
+                  {"max_split_ms", c.max_split_ms}};
   }
   // without levels of detail every point is simulated
   const LodSummary& l = s.lod;
