@@ -33,7 +33,7 @@ Rgb paler(const Rgb& c) { return {0.35f * c[0] + 0.65f * 0.55f, 0.35f * c[1] + 0
 // rise at once, fall slowly, so the colours do not flicker
 void follow_scale(float& top, double largest, float floor) { top = std::max({static_cast<float>(largest), 0.97f * top, floor}); }
 
-bool surface_drawn(const Prepared& p, const SceneView& view) { return p.surface && view.draw_surface; }
+bool surface_drawn(const Prepared& p, const SceneView& view) { return p.drawn_surface() && view.draw_surface; }
 
 /// The colour of point i (its flags first, then the chosen field: `magnitude` is its displacement's norm,
 /// m, or its von Mises stress, Pa, as view.colour_by says); with `pale_unsimulated`, paler where levels of
@@ -84,7 +84,7 @@ void build_spheres(const Prepared& p, const DisplayFrame& f, SceneView& view) {
 void build_surface(const Prepared& p, const DisplayFrame& f, SceneView& view) {
   view.surface_vertices.clear();
   if (!surface_drawn(p, view)) return;
-  const ObjectSurface& surface = *p.surface;
+  const ObjectSurface& surface = *p.drawn_surface();
   const Eigen::Index n = p.reference.cols(), m = surface.mesh.V.cols();
   if (view.indexed_surface != &surface) {  // a new object (a rebuild): its triangles
     view.indexed_surface = &surface;
@@ -109,7 +109,7 @@ void build_surface(const Prepared& p, const DisplayFrame& f, SceneView& view) {
     const Vec3 y = view.surface_positions.col(v);
     const Vec3 normal = view.surface_normals.col(v).normalized();
     const double magnitude = stress ? view.surface_stress(0, v) : (y - surface.mesh.V.col(v)).norm();
-    const Rgb c = point_colour(p, f, view, static_cast<std::size_t>(p.surface_point[static_cast<std::size_t>(v)]), magnitude, false);
+    const Rgb c = point_colour(p, f, view, static_cast<std::size_t>(p.drawn_surface_point()[static_cast<std::size_t>(v)]), magnitude, false);
     view.surface_vertices.push_back({static_cast<float>(y.x()), static_cast<float>(y.y()), static_cast<float>(y.z()),
                                      static_cast<float>(normal.x()), static_cast<float>(normal.y()), static_cast<float>(normal.z()), c[0],
                                      c[1], c[2]});
@@ -192,7 +192,9 @@ void write_frame_info(const std::string& path, const Prepared& p, const DisplayF
   for (Eigen::Index i = 0; i < x.cols(); i += stride) samples.push_back(vec(x.col(i)));
   j["sample_points"] = std::move(samples);
   // the drawn surface: its triangles, and a few deformed vertices for tests to project
-  j["surface"] = {{"drawn", !view.surface_vertices.empty()}, {"triangles", view.surface_indices.size() / 3}};
+  j["surface"] = {{"drawn", !view.surface_vertices.empty()},
+                  {"triangles", view.surface_indices.size() / 3},
+                  {"cut_faces", p.drawn_surface() ? p.drawn_surface()->cut_faces : 0}};
   json surface_samples = json::array();
   const std::size_t vertex_stride = std::max<std::size_t>(1, view.surface_vertices.size() / 300);
   for (std::size_t v = 0; v < view.surface_vertices.size(); v += vertex_stride) {

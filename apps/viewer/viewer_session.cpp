@@ -4,6 +4,7 @@
 #include <pointhaptics/scene_session.hpp>
 
 #include <fmt/format.h>
+#include <oneapi/tbb/task_arena.h>
 
 #include <algorithm>
 #include <chrono>
@@ -103,16 +104,7 @@ std::unique_ptr<Prepared> prepare(const Scene& scene_in, ProbeSource source, int
   } catch (const Error& e) {  // the points are drawn instead, and the panel says why
     p->note += std::string(p->note.empty() ? "" : "; ") + "no surface: " + e.what();
   }
-  if (p->surface) {
-    const SurfaceMap& map = p->surface->map;
-    p->surface_point.resize(static_cast<std::size_t>(map.n_vertices()));
-    for (index_t v = 0; v < map.n_vertices(); ++v) {
-      index_t heaviest = map.points.begin(v);
-      for (index_t e = map.points.begin(v); e < map.points.end(v); ++e)
-        if (map.weight[e] > map.weight[heaviest]) heaviest = e;
-      p->surface_point[static_cast<std::size_t>(v)] = map.points.index[heaviest];
-    }
-  }
+  if (p->surface) p->surface_point = heaviest_points(p->surface->map);
   // the mouse pushes, and grabs while its button is held; a scene's grab mode grabs only, its blade cuts while
   // the button is held
   if (!scene.probe.grab && !scene.probe.cut) p->options.probe.mode = ProbeMode::PUSH_GRAB;
@@ -133,6 +125,25 @@ std::unique_ptr<Prepared> prepare(const Scene& scene_in, ProbeSource source, int
   return p;
 }
 
+std::vector<index_t> heaviest_points(const SurfaceMap& map) {
+  std::vector<index_t> point(static_cast<std::size_t>(map.n_vertices()), 0);
+  for (index_t v = 0; v < map.n_vertices(); ++v) {
+    if (map.points.end(v) == map.points.begin(v)) continue;
+    index_t heaviest = map.points.begin(v);
+    for (index_t e = map.points.begin(v); e < map.points.end(v); ++e)
+      if (map.weight[e] > map.weight[heaviest]) heaviest = e;
+    point[static_cast<std::size_t>(v)] = map.points.index[heaviest];
+  }
+  return point;
+}
+
+void split_surface_now(Prepared& p, const DisplayFrame& frame) {
+  if (!p.surface || frame.cut_revision == p.cut_revision || frame.cut_sheets.empty()) return;
+  p.cut_surface = split_surface(*p.surface, p.simulation->model(), frame.cut_sheets);
+  p.cut_surface_point = heaviest_points(p.cut_surface->map);
+  p.cut_revision = frame.cut_revision;
+}
+
 DisplayFrame simulate_frame(Prepared& p, double time) {
   DisplayFrame frame = p.display->front();
   if (!(time > 0)) return frame;
@@ -142,6 +153,7 @@ DisplayFrame simulate_frame(Prepared& p, double time) {
   o.display = p.display.get();
   run_interactive(*p.simulation, *p.device, o);
   p.display->update();
+  split_surface_now(p, p.display->front());
   return p.display->front();
 }
 
@@ -151,6 +163,7 @@ ViewerSession::ViewerSession(std::unique_ptr<Prepared> prepared, ProbeSource sou
 ViewerSession::~ViewerSession() {
   stop();
   if (pending_.valid()) pending_.wait();
+  if (split_.valid()) split_.wait();
 }
 
 void ViewerSession::start() {
@@ -187,6 +200,7 @@ void ViewerSession::rebuild(const Scene& scene) {
 bool ViewerSession::poll() {
   prepared_->display->update();
   if (finished_.load(std::memory_order_acquire) && thread_.joinable()) stop();  // collect the error
+  poll_cut_surface();
   if (!pending_.valid() || pending_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return false;
   std::unique_ptr<Prepared> next;
   try {
@@ -196,10 +210,32 @@ bool ViewerSession::poll() {
     return false;
   }
   stop();
+  if (split_.valid()) split_.get();  // a split for the old object: it reads it
   prepared_ = std::move(next);
   error_.clear();
   start();
   return true;
+}
+
+void ViewerSession::poll_cut_surface() {
+  Prepared& p = *prepared_;
+  if (split_.valid()) {
+    if (split_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
+    Split done = split_.get();
+    if (done.of == &p && done.revision != p.cut_revision) {
+      p.cut_surface = std::move(done.surface);
+      p.cut_surface_point = heaviest_points(p.cut_surface->map);
+      p.cut_revision = done.revision;
+    }
+  }
+  const DisplayFrame& frame = p.display->front();
+  if (!p.surface || frame.cut_revision == p.cut_revision || frame.cut_sheets.empty()) return;
+  // on a worker, on one thread (the simulation and the haptic loop have the cores); the model's reference
+  // positions, kernel and supports, all the split reads of it, do not change while it runs
+  split_ = std::async(std::launch::async, [&p, sheets = frame.cut_sheets, revision = frame.cut_revision] {
+    tbb::task_arena one_thread(1);
+    return one_thread.execute([&] { return Split{split_surface(*p.surface, p.simulation->model(), sheets), &p, revision}; });
+  });
 }
 
 Vec3 ViewerSession::device_of_scene(const Vec3& scene) const {

@@ -40,6 +40,15 @@ struct Prepared {
   /// (whose flags, band and grab the vertex shows).
   std::optional<ObjectSurface> surface;
   std::vector<index_t> surface_point;
+  /// After cuts: the surface split along their sheets (cut_surface.hpp) as of the frame's cut_revision, drawn
+  /// instead of `surface`, and its vertices' points of largest weight.
+  std::optional<ObjectSurface> cut_surface;
+  std::vector<index_t> cut_surface_point;
+  long long cut_revision = 0;
+
+  /// The surface drawn (the cut one after cuts), or null; and its vertices' points of largest weight.
+  const ObjectSurface* drawn_surface() const { return cut_surface ? &*cut_surface : surface ? &*surface : nullptr; }
+  const std::vector<index_t>& drawn_surface_point() const { return cut_surface ? cut_surface_point : surface_point; }
   Vec3 lo, hi;                   ///< bounding box of the reference configuration
   std::string note;              ///< what was changed to run the scene here (a static solver), else empty
   std::unique_ptr<TripleBuffer<DisplayFrame>> display;
@@ -50,6 +59,12 @@ std::vector<index_t> visible_shell(const Csr& neighbours);
 
 /// Build a scene for viewing; throws Error for a scene that cannot be built.
 std::unique_ptr<Prepared> prepare(const Scene& scene, ProbeSource source, int threads);
+
+/// Each vertex's point of largest weight in `map`.
+std::vector<index_t> heaviest_points(const SurfaceMap& map);
+
+/// Split prepared.surface along `frame`'s cut sheets now, if the frame has newer ones than prepared.cut_surface.
+void split_surface_now(Prepared& prepared, const DisplayFrame& frame);
 
 /// The display frame after `time` s of the scene, simulated deterministically (no threads, no wall
 /// clock) with the scene's scripted probe if it has one, else with the probe resting at its origin.
@@ -79,12 +94,23 @@ class ViewerSession {
   Vec3 device_of_scene(const Vec3& scene) const;
 
  private:
+  /// Take a finished split of the surface along the cuts, and start one if the frame has newer cuts.
+  void poll_cut_surface();
+
   std::unique_ptr<Prepared> prepared_;
   ProbeSource source_;
   int threads_;
   std::thread thread_;
   std::atomic<bool> stop_{false}, finished_{false};
   std::future<std::unique_ptr<Prepared>> pending_;
+  /// The surface split along a frame's cut sheets on a worker (poll() takes it), for the Prepared it was made
+  /// for, of that frame's cut revision.
+  struct Split {
+    ObjectSurface surface;
+    const Prepared* of = nullptr;
+    long long revision = 0;
+  };
+  std::future<Split> split_;
   std::string error_, run_error_;
 };
 

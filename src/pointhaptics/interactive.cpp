@@ -34,6 +34,10 @@ void publish_display(Simulation& sim, const HapticFrame& haptic, long long step,
     for (const index_t i : selection.selected) d.lod_band[i] = selection.band[i];
     d.lod_selections = sim.lod_selections();
   }
+  if (d.cut_revision != sim.cut_sheets().revision) {  // after a cut (each slot catches up once)
+    d.cut_sheets = sim.cut_sheets().triangles;
+    d.cut_revision = sim.cut_sheets().revision;
+  }
   display.publish();
 }
 

@@ -26,6 +26,10 @@ struct DisplayFrame {
   std::vector<std::int8_t> lod_band;
   long long lod_selections = 0;
   index_t simulated = 0;              ///< points simulated (the active set with levels of detail)
+  /// The cuts' sheets (reference configuration; cut_surface.hpp), rewritten only when cut_revision changes:
+  /// a viewer splits the object's surface along them.
+  std::vector<SheetTriangle> cut_sheets;
+  long long cut_revision = 0;
 };
 
 struct InteractiveOptions {

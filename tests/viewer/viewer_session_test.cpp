@@ -164,5 +164,27 @@ TEST(ViewerSession, TheMouseDrivesARealTimeRunAndEditsRebuildIt) {
   EXPECT_FALSE(session.running());
 }
 
+TEST(ViewerSession, AScriptedCutSplitsTheDrawnSurfaceInAStillFrameAndInRealTime) {
+  // scenes/cantilever_cut.toml: a blade through the beam's root from t = 0.2 s to 0.25 s
+  const Scene scene = read_scene_file(PH_SCENES_DIR "/cantilever_cut.toml");
+  auto still = prepare(scene, ProbeSource::MOUSE, 1);
+  const index_t whole = static_cast<index_t>(still->drawn_surface()->mesh.F.size());
+  EXPECT_EQ(still->drawn_surface()->cut_faces, 0);
+  const DisplayFrame frame = simulate_frame(*still, 0.3);
+  ASSERT_FALSE(frame.cut_sheets.empty());
+  ASSERT_TRUE(still->cut_surface.has_value());
+  EXPECT_EQ(still->cut_revision, frame.cut_revision);
+  EXPECT_GT(still->drawn_surface()->cut_faces, 0);
+  EXPECT_GT(static_cast<index_t>(still->drawn_surface()->mesh.F.size()), whole);
+  EXPECT_EQ(still->drawn_surface_point().size(), static_cast<std::size_t>(still->drawn_surface()->mesh.V.cols()));
+
+  // in real time the split is made on a worker and taken over by poll()
+  ViewerSession session(prepare(scene, ProbeSource::MOUSE, 1), ProbeSource::MOUSE, 1);
+  session.start();
+  EXPECT_TRUE(poll_until(session, [&](bool) { return session.current().cut_surface.has_value() && session.frame().time > 0.26; }));
+  EXPECT_GT(session.current().drawn_surface()->cut_faces, 0);
+  session.stop();
+}
+
 }  // namespace
 }  // namespace pointhaptics::viewer
