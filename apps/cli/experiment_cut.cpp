@@ -1,5 +1,7 @@
 #include "experiment_cut.hpp"
 
+#include "plots.hpp"
+
 #include <pointhaptics/haptics/devices/virtual_device.hpp>
 #include <pointhaptics/haptics/force_rendering.hpp>
 #include <pointhaptics/mechanics/cut.hpp>
@@ -38,12 +40,24 @@ Scene cantilever() {
   return scene;
 }
 
-/// What a cut run measured, for cut.json.
+/// What a cut run measured, for cut.json, and the frames of its surface for the pictures.
 struct CutRun {
   nlohmann::json json;
+  nlohmann::json frames = nlohmann::json::array();
   long long pieces = 0, cut_pairs = 0, non_finite = 0;
   double max_update_ms = 0, max_force_step_n = 0;
 };
+
+/// A frame of the object's surface as its cuts leave it (split along their sheets), deformed by u x `scale`:
+/// vertices, triangles, and how many of the last ones are faces of cuts.
+nlohmann::json surface_frame(const std::string& title, CutSurface& surface, const Simulation& sim, double scale) {
+  const ObjectSurface& cut = surface.at(sim.model(), sim.cut_sheets());
+  const Points y = deformed_surface(cut, scale * sim.state().u);
+  nlohmann::json vertices = nlohmann::json::array(), faces = nlohmann::json::array();
+  for (Eigen::Index v = 0; v < y.cols(); ++v) vertices.push_back({y(0, v), y(1, v), y(2, v)});
+  for (const auto& f : cut.mesh.F) faces.push_back({f[0], f[1], f[2]});
+  return {{"title", title}, {"time_s", sim.time()}, {"vertices", std::move(vertices)}, {"faces", std::move(faces)}, {"cut_faces", cut.cut_faces}};
+}
 
 long long non_finite_entries(const Points& p) { return static_cast<long long>((!p.array().isFinite()).count()); }
 
@@ -65,7 +79,16 @@ CutRun blade_through_cantilever(const CutOptions& options, double resistance) {
   o.real_time = false;
   double work = 0, largest = 0, blade_step = 0;
   Vec3 last_probe = Vec3::Constant(NAN), last_force = Vec3::Zero();
+  CutRun run;
+  // the surface as the blade goes through and the free piece falls
+  CutSurface surface(build_object_surface(scene, sim.model()));
+  const std::vector<double> frame_times{0.1, 0.15, 0.2, 0.3, 0.4, 0.5};
+  std::size_t next_frame = 0;
   o.after_step = [&](long long) {
+    if (next_frame < frame_times.size() && sim.time() >= frame_times[next_frame] - 1e-9) {
+      run.frames.push_back(surface_frame(fmt::format("blade through the cantilever, t = {:.2f} s", sim.time()), surface, sim, 1.0));
+      ++next_frame;
+    }
     const ProbeTool* tool = sim.probe();
     const Vec3 f = tool->contact_model().f0;
     if (last_probe.allFinite()) work -= f.dot(tool->probe() - last_probe);
@@ -78,7 +101,6 @@ CutRun blade_through_cantilever(const CutOptions& options, double resistance) {
   if (r.haptic.device_failed) throw Error(fmt::format("experiment cut: the device failed: {}", r.haptic.device_error));
   if (sim.diagnostics().failed) throw Error(fmt::format("experiment cut: {}", sim.diagnostics().failure));
   const RunSummary s = sim.summary();
-  CutRun run;
   double tick_step = 0;
   for (std::size_t k = 0; k < r.log.size(); ++k) {
     run.non_finite += !r.log[k].force.allFinite();
@@ -168,6 +190,8 @@ CutRun slit_opens_under_load(const CutOptions& options) {
     if (s->diagnostics().failed) throw Error(fmt::format("experiment cut: the slit's static solve failed: {}", s->diagnostics().failure));
   const RunSummary s = cut.summary();
   CutRun run;
+  CutSurface surface(build_object_surface(scene, cut.model()));
+  run.frames.push_back(surface_frame("the slit pulled open (displacements x 10)", surface, cut, 10.0));
   run.non_finite = non_finite_entries(cut.state().u) + non_finite_entries(whole.state().u);
   run.pieces = static_cast<long long>(s.cut.piece_points.size());
   run.cut_pairs = s.cut.cut_pairs;
@@ -204,6 +228,12 @@ int run_cut_experiment(const CutOptions& options) {
   auto json = fmt::output_file((out / "cut.json").string());
   json.print("{}\n", doc.dump(1));
   json.close();
+  nlohmann::json frames = through.frames;
+  for (const auto& f : slit.frames) frames.push_back(f);
+  auto frames_file = fmt::output_file((out / "surface-frames.json").string());
+  frames_file.print("{}\n", frames.dump());
+  frames_file.close();
+  const int plots = run_plot_script("plot_cut.py", out.string());
   const nlohmann::json& t = through.json;
   const nlohmann::json& s = slit.json;
   auto md = fmt::output_file((out / "summary.md").string());
@@ -222,14 +252,18 @@ int run_cut_experiment(const CutOptions& options) {
            "solved statically. A scripted blade cuts a slit {} cm deep from the top between two planes of points.\n\n"
            "| | |\n|---|---|\n| pieces | {} |\n| pairs cut | {} |\n| the top's opening across the slit, whole | {:.4g} m |\n"
            "| ... with the slit | {:.4g} m |\n| converged | {} |\n| non-finite values | {} |\n\n"
-           "The surface does not split yet, so no images of the cut are written.\n",
+           "## The surface\n\n"
+           "The object's surface split along the cuts' sheets (the faces of the cuts darker), as the blade goes through "
+           "and the free piece falls, then the slit pulled open (displacements x 10): `surface-1.png` ... `surface-{}.png`, "
+           "all in `surface-series.png`; the frames' vertices and triangles in `surface-frames.json`.\n",
            t["points"].get<long long>(), resistance, t["pieces"].get<long long>(), t["piece_points"].dump(), t["cut_pairs"].get<long long>(),
            t["cut_area_m2"].get<double>(), t["work_j"].get<double>(), t["resistance_times_area_j"].get<double>(),
            t["largest_force_n"].get<double>(), t["max_force_step_n"].get<double>(), t["per_tick_bound_n"].get<double>(),
            t["sweeps"].get<long long>(), t["mean_update_ms"].get<double>(), t["max_update_ms"].get<double>(),
            t["free_piece_speed_m_per_s"].get<double>(), t["terminal_speed_m_per_s"].get<double>(), t["non_finite"].get<long long>(),
            s["points"].get<long long>(), 100 * s["slit_depth_m"].get<double>(), s["pieces"].get<long long>(), s["cut_pairs"].get<long long>(),
-           s["opening_whole_m"].get<double>(), s["opening_slit_m"].get<double>(), s["converged"].get<bool>(), s["non_finite"].get<long long>());
+           s["opening_whole_m"].get<double>(), s["opening_slit_m"].get<double>(), s["converged"].get<bool>(), s["non_finite"].get<long long>(),
+           frames.size());
   md.close();
   fmt::print("cut: blade through the cantilever: {} pieces, {} pairs, work {:.4g} J against {:.4g} J, force step per tick {:.3g} N; "
              "slit: opening {:.3g} m against {:.3g} m whole; non-finite {}\n",
@@ -237,9 +271,11 @@ int run_cut_experiment(const CutOptions& options) {
              t["resistance_times_area_j"].get<double>(), t["max_force_step_n"].get<double>(), s["opening_slit_m"].get<double>(),
              s["opening_whole_m"].get<double>(), doc["non_finite"].get<long long>());
   fmt::print("wrote {}\n", out.string());
-  // what must hold: nothing non-finite, the cantilever in two, the slit open wider than the whole block's top
+  // what must hold: nothing non-finite, the cantilever in two, the slit open wider than the whole block's top,
+  // both surfaces split (faces of cuts), the pictures drawn
   const bool held = doc["non_finite"].get<long long>() == 0 && through.pieces == 2 && slit.pieces == 1 &&
-                    s["opening_slit_m"].get<double>() > 2 * s["opening_whole_m"].get<double>();
+                    s["opening_slit_m"].get<double>() > 2 * s["opening_whole_m"].get<double>() && plots == 0 &&
+                    through.frames.back()["cut_faces"].get<long long>() > 0 && slit.frames.back()["cut_faces"].get<long long>() > 0;
   if (!held) fmt::print(stderr, "experiment cut: a check failed (see {})\n", (out / "cut.json").string());
   return held ? 0 : 1;
 }
