@@ -55,7 +55,7 @@ CutReport ModelSimulation::cut(std::span<const BladeSweep> sweeps) {
     // the modes the cut made in a few steps (elsewhere the model is as it was); implicit and static steps do
     // not depend on the stable step
     if (solver_.kind == SolverKind::EXPLICIT)
-      stable_dt_ = std::min(stable_dt_, stable_time_step(model_, 0.8, cut_lanczos_steps, n_threads_, report.cut_points));
+      stable_dt_ = std::min(stable_dt_, local_stable_time_step(model_, report.cut_points, cut_patch_rings, 0.8, cut_lanczos_steps));
     solver_impl_ = make_solver(model_, solver_, stable_dt_);
   }
   // (also when this sweep severed nothing: pairs cross a blade's path unevenly, and a strip left out would

@@ -130,6 +130,7 @@ class ModelSimulation {
   int n_threads_ = 0;
   double stable_dt_ = 0;
   static constexpr int cut_lanczos_steps = 12;
+  static constexpr int cut_patch_rings = 1;  ///< the patch the stable step is checked on: the cut's points and one ring
   Points cut_positions_;                 ///< X + u at a cut (kept: no allocation per blade step)
   std::vector<BladeSweep> blade_strips_;  ///< a blade's strips this step
   CutSheets cut_sheets_;

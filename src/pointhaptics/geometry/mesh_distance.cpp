@@ -51,7 +51,8 @@ MeshDistance::MeshDistance(const TriangleMesh& mesh) : mesh_(mesh) {
     const Vec3 n = (v[1] - v[0]).cross(v[2] - v[0]).normalized();
     face_normal_[t] = n;
     for (int k = 0; k < 3; ++k) {
-      edge_sum[key(f[k], f[(k + 1) % 3])] += n;
+      // (Eigen's vectors start uninitialised: the map's new entries are made zero first)
+      edge_sum.try_emplace(key(f[k], f[(k + 1) % 3]), Vec3::Zero()).first->second += n;
       const Vec3 e1 = (v[(k + 1) % 3] - v[k]).normalized(), e2 = (v[(k + 2) % 3] - v[k]).normalized();
       vertex_normal_[static_cast<std::size_t>(f[k])] += std::acos(std::clamp(e1.dot(e2), -1.0, 1.0)) * n;
     }

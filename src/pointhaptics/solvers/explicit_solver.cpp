@@ -4,6 +4,7 @@
 #include <pointhaptics/geometry/neighbour_search.hpp>
 #include <pointhaptics/mechanics/energies/material.hpp>
 #include <pointhaptics/mechanics/forces.hpp>
+#include <pointhaptics/mechanics/model_patch.hpp>
 #include <pointhaptics/mechanics/tangent.hpp>
 #include <pointhaptics/mechanics/viscoelasticity.hpp>
 
@@ -82,6 +83,15 @@ double stable_time_step(const Model& model, double safety, int lanczos_steps, in
   const double omega2 = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(T, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
   if (!(omega2 > 0) || !std::isfinite(omega2)) return fallback();
   return safety * 2.0 / std::sqrt(omega2);
+}
+
+double local_stable_time_step(const Model& model, const std::vector<index_t>& around, int rings, double safety, int lanczos_steps) {
+  const ModelPatch patch = model_patch(model, neighbourhood(model, around, rings));
+  std::vector<index_t> patch_of(static_cast<std::size_t>(model.n_points), -1);
+  for (std::size_t k = 0; k < patch.full_of.size(); ++k) patch_of[static_cast<std::size_t>(patch.full_of[k])] = static_cast<index_t>(k);
+  std::vector<index_t> focus;
+  for (const index_t i : around) focus.push_back(patch_of[static_cast<std::size_t>(i)]);
+  return stable_time_step(patch.model, safety, lanczos_steps, 1, focus);
 }
 
 double stable_time_step_with_springs(double stable_dt, double spring_stiffness, double min_mass, double safety) {

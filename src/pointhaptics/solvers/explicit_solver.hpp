@@ -17,6 +17,14 @@ namespace pointhaptics {
 double stable_time_step(const Model& model, double safety = 0.8, int lanczos_steps = 40, int n_threads = 1,
                         const std::vector<index_t>& focus = {});
 
+/// stable_time_step() of the patch of the model within `rings` neighbour steps of `around` (a cut's points), the
+/// ring beyond held (mechanics/model_patch.hpp), started on `around`: the fastest modes a local change made,
+/// at the cost of the patch. The patch's tangent is the model's restricted to it, so its modes are the model's
+/// held at the patch's edge: a mode that reaches beyond the patch is found slower than it is, and `rings` must
+/// cover the change's reach (tests/simulation_test.cpp checks it against Lanczos on the whole model).
+double local_stable_time_step(const Model& model, const std::vector<index_t>& around, int rings, double safety = 0.8,
+                              int lanczos_steps = 12);
+
 /// The older, cheaper estimate: safety x a / c_p with a the smallest point distance and c_p the p-wave
 /// speed sqrt((lambda + 2 mu + k_v + alpha E) / rho) of the densest point. Used when Lanczos cannot run.
 double estimated_stable_time_step(const Model& model, double safety = 0.7);

@@ -1,0 +1,116 @@
+#include <pointhaptics/mechanics/model_patch.hpp>
+
+#include <pointhaptics/core/error.hpp>
+
+#include <fmt/format.h>
+
+#include <algorithm>
+
+namespace pointhaptics {
+
+std::vector<index_t> neighbourhood(const Model& model, const std::vector<index_t>& seeds, int rings) {
+  std::vector<char> in(static_cast<std::size_t>(model.n_points), 0);
+  std::vector<index_t> found, front;
+  for (const index_t i : seeds) {
+    if (i < 0 || i >= model.n_points) throw Error(fmt::format("model patch: point {} of {}", i, model.n_points));
+    if (!in[static_cast<std::size_t>(i)]) in[static_cast<std::size_t>(i)] = 1, front.push_back(i);
+  }
+  found = front;
+  for (int ring = 0; ring < rings; ++ring) {
+    std::vector<index_t> next;
+    for (const index_t i : front)
+      for (index_t e = model.neighbours.begin(i); e < model.neighbours.end(i); ++e) {
+        const index_t j = model.neighbours.index[e];
+        if (!in[static_cast<std::size_t>(j)]) in[static_cast<std::size_t>(j)] = 1, next.push_back(j);
+      }
+    found.insert(found.end(), next.begin(), next.end());
+    front = std::move(next);
+  }
+  std::sort(found.begin(), found.end());
+  return found;
+}
+
+ModelPatch model_patch(const Model& model, const std::vector<index_t>& free) {
+  const std::vector<index_t> inner = neighbourhood(model, free, 0);
+  // two rings: a free point's force comes from the stencils that reach it (one ring), and their hourglass
+  // pairs (energies/hourglass.hpp) reach one ring further
+  const std::vector<index_t> all = neighbourhood(model, inner, 2);
+  ModelPatch patch;
+  patch.n_free = static_cast<index_t>(inner.size());
+  patch.full_of = inner;
+  std::vector<index_t> patch_of(static_cast<std::size_t>(model.n_points), -1);
+  for (std::size_t k = 0; k < inner.size(); ++k) patch_of[static_cast<std::size_t>(inner[k])] = static_cast<index_t>(k);
+  for (const index_t i : all)
+    if (patch_of[static_cast<std::size_t>(i)] < 0) {
+      patch_of[static_cast<std::size_t>(i)] = static_cast<index_t>(patch.full_of.size());
+      patch.full_of.push_back(i);
+    }
+  const index_t n = static_cast<index_t>(patch.full_of.size());
+  Model& m = patch.model;
+  m.n_points = n;
+  m.spacing = model.spacing;
+  m.h = model.h;
+  m.extent = model.extent;
+  m.kernel = model.kernel;
+  m.material = model.material;
+  m.lambda = model.lambda;
+  m.mu = model.mu;
+  m.point_materials = model.point_materials;
+  auto rows = [&](const Eigen::VectorXd& v) {
+    if (v.size() != model.n_points) return Eigen::VectorXd();
+    Eigen::VectorXd out(n);
+    for (index_t k = 0; k < n; ++k) out[k] = v[patch.full_of[static_cast<std::size_t>(k)]];
+    return out;
+  };
+  auto columns = [&](const Points& p) {
+    Points out(3, n);
+    for (index_t k = 0; k < n; ++k) out.col(k) = p.col(patch.full_of[static_cast<std::size_t>(k)]);
+    return out;
+  };
+  m.X = columns(model.X);
+  m.d_self = columns(model.d_self);
+  m.f_ext = model.f_ext.cols() == model.n_points ? columns(model.f_ext) : Points::Zero(3, n);
+  m.volume = rows(model.volume);
+  m.mass = rows(model.mass);
+  m.support = rows(model.support);
+  m.stiffness_scale = rows(model.stiffness_scale);
+  m.stiffness_volume = rows(model.stiffness_volume);
+  m.hg_diagonal = rows(model.hg_diagonal);
+  m.fixed.assign(static_cast<std::size_t>(n), 1);
+  for (index_t k = 0; k < patch.n_free; ++k) m.fixed[static_cast<std::size_t>(k)] = model.fixed[static_cast<std::size_t>(patch.full_of[static_cast<std::size_t>(k)])];
+  if (!model.material_of.empty())
+    for (const index_t i : patch.full_of) m.material_of.push_back(model.material_of[static_cast<std::size_t>(i)]);
+  // the pairs within the patch, rows in the model's order (sorted, as the patch's indices keep it within a row
+  // only if renumbered monotonically: sort each row by the patch index)
+  std::vector<index_t> pair_of;  // patch pair -> the model's
+  m.neighbours.offset.assign(1, 0);
+  for (index_t k = 0; k < n; ++k) {
+    const index_t i = patch.full_of[static_cast<std::size_t>(k)];
+    const std::size_t row_start = pair_of.size();
+    for (index_t e = model.neighbours.begin(i); e < model.neighbours.end(i); ++e)
+      if (patch_of[static_cast<std::size_t>(model.neighbours.index[e])] >= 0) pair_of.push_back(e);
+    std::sort(pair_of.begin() + static_cast<std::ptrdiff_t>(row_start), pair_of.end(), [&](index_t a, index_t b) {
+      return patch_of[static_cast<std::size_t>(model.neighbours.index[a])] < patch_of[static_cast<std::size_t>(model.neighbours.index[b])];
+    });
+    for (std::size_t p = row_start; p < pair_of.size(); ++p)
+      m.neighbours.index.push_back(patch_of[static_cast<std::size_t>(model.neighbours.index[pair_of[p]])]);
+    m.neighbours.offset.push_back(static_cast<index_t>(m.neighbours.index.size()));
+  }
+  const index_t pairs = static_cast<index_t>(pair_of.size());
+  std::vector<index_t> patch_pair(static_cast<std::size_t>(model.n_pairs()), -1);
+  for (index_t p = 0; p < pairs; ++p) patch_pair[static_cast<std::size_t>(pair_of[static_cast<std::size_t>(p)])] = p;
+  m.d.resize(3, pairs);
+  m.hg_coef.resize(model.hg_coef.size() == model.n_pairs() ? pairs : 0);
+  m.reverse_pair.resize(static_cast<std::size_t>(pairs));
+  if (!model.severed.empty()) m.severed.resize(static_cast<std::size_t>(pairs));
+  for (index_t p = 0; p < pairs; ++p) {
+    const index_t e = pair_of[static_cast<std::size_t>(p)];
+    m.d.col(p) = model.d.col(e);
+    if (m.hg_coef.size()) m.hg_coef[p] = model.hg_coef[e];
+    if (!m.severed.empty()) m.severed[static_cast<std::size_t>(p)] = model.severed[static_cast<std::size_t>(e)];
+    m.reverse_pair[static_cast<std::size_t>(p)] = patch_pair[static_cast<std::size_t>(model.reverse_pair[static_cast<std::size_t>(e)])];
+  }
+  return patch;
+}
+
+}  // namespace pointhaptics
