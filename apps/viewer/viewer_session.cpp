@@ -230,6 +230,9 @@ void ViewerSession::poll_cut_surface() {
   }
   const DisplayFrame& frame = p.display->front();
   if (!p.surface || frame.cut_revision == p.cut_revision || frame.cut_sheets.empty()) return;
+  const auto now = std::chrono::steady_clock::now();
+  if (now - last_split_ < std::chrono::milliseconds(250)) return;
+  last_split_ = now;
   // on a worker, on one thread (the simulation and the haptic loop have the cores); the model's reference
   // positions, kernel and supports, all the split reads of it, do not change while it runs
   split_ = std::async(std::launch::async, [&p, sheets = frame.cut_sheets, revision = frame.cut_revision] {

@@ -7,6 +7,7 @@
 #include <pointhaptics/object_surface.hpp>
 
 #include <atomic>
+#include <chrono>
 #include <future>
 #include <memory>
 #include <optional>
@@ -111,6 +112,9 @@ class ViewerSession {
     long long revision = 0;
   };
   std::future<Split> split_;
+  /// When the last split started: the next waits a quarter of a second after it, so that a stroke of the blade
+  /// (new sheets every step) does not keep a core busy that the simulation and the haptic loop need.
+  std::chrono::steady_clock::time_point last_split_{};
   std::string error_, run_error_;
 };
 

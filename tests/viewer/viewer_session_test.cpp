@@ -19,10 +19,10 @@ namespace {
 // the default scene: the seed's beam held at both ends, a scripted hand pressing its middle
 Scene beam_scene() { return read_scene_file(PH_SCENES_DIR "/beam_probe.toml"); }
 
-// wait (at most 20 s) until `done` holds, polling the session as the viewer's frame loop does
+// wait (at most `seconds`) until `done` holds, polling the session as the viewer's frame loop does
 template <class Done>
-bool poll_until(ViewerSession& session, Done done) {
-  for (int k = 0; k < 2000; ++k) {
+bool poll_until(ViewerSession& session, Done done, int seconds = 20) {
+  for (int k = 0; k < 100 * seconds; ++k) {
     const bool took_over = session.poll();
     if (done(took_over)) return true;
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
@@ -178,10 +178,11 @@ TEST(ViewerSession, AScriptedCutSplitsTheDrawnSurfaceInAStillFrameAndInRealTime)
   EXPECT_GT(static_cast<index_t>(still->drawn_surface()->mesh.F.size()), whole);
   EXPECT_EQ(still->drawn_surface_point().size(), static_cast<std::size_t>(still->drawn_surface()->mesh.V.cols()));
 
-  // in real time the split is made on a worker and taken over by poll()
+  // in real time the split is made on a worker and taken over by poll() (the blade reaches the beam at t = 0.2 s:
+  // under a sanitizer the simulation runs far behind the wall clock)
   ViewerSession session(prepare(scene, ProbeSource::MOUSE, 1), ProbeSource::MOUSE, 1);
   session.start();
-  EXPECT_TRUE(poll_until(session, [&](bool) { return session.current().cut_surface.has_value() && session.frame().time > 0.26; }));
+  EXPECT_TRUE(poll_until(session, [&](bool) { return session.current().cut_surface.has_value(); }, 300));
   EXPECT_GT(session.current().drawn_surface()->cut_faces, 0);
   session.stop();
 }
