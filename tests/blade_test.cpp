@@ -5,11 +5,13 @@
 #include <pointhaptics/haptics/devices/virtual_device.hpp>
 #include <pointhaptics/interactive.hpp>
 #include <pointhaptics/io/scene_toml.hpp>
+#include <pointhaptics/cut_surface.hpp>
 #include <pointhaptics/object_surface.hpp>
 #include <pointhaptics/scene_builder.hpp>
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 
@@ -162,12 +164,25 @@ TEST(Blade, SawingForASecondStaysFiniteBoundedAndWithinTheDevice) {
   const RunSummary s = sim.summary();
   EXPECT_GT(s.cut.cut_pairs, 100);
   EXPECT_EQ(static_cast<index_t>(sim.model().severed.size()), sim.model().n_pairs());
+  // the cut's sheets: at most a strip (two triangles) per step, fewer where strips run on straight
+  const std::size_t sheets = sim.cut_sheets().triangles.size();
+  EXPECT_GT(sheets, 0u);
+  EXPECT_LE(sheets, 2u * 1000u);
+  // and the surface split along them all (sheets sawn back and forth over one another): finite, and carried
+  const auto start = std::chrono::steady_clock::now();
+  const ObjectSurface split = split_surface(build_object_surface(scene, sim.model()), sim.model(), sim.cut_sheets().triangles);
+  const double split_ms = 1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_GT(split.cut_faces, 0);
+  EXPECT_TRUE(split.mesh.V.allFinite());
+  EXPECT_TRUE(deformed_surface(split, sim.state().u).allFinite());
+  std::printf("sawn surface: %zu triangles, %lld faces of cuts, split in %.0f ms (%s)\n", split.mesh.F.size(),
+              static_cast<long long>(split.cut_faces), split_ms, split.source.c_str());
   for (const auto& tick : r.log) {
     ASSERT_TRUE(tick.force.allFinite());
     ASSERT_LE(tick.force.norm(), known_device_specs("touch").max_force + 1e-9);
   }
-  std::printf("sawing: %lld pairs cut, %zu pieces, a sweep %.3f ms on average, %.3f ms at most\n", s.cut.cut_pairs,
-              s.cut.piece_points.size(), s.cut.mean_update_ms, s.cut.max_update_ms);
+  std::printf("sawing: %lld pairs cut, %zu pieces, a sweep %.3f ms on average, %.3f ms at most, %zu sheet triangles\n",
+              s.cut.cut_pairs, s.cut.piece_points.size(), s.cut.mean_update_ms, s.cut.max_update_ms, sheets);
 }
 
 }  // namespace

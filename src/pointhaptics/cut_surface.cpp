@@ -56,6 +56,80 @@ struct Building {
   }
 };
 
+/// The sheets by the cells of a uniform grid their boxes overlap, so that whether a segment crosses a sheet
+/// is asked of the sheets near it only (a sawn object has hundreds of sheets within a support).
+class SheetGrid {
+ public:
+  SheetGrid(std::span<const SheetTriangle> sheets, const std::vector<Box>& boxes, const Box& region, double cell)
+      : sheets_(sheets), boxes_(boxes) {
+    for (const Box& b : boxes) {
+      bounds_.add(b.lo.cwiseMax(region.lo));
+      bounds_.add(b.hi.cwiseMin(region.hi));
+    }
+    if (boxes.empty() || !(bounds_.lo.array() <= bounds_.hi.array()).all()) return;
+    // (at most about a million cells: a coarser grid for a region far larger than the cell)
+    const Vec3 extent = bounds_.hi - bounds_.lo;
+    cell_ = std::max(cell, std::cbrt(extent.prod() / 1e6));
+    for (int a = 0; a < 3; ++a) cells_[a] = std::max<index_t>(1, static_cast<index_t>(std::ceil(extent[a] / cell_)));
+    offset_.assign(static_cast<std::size_t>(cells_[0] * cells_[1] * cells_[2]) + 1, 0);
+    for (int pass = 0; pass < 2; ++pass) {  // count, then fill
+      for (std::size_t t = 0; t < boxes.size(); ++t)
+        for_cells(boxes[t], [&](std::size_t c) {
+          if (pass == 0) ++offset_[c + 1];
+          else sheet_[static_cast<std::size_t>(fill_[c]++)] = static_cast<std::uint32_t>(t);
+        });
+      if (pass == 0) {
+        for (std::size_t c = 1; c < offset_.size(); ++c) offset_[c] += offset_[c - 1];
+        sheet_.resize(static_cast<std::size_t>(offset_.back()));
+        fill_.assign(offset_.begin(), offset_.end() - 1);
+      }
+    }
+  }
+
+  /// Whether the segment p-q crosses a sheet.
+  bool crosses(const Vec3& p, const Vec3& q) const {
+    Box segment;
+    segment.add(p);
+    segment.add(q);
+    if (offset_.empty() || !segment.overlaps(bounds_)) return false;
+    // each sheet tested once per question, though it lies in several of the cells (a stamp per sheet and thread)
+    thread_local std::vector<std::uint32_t> asked;
+    thread_local std::uint32_t question = 0;
+    if (asked.size() != boxes_.size() || ++question == 0) asked.assign(boxes_.size(), 0), question = 1;
+    bool crossed = false;
+    for_cells(segment, [&](std::size_t c) {
+      for (std::int64_t k = offset_[c]; k < offset_[c + 1] && !crossed; ++k) {
+        const std::uint32_t t = sheet_[static_cast<std::size_t>(k)];
+        if (asked[t] == question) continue;
+        asked[t] = question;
+        crossed = segment.overlaps(boxes_[t]) && segment_crossing(p, q, sheets_[t][0], sheets_[t][1], sheets_[t][2]).has_value();
+      }
+    });
+    return crossed;
+  }
+
+ private:
+  template <class Fn>
+  void for_cells(const Box& b, Fn&& fn) const {
+    index_t first[3], last[3];
+    for (int a = 0; a < 3; ++a) {
+      first[a] = std::clamp<index_t>(static_cast<index_t>(std::floor((b.lo[a] - bounds_.lo[a]) / cell_)), 0, cells_[a] - 1);
+      last[a] = std::clamp<index_t>(static_cast<index_t>(std::floor((b.hi[a] - bounds_.lo[a]) / cell_)), 0, cells_[a] - 1);
+    }
+    for (index_t k = first[2]; k <= last[2]; ++k)
+      for (index_t j = first[1]; j <= last[1]; ++j)
+        for (index_t i = first[0]; i <= last[0]; ++i) fn(static_cast<std::size_t>(i + cells_[0] * (j + cells_[1] * k)));
+  }
+
+  std::span<const SheetTriangle> sheets_;
+  const std::vector<Box>& boxes_;
+  Box bounds_;
+  double cell_ = 1;
+  index_t cells_[3] = {1, 1, 1};
+  std::vector<std::int64_t> offset_, fill_;
+  std::vector<std::uint32_t> sheet_;
+};
+
 /// Part 1: the surface's triangles, split where their edges cross a sheet.
 void split_triangles(const TriangleMesh& mesh, std::span<const SheetTriangle> sheets, const std::vector<Box>& sheet_box,
                      double offset, Building& out) {
@@ -254,32 +328,30 @@ ObjectSurface split_surface(const ObjectSurface& whole, const Model& model, std:
   add_sheet_faces(mesh, sheets, sheet_box, edge, offset, out);
   const std::size_t n_vertices = out.vertex.size();
 
-  // the sheets each vertex could see across: those within the widest neighbourhood the map searches (the
-  // support, widened up to five times by 1.5); a vertex with none keeps its row of the whole surface's map
-  const double reach = h * std::pow(1.5, 5);
-  std::vector<std::vector<std::uint32_t>> near(n_vertices);
+  // a vertex near a sheet sees points within two widenings of the support (1.5^2 h) at most: further widenings
+  // cannot see round the sheets that hem it in (a vertex between two close sheets of a sawn object), and each
+  // would test every point within 7.6 h against the sheets. A vertex with no sheet within that reach keeps its
+  // row of the whole surface's map.
+  const double reach = h * 1.5 * 1.5;
+  std::vector<char> near(n_vertices, 0);
   tbb::parallel_for(std::size_t{0}, n_vertices, [&](std::size_t v) {
     Box at;
     at.add(out.vertex[v]);
     at = at.inflated(reach);
-    for (std::size_t s = 0; s < sheets.size(); ++s)
-      if (at.overlaps(sheet_box[s])) near[v].push_back(static_cast<std::uint32_t>(s));
+    for (std::size_t s = 0; s < sheets.size() && !near[v]; ++s) near[v] = at.overlaps(sheet_box[s]);
   });
   std::vector<index_t> remap;  // the vertices whose rows are built anew
   for (std::size_t v = 0; v < n_vertices; ++v)
-    if (static_cast<index_t>(v) >= n_whole || !near[v].empty()) remap.push_back(static_cast<index_t>(v));
+    if (static_cast<index_t>(v) >= n_whole || near[v]) remap.push_back(static_cast<index_t>(v));
+  Box region;  // where vertices and the points they see can be
+  for (Eigen::Index j = 0; j < model.X.cols(); ++j) region.add(model.X.col(j));
+  for (const Vec3& v : out.vertex) region.add(v);
+  const SheetGrid grid(sheets, sheet_box, region.inflated(reach), 0.5 * h);
   Points Y(3, static_cast<Eigen::Index>(remap.size()));
   for (std::size_t r = 0; r < remap.size(); ++r) Y.col(static_cast<Eigen::Index>(r)) = out.vertex[static_cast<std::size_t>(remap[r])];
   const VertexSees sees = [&](index_t r, index_t j) {
     const std::size_t v = static_cast<std::size_t>(remap[static_cast<std::size_t>(r)]);
-    const Vec3& p = out.from[v];
-    const Vec3 q = model.X.col(j);
-    Box segment;
-    segment.add(p);
-    segment.add(q);
-    for (const std::uint32_t s : near[v])
-      if (segment.overlaps(sheet_box[s]) && segment_crossing(p, q, sheets[s][0], sheets[s][1], sheets[s][2])) return false;
-    return true;
+    return (model.X.col(j) - out.vertex[v]).squaredNorm() <= reach * reach && !grid.crosses(out.from[v], model.X.col(j));
   };
   std::vector<char> uncarried;
   const SurfaceMap fresh = build_surface_map(model, Y, &uncarried, sees);
