@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
 
 namespace pointhaptics {
@@ -132,6 +133,15 @@ TEST(CutSurface, NoSheetOrOneOutsideTheObjectChangesNothing) {
   const ObjectSurface outside = split_surface(b.whole, b.model, sheets_of(away));
   EXPECT_EQ(outside.mesh.F, b.whole.mesh.F);
   EXPECT_EQ(outside.cut_faces, 0);
+}
+
+TEST(CutSurface, ASheetThatIsNotFiniteSplitsNothing) {
+  const Block b = block();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<SheetTriangle> bad{SheetTriangle{Vec3(nan, 0, 0), Vec3(0.01, 0, 0), Vec3(0, 0.01, 0)}};
+  const ObjectSurface same = split_surface(b.whole, b.model, bad);
+  EXPECT_EQ(same.mesh.F, b.whole.mesh.F);
+  EXPECT_TRUE(same.mesh.V.allFinite());
 }
 
 TEST(CutSurface, RandomSheetsGiveAFiniteSurfaceCarriedByWeightsThatSumToOne) {

@@ -308,7 +308,13 @@ void CutSheets::add_strip(const Vec3& A0, const Vec3& B0, const Vec3& A1, const 
   triangles.push_back({A0, B1, A1});
 }
 
-ObjectSurface split_surface(const ObjectSurface& whole, const Model& model, std::span<const SheetTriangle> sheets) {
+ObjectSurface split_surface(const ObjectSurface& whole, const Model& model, std::span<const SheetTriangle> given) {
+  // (a sheet that is not finite, from a state that was not, splits nothing)
+  std::vector<SheetTriangle> finite;
+  finite.reserve(given.size());
+  for (const SheetTriangle& t : given)
+    if (t[0].allFinite() && t[1].allFinite() && t[2].allFinite()) finite.push_back(t);
+  const std::span<const SheetTriangle> sheets(finite);
   if (sheets.empty()) return whole;
   const TriangleMesh& mesh = whole.mesh;
   const index_t n_whole = static_cast<index_t>(mesh.V.cols());

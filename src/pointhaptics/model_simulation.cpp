@@ -98,6 +98,7 @@ void ModelSimulation::record_cut_sheet(const BladeSweep& sweep) {
   const bool continues = sheet_edge_.has_value() && (*sheet_edge_)[0] == sweep.a0 && (*sheet_edge_)[1] == sweep.b0;
   const Vec3 a0 = continues ? (*sheet_edge_)[2] : reference(sweep.a0), b0 = continues ? (*sheet_edge_)[3] : reference(sweep.b0);
   const Vec3 a1 = reference(sweep.a1), b1 = reference(sweep.b1);
+  if (!(a0.allFinite() && b0.allFinite() && a1.allFinite() && b1.allFinite())) return;  // a state that is not finite
   // (a straight run of strips is kept as one quad, to within a hundredth of the spacing)
   cut_sheets_.add_strip(a0, b0, a1, b1, continues, 0.01 * (model_.spacing > 0 ? model_.spacing : 0.5 * model_.h));
   sheet_edge_ = {sweep.a1, sweep.b1, a1, b1};
