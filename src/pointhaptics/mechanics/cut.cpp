@@ -29,17 +29,20 @@ index_t row_of(const Csr& nbr, index_t e) {
 }  // namespace
 
 std::vector<index_t> pairs_crossing(const Model& model, const Points& x, const BladeSweep& sweep) {
-  const std::array<Vec3, 4> corners{sweep.a0, sweep.b0, sweep.a1, sweep.b1};
+  // a crossing pair has both ends within its length of the sweep: twice the largest support covers pairs
+  // stretched to twice their reference length. With an edge reach only crossings within it of the last edge
+  // count, so the box around that edge does (a trail swept since the cut began covers ever more points, of
+  // which only those near the edge can cut)
+  const double reach = 2.0 * (model.support.size() ? model.support.maxCoeff() : model.h);
+  const bool near_edge = sweep.edge_reach != std::numeric_limits<double>::infinity();
+  const std::array<Vec3, 4> corners{near_edge ? sweep.a1 : sweep.a0, near_edge ? sweep.b1 : sweep.b0, sweep.a1, sweep.b1};
   Vec3 lo = corners[0], hi = corners[0];
   for (const Vec3& c : corners) {
     lo = lo.cwiseMin(c);
     hi = hi.cwiseMax(c);
   }
-  // a crossing pair has both ends within its length of the sweep: twice the largest support covers pairs
-  // stretched to twice their reference length
-  const double reach = 2.0 * (model.support.size() ? model.support.maxCoeff() : model.h);
-  lo.array() -= reach;
-  hi.array() += reach;
+  lo.array() -= reach + (near_edge ? sweep.edge_reach : 0.0);
+  hi.array() += reach + (near_edge ? sweep.edge_reach : 0.0);
   auto inside = [&](index_t i) { return (x.col(i).array() >= lo.array()).all() && (x.col(i).array() <= hi.array()).all(); };
   const Csr& nbr = model.neighbours;
   std::vector<index_t> crossing;
