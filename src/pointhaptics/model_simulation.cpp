@@ -106,15 +106,18 @@ void ModelSimulation::record_cut_sheet(const BladeSweep& sweep) {
 
 void ModelSimulation::refresh_probe_surface() {
   ProbeAttachment& probe = *probe_;
-  if (split_.valid()) {
-    if (split_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;  // the worker is at it
-    SplitContact done = split_.get();
+  // the probe's contact from now on: with the split surface
+  auto take = [&](SplitContact done) {
     std::vector<index_t> same(static_cast<std::size_t>(model_.n_points));
     std::iota(same.begin(), same.end(), index_t{0});
     probe.tool.remap(model_, same, std::move(done.contact));
     probe.surface_revision = done.revision;
     ++diagnostics_.surface_splits;
     diagnostics_.max_split_seconds = std::max(diagnostics_.max_split_seconds, done.seconds);
+  };
+  if (split_.valid()) {
+    if (split_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;  // the worker is at it
+    take(split_.get());
   }
   if (probe.surface_revision == cut_sheets_.revision) return;
   // on one thread: in real time the other core runs the haptic loop
@@ -130,14 +133,8 @@ void ModelSimulation::refresh_probe_surface() {
     return made;
   };
   // in real time on a worker, taken over at a later step; otherwise now (reproducible runs)
-  if (probe.asynchronous_lod) {
-    split_ = std::async(std::launch::async, std::move(split));
-  } else {
-    std::promise<SplitContact> now;
-    now.set_value(split());
-    split_ = now.get_future();
-    refresh_probe_surface();
-  }
+  if (probe.asynchronous_lod) split_ = std::async(std::launch::async, std::move(split));
+  else take(split());
 }
 
 // ---- the step pipeline below the active set: each stage is one function, in the order step() calls them ----

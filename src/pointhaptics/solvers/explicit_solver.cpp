@@ -87,10 +87,10 @@ double stable_time_step(const Model& model, double safety, int lanczos_steps, in
 
 double local_stable_time_step(const Model& model, const std::vector<index_t>& around, int rings, double safety, int lanczos_steps) {
   const ModelPatch patch = model_patch(model, neighbourhood(model, around, rings));
-  std::vector<index_t> patch_of(static_cast<std::size_t>(model.n_points), -1);
-  for (std::size_t k = 0; k < patch.full_of.size(); ++k) patch_of[static_cast<std::size_t>(patch.full_of[k])] = static_cast<index_t>(k);
+  // the free points come first in the patch, in increasing order, and `around` is among them
+  const auto free_end = patch.full_of.begin() + patch.n_free;
   std::vector<index_t> focus;
-  for (const index_t i : around) focus.push_back(patch_of[static_cast<std::size_t>(i)]);
+  for (const index_t i : around) focus.push_back(static_cast<index_t>(std::lower_bound(patch.full_of.begin(), free_end, i) - patch.full_of.begin()));
   return stable_time_step(patch.model, safety, lanczos_steps, 1, focus);
 }
 
