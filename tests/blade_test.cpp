@@ -4,6 +4,7 @@
 // felt is continuous, bounded and finite.
 #include <pointhaptics/haptics/devices/virtual_device.hpp>
 #include <pointhaptics/interactive.hpp>
+#include <pointhaptics/lod/active_surface.hpp>
 #include <pointhaptics/io/scene_toml.hpp>
 #include <pointhaptics/cut_surface.hpp>
 #include <pointhaptics/object_surface.hpp>
@@ -94,12 +95,23 @@ TEST(Blade, ADevicesBladeCutsTheCantileverThroughAndTheHandFeelsTheResistance) {
               s.cut.cut_pairs, area, work, resistance * area, largest, resistance * 0.03, largest_step, s.cut.max_update_ms);
 }
 
-TEST(Blade, LiftedAfterAStrokeTheBladePushesOnTheSplitSurfaceAndStopsAtTheCutFace) {
-  // the blade cuts through as above with the probe on the object's surface; the button let go below the beam,
-  // it goes round (beside the beam in z), waits in the gap the falling piece leaves, and is pushed 1.4 cm into
-  // the stump's cut face at x = 3.375 cm
+// Levels of detail around the root (the points within 2.25 cm of the top of the cut plane, part of those to 2.85 cm;
+// nothing beyond): the section's bottom lies outside, so the cut there is the object's only
+LodParams root_lod() {
+  LodParams p;
+  p.k1 = 1.5;  // x h = 1.5 cm
+  p.k2 = 1.9;
+  return p;
+}
+const Vec3 cut_top(0.03375, 0.03, 0.015);
+
+// the blade cuts through as above with the probe on the object's surface; the button let go below the beam,
+// it goes round (beside the beam in z), waits in the gap the falling piece leaves, and is pushed 1.4 cm into
+// the stump's cut face at x = 3.375 cm; with levels of detail or without
+void lifted_blade_stops_at_the_cut_face(bool levels_of_detail) {
   const Scene scene = beam();
   Simulation sim(build_scene_model(scene), scene.solver, 2);
+  if (levels_of_detail) sim.enable_lod(root_lod(), cut_top);
   const auto whole = std::make_shared<const ObjectSurface>(build_object_surface(scene, sim.model()));
   const Vec3 above(0.03375, 0.05, 0.015);
   VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), true},
@@ -129,15 +141,23 @@ TEST(Blade, LiftedAfterAStrokeTheBladePushesOnTheSplitSurfaceAndStopsAtTheCutFac
   ASSERT_EQ(s.cut.piece_points.size(), 2u);
   // once the button was let go the probe's surface was split along the stroke's sheets, once
   EXPECT_EQ(s.cut.surface_splits, 1);
-  EXPECT_GT(vertices, whole->map.n_vertices());
+  // (with levels of detail, than the part of the uncut surface the active set carries)
+  const index_t uncut = levels_of_detail ? restrict_surface(whole->mesh, whole->map, *sim.active_set()).map.n_vertices()
+                                         : whole->map.n_vertices();
+  EXPECT_GT(vertices, uncut);
   // the blade (radius 1 mm) stands on the stump's cut face, pushed back along +x; the hand is 1.4 cm beyond
   const double face = 0.03375 + 0.001;
   EXPECT_NEAR(probe.x(), face, 0.0015) << probe.transpose();
   EXPECT_GT(force.x(), 0.5);
   EXPECT_LT(std::abs(force.y()), 0.2 * force.x());
-  std::printf("lifted blade: at (%.5f, %.5f, %.5f) m against the face at x = %.5f m, force (%.3g, %.3g, %.3g) N, split in %.2f ms\n",
-              probe.x(), probe.y(), probe.z(), face, force.x(), force.y(), force.z(), s.cut.max_split_ms);
+  std::printf("lifted blade%s: at (%.5f, %.5f, %.5f) m against the face at x = %.5f m, force (%.3g, %.3g, %.3g) N, split in %.2f ms\n",
+              levels_of_detail ? " (levels of detail)" : "", probe.x(), probe.y(), probe.z(), face, force.x(), force.y(), force.z(),
+              s.cut.max_split_ms);
 }
+
+TEST(Blade, LiftedAfterAStrokeTheBladePushesOnTheSplitSurfaceAndStopsAtTheCutFace) { lifted_blade_stops_at_the_cut_face(false); }
+
+TEST(Blade, WithLevelsOfDetailTheLiftedBladePushesOnTheActiveSetsPartOfTheSplitSurface) { lifted_blade_stops_at_the_cut_face(true); }
 
 TEST(Blade, SawingForASecondStaysFiniteBoundedAndWithinTheDevice) {
   // the blade sawed back and forth along the beam's root region while it sinks, a thousand steps: every step
@@ -183,6 +203,98 @@ TEST(Blade, SawingForASecondStaysFiniteBoundedAndWithinTheDevice) {
   }
   std::printf("sawing: %lld pairs cut, %zu pieces, a sweep %.3f ms on average, %.3f ms at most, %zu sheet triangles\n",
               s.cut.cut_pairs, s.cut.piece_points.size(), s.cut.mean_update_ms, s.cut.max_update_ms, sheets);
+}
+
+// No unsevered pair of `model` crosses the plane x = 3.375 cm (reference configuration); the pairs that do, counted
+index_t pairs_across_the_cut(const Model& model, index_t& severed) {
+  index_t whole = 0;
+  severed = 0;
+  for (index_t i = 0; i < model.n_points; ++i)
+    for (index_t e = model.neighbours.begin(i); e < model.neighbours.end(i); ++e) {
+      const index_t j = model.neighbours.index[e];
+      if (j < i || (model.X(0, i) < 0.03375) == (model.X(0, j) < 0.03375)) continue;
+      if (!model.severed.empty() && model.severed[e]) ++severed;
+      else ++whole;
+    }
+  return whole;
+}
+
+TEST(Blade, WithLevelsOfDetailAScriptedCutInTheActiveSetReachesTheObjectAndTheNextActiveSets) {
+  const Scene scene = read_scene_file(PH_SCENES "/cantilever_cut.toml");
+  // without levels of detail, for comparison
+  Simulation plain(build_scene_model(scene), scene.solver, 2);
+  for (const CutSpec& cut : scene.cuts) plain.add_scripted_cut(cut);
+  plain.run(0.3);
+  const RunSummary p = plain.summary();
+  Simulation sim(build_scene_model(scene), scene.solver, 2);
+  for (const CutSpec& cut : scene.cuts) sim.add_scripted_cut(cut);
+  sim.enable_lod(root_lod(), cut_top);
+  const index_t object_points = sim.model().n_points, simulated = sim.simulated_model().n_points;
+  EXPECT_LT(sim.active_set()->n_selected, object_points / 2);
+  // part of the section is not simulated: the points on its two sides at the bottom lie beyond the bands
+  index_t bottom_simulated = 0;
+  for (index_t k = 0; k < sim.active_set()->n_selected; ++k) {
+    const Vec3 X = sim.model().X.col(sim.active_set()->full_of[k]);
+    bottom_simulated += std::abs(X.x() - 0.03375) < 0.004 && X.y() < 1e-9;
+  }
+  EXPECT_EQ(bottom_simulated, 0);
+  sim.run(0.3);
+  ASSERT_FALSE(sim.diagnostics().failed) << sim.diagnostics().failure;
+  const RunSummary s = sim.summary();
+  ASSERT_TRUE(s.cut.present);
+  // the object is in two pieces, as without levels of detail, and the same pairs (to the few at the section's
+  // rim, where the sheets mapped back and the current positions may differ)
+  ASSERT_EQ(s.cut.piece_points.size(), 2u);
+  EXPECT_EQ(s.cut.piece_points, p.cut.piece_points);
+  EXPECT_NEAR(static_cast<double>(s.cut.cut_pairs), static_cast<double>(p.cut.cut_pairs), 0.05 * static_cast<double>(p.cut.cut_pairs));
+  index_t severed = 0;
+  EXPECT_EQ(pairs_across_the_cut(sim.model(), severed), 0);
+  EXPECT_EQ(severed, s.cut.cut_pairs);
+  // the active set too
+  EXPECT_EQ(pairs_across_the_cut(sim.simulated_model(), severed), 0);
+  EXPECT_GT(severed, 0);
+  // a new active set elsewhere, then back at the cut: built from the cut object, both pieces in it
+  EXPECT_FALSE(sim.update_lod(Vec3(0.12, 0.03, 0.015), true).empty());
+  EXPECT_FALSE(sim.update_lod(cut_top + Vec3(0, 0, 0.005), true).empty());
+  const Model& again = sim.simulated_model();
+  EXPECT_EQ(pairs_across_the_cut(again, severed), 0);
+  EXPECT_GT(severed, 0);
+  std::vector<index_t> piece_of;
+  EXPECT_EQ(connected_pieces(again, piece_of), 2);
+  sim.run(0.35);
+  ASSERT_FALSE(sim.diagnostics().failed) << sim.diagnostics().failure;
+  EXPECT_TRUE(sim.state().u.allFinite());
+  std::printf("levels of detail: %lld of %lld points simulated; %lld pairs cut in the object (%lld without levels of detail), "
+              "pieces %zu\n", static_cast<long long>(simulated), static_cast<long long>(object_points), s.cut.cut_pairs,
+              p.cut.cut_pairs, s.cut.piece_points.size());
+}
+
+TEST(Blade, WithLevelsOfDetailADevicesBladeCutsTheObjectThrough) {
+  // the stroke of the first test, with levels of detail following the blade (the points near it simulated)
+  const Scene scene = beam();
+  Simulation sim(build_scene_model(scene), scene.solver, 2);
+  sim.enable_lod(root_lod(), cut_top);
+  const Vec3 above(0.03375, 0.05, 0.015), below(0.03375, -0.02, 0.015);
+  VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), true}, {0.05, Vec3::Zero(), true}, {0.25, below - above, true}, {0.4, below - above, true}}),
+                       known_device_specs("touch"));
+  InteractiveOptions o = blade(above, 0.4);
+  double largest = 0;
+  o.after_step = [&](long long) { largest = std::max(largest, sim.probe()->contact_model().f0.norm()); };
+  const InteractiveResult r = run_interactive(sim, device, o);
+  ASSERT_FALSE(sim.diagnostics().failed) << sim.diagnostics().failure;
+  const RunSummary s = sim.summary();
+  ASSERT_EQ(s.cut.piece_points.size(), 2u);
+  EXPECT_EQ(s.cut.piece_points[0], 125);
+  EXPECT_EQ(s.cut.piece_points[1], 400);
+  index_t severed = 0;
+  EXPECT_EQ(pairs_across_the_cut(sim.model(), severed), 0);
+  EXPECT_GT(s.lod.selections, 1);  // the active set followed the blade
+  // the hand felt the resistance, as without levels of detail
+  EXPECT_GT(largest, 0.6 * resistance * 0.03);
+  EXPECT_LT(largest, 1.6 * resistance * 0.03);
+  for (const auto& tick : r.log) ASSERT_TRUE(tick.force.allFinite());
+  std::printf("a blade with levels of detail: %lld pairs cut, %lld selections, largest force %.3g N, longest update %.3g ms\n",
+              s.cut.cut_pairs, s.lod.selections, largest, s.cut.max_update_ms);
 }
 
 }  // namespace

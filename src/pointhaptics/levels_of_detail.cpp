@@ -3,20 +3,28 @@
 #include <pointhaptics/core/error.hpp>
 #include <pointhaptics/mechanics/energy.hpp>
 #include <pointhaptics/solvers/explicit_solver.hpp>
+#include <pointhaptics/mechanics/cut.hpp>
 
+#include <algorithm>
 #include <chrono>
+#include <span>
 #include <cmath>
 #include <random>
 
 namespace pointhaptics {
 namespace {
 
-LodBuild build_lod(const Model& full, const LodParams& params, const Vec3& centre, SolverKind solver) {
+// `sheets`: the cuts' so far (a copy: a worker builds while the simulation cuts on); object_cuts: the count of
+// the object's cuts they stand for
+LodBuild build_lod(const Model& full, const LodParams& params, const Vec3& centre, SolverKind solver,
+                   std::vector<std::array<Vec3, 3>> sheets, long long object_cuts) {
   const auto start = std::chrono::steady_clock::now();
   LodBuild b;
   std::mt19937_64 rng(params.seed);  // a fresh generator: every point keeps its draw across selections
   b.selection = select_points(full, centre, params, rng);
   b.active = build_active_set(full, b.selection, params);
+  cut_as_object(b.active, full, sheets);  // before its stable step: a cut stencil can be stiffer
+  b.object_cuts = object_cuts;
   b.centre = centre;
   if (solver == SolverKind::EXPLICIT) b.stable_dt = stable_time_step(b.active.model, 0.8, 20);
   b.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -48,7 +56,53 @@ LevelsOfDetail::LevelsOfDetail(ModelSimulation&& object, const LodParams& params
   // the object's simulation, its model taken, hands its diagnostics, inputs and probe to the first active
   // set like any re-selection; built here, before any step (set-up, not a stall)
   active_ = std::make_unique<ModelSimulation>(std::move(object));
-  take_over(build_lod(full_, params_, snap(contact), solver_.kind), true);
+  // the object's own cuts so far are in its model (and its sheets): the active sets are built with them
+  sheets_carried_ = active_->cut_sheets_.triangles.size();
+  sheet_revision_carried_ = active_->cut_sheets_.revision;
+  take_over(build_lod(full_, params_, snap(contact), solver_.kind, active_->cut_sheets_.triangles, object_cuts_made_), true);
+}
+
+void LevelsOfDetail::carry_cuts() {
+  ModelSimulation& sim = *active_;
+  // the pairs the active model lost, where the object has them
+  const Csr& object = full_.neighbours;
+  for (const auto& [k, l] : sim.severed_log_) {
+    const index_t i = active_set_.full_of[k], j = active_set_.full_of[l];
+    for (index_t e = object.begin(i); e < object.end(i); ++e)
+      if (object.index[e] == j) {
+        object_cuts_.push_back(e);
+        break;
+      }
+  }
+  sim.severed_log_.clear();
+  // the object's pairs across the new sheets: those between points that are not both simulated too (the
+  // last strip's two triangles again, as a straight cut extends them)
+  const CutSheets& sheets = sim.cut_sheets_;
+  if (sheets.revision != sheet_revision_carried_) {
+    const std::size_t from = std::min(sheets_carried_ >= 2 ? sheets_carried_ - 2 : 0, sheets.triangles.size());
+    const std::vector<index_t> crossing =
+        pairs_crossing_triangles(full_, full_.X, std::span(sheets.triangles).subspan(from));
+    object_cuts_.insert(object_cuts_.end(), crossing.begin(), crossing.end());
+    sheets_carried_ = sheets.triangles.size();
+    sheet_revision_carried_ = sheets.revision;
+  }
+  // a re-selection in flight reads the object's model: the cut waits for it (take_over())
+  if (!pending_.valid()) apply_object_cuts();
+}
+
+void LevelsOfDetail::apply_object_cuts() {
+  if (object_cuts_.empty()) return;
+  if (sever_pairs(full_, object_cuts_).severed_pairs > 0) {
+    ++object_cuts_made_;
+    object_state_current_ = false;  // (the state is the same; kept simple: recomputed when asked)
+  }
+  object_cuts_.clear();
+}
+
+const Model& LevelsOfDetail::settled_object_model() {
+  if (pending_.valid()) pending_.wait();
+  apply_object_cuts();
+  return full_;
 }
 
 LevelsOfDetail::~LevelsOfDetail() {
@@ -125,9 +179,12 @@ std::vector<index_t> LevelsOfDetail::update(const Vec3& contact, bool onset, boo
   if (onset ? moved < 0.25 * params_.reselect * full_.h : moved <= params_.reselect * full_.h) return {};
   if (!onset && active_->state().time - last_selection_time_ < params_.reselect_interval) return {};
   contact_ = contact;
-  if (!asynchronous) return take_over(build_lod(full_, params_, snap(contact), solver_.kind), true);
-  // the worker only reads the object's model, which nothing writes while levels of detail are on
-  pending_ = std::async(std::launch::async, build_lod, std::cref(full_), params_, snap(contact), solver_.kind);
+  apply_object_cuts();
+  if (!asynchronous)
+    return take_over(build_lod(full_, params_, snap(contact), solver_.kind, active_->cut_sheets_.triangles, object_cuts_made_), true);
+  // the worker only reads the object's model: a cut meanwhile reaches it once the build is done (carry_cuts())
+  pending_ = std::async(std::launch::async, build_lod, std::cref(full_), params_, snap(contact), solver_.kind,
+                        active_->cut_sheets_.triangles, object_cuts_made_);
   return {};
 }
 
@@ -135,6 +192,13 @@ std::vector<index_t> LevelsOfDetail::take_over(LodBuild build, bool built_here) 
   const auto start = std::chrono::steady_clock::now();
   const bool first = selections_ == 0;  // the constructor's, before any step: set-up, not a stall
   ActiveSet& next = build.active;
+  // the cuts made while it was built: on the object now (nothing reads it), and on the new set
+  carry_cuts();
+  if (build.object_cuts != object_cuts_made_) {
+    const CutReport late = cut_as_object(next, full_, active_->cut_sheets_.triangles);
+    if (late.severed_pairs > 0 && build.stable_dt > 0)
+      build.stable_dt = std::min(build.stable_dt, local_stable_time_step(next.model, late.cut_points, 1, 0.8, 12));
+  }
   std::vector<index_t> new_index(first ? 0 : static_cast<std::size_t>(active_->model().n_points), -1);
   double energy_before = 0;
   State carried = full_state_;
@@ -157,12 +221,20 @@ std::vector<index_t> LevelsOfDetail::take_over(LodBuild build, bool built_here) 
   sim->diagnostics_ = std::move(active_->diagnostics_);
   sim->inputs_ = active_->inputs_;
   sim->probe_ = std::move(active_->probe_);
+  // the cuts' sheets, and a split of the surface along them in flight (it reads the object's model)
+  sim->cut_sheets_ = std::move(active_->cut_sheets_);
+  sim->sheet_edge_ = active_->sheet_edge_;
+  sim->split_ = std::move(active_->split_);
+  sim->log_severed_ = true;
   active_ = std::move(sim);
   if (active_->probe_) {
     ProbeAttachment& probe = *active_->probe_;
+    probe.object_model = &full_;
+    probe.active_set = &active_set_;  // (next, once moved there below)
     std::optional<SurfaceContact> surface;
     if (probe.surface)
-      surface.emplace(probe_surface_contact(*probe.surface, probe.contact, probe_shape(probe.tool.contact().params()), active_->model(), &next));
+      surface.emplace(probe_surface_contact(probe.split ? *probe.split : *probe.surface, probe.contact,
+                                            probe_shape(probe.tool.contact().params()), active_->model(), &next));
     probe.tool.remap(active_->model(), new_index, std::move(surface));
   }
   active_->set_state(state);

@@ -19,6 +19,7 @@ struct LodBuild {
   Selection selection;
   ActiveSet active;
   Vec3 centre;
+  long long object_cuts = 0;  ///< the object's cuts it was built after (LevelsOfDetail::object_cuts_made_)
   double stable_dt = 0;
   double ms = 0;  ///< selection, active model and its stable step
 };
@@ -42,6 +43,13 @@ class LevelsOfDetail {
   void set_object_state(const State& state);
   /// The active state changed (a step): the object's is recomputed when next asked for.
   void mark_stale() { object_state_current_ = false; }
+  /// After the active model was cut (a step's blade, a scripted cut, Simulation::cut): the cut reaches the
+  /// object. The pairs the active model lost, where the object has them, and the object's pairs that cross the
+  /// cuts' new sheets (reference configuration) are severed in the object's model, at once, or once a
+  /// re-selection in flight (which reads it) is built; every later active set is built with them severed.
+  void carry_cuts();
+  /// The object's model with every cut carried (waits for a re-selection in flight).
+  const Model& settled_object_model();
 
   /// The pipeline's active-set stage: follow the probe's contact point as the last step left it (contact
   /// onset, or moved by more than params.reselect h), re-selecting in place or on a worker thread as the
@@ -67,6 +75,7 @@ class LevelsOfDetail {
 
  private:
   std::vector<index_t> take_over(LodBuild build, bool built_here);
+  void apply_object_cuts();
   Vec3 snap(const Vec3& c) const;
 
   Model full_;
@@ -84,6 +93,10 @@ class LevelsOfDetail {
   long long selections_ = 0;
   double last_build_ms_ = 0, max_reselect_ms_ = 0;
   std::future<LodBuild> pending_;       ///< an asynchronous re-selection in flight
+  std::vector<index_t> object_cuts_;    ///< the object's pairs to sever once no re-selection reads its model
+  long long object_cuts_made_ = 0;      ///< times the object's model was cut
+  std::size_t sheets_carried_ = 0;      ///< sheet triangles whose pairs were found in the object
+  long long sheet_revision_carried_ = 0;
   double last_selection_time_ = -std::numeric_limits<double>::infinity();  ///< of the last take-over, s
 };
 

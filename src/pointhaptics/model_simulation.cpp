@@ -50,6 +50,7 @@ CutReport ModelSimulation::cut(std::span<const BladeSweep> sweeps) {
   const auto start = std::chrono::steady_clock::now();
   cut_positions_ = model_.X + state_.u;  // allocates only the first time
   const CutReport report = pointhaptics::cut(model_, cut_positions_, sweeps);
+  if (log_severed_) severed_log_.insert(severed_log_.end(), report.severed.begin(), report.severed.end());
   if (report.severed_pairs > 0) {
     // a one-sided or thin stencil can be stiffer than a whole one: Lanczos on a patch around the cut's points
     // (the model's tangent restricted to it) finds the modes the cut made in a few steps, at the patch's cost
@@ -106,11 +107,16 @@ void ModelSimulation::record_cut_sheet(const BladeSweep& sweep) {
 
 void ModelSimulation::refresh_probe_surface() {
   ProbeAttachment& probe = *probe_;
-  // the probe's contact from now on: with the split surface
+  // the probe's contact from now on: with the split surface (with levels of detail, its part the active set
+  // carries, made here: the active set may have changed since the split began)
   auto take = [&](SplitContact done) {
     std::vector<index_t> same(static_cast<std::size_t>(model_.n_points));
     std::iota(same.begin(), same.end(), index_t{0});
-    probe.tool.remap(model_, same, std::move(done.contact));
+    SurfaceContact contact = done.contact ? std::move(*done.contact)
+                                          : probe_surface_contact(*done.surface, probe.contact, probe_shape(probe.tool.contact().params()),
+                                                                  model_, probe.active_set);
+    probe.tool.remap(model_, same, std::move(contact));
+    probe.split = std::move(done.surface);
     probe.surface_revision = done.revision;
     ++diagnostics_.surface_splits;
     diagnostics_.max_split_seconds = std::max(diagnostics_.max_split_seconds, done.seconds);
@@ -120,14 +126,17 @@ void ModelSimulation::refresh_probe_surface() {
     take(split_.get());
   }
   if (probe.surface_revision == cut_sheets_.revision) return;
-  // on one thread: in real time the other core runs the haptic loop
+  // on one thread: in real time the other core runs the haptic loop. The surface is the object's, split along
+  // its points (with levels of detail the object's model, which outlives this simulation, not the active one)
   auto split = [surface = probe.surface, sheets = cut_sheets_, params = probe.contact,
-                shape = probe_shape(probe.tool.contact().params()), &model = model_]() {
+                shape = probe_shape(probe.tool.contact().params()), &object = probe.object_model ? *probe.object_model : model_,
+                whole_model = probe.active_set == nullptr]() {
     const auto start = std::chrono::steady_clock::now();
     tbb::task_arena one_thread(1);
     SplitContact made = one_thread.execute([&] {
-      return SplitContact{probe_surface_contact(split_surface(*surface, model, sheets.triangles), params, shape, model, nullptr),
-                          sheets.revision};
+      SplitContact m{std::make_shared<const ObjectSurface>(split_surface(*surface, object, sheets.triangles)), std::nullopt, sheets.revision};
+      if (whole_model) m.contact.emplace(probe_surface_contact(*m.surface, params, shape, object, nullptr));
+      return m;
     });
     made.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return made;

@@ -14,6 +14,7 @@
 #include <future>
 #include <pointhaptics/solvers/solver.hpp>
 
+#include <array>
 #include <memory>
 #include <optional>
 #include <span>
@@ -64,6 +65,11 @@ struct ProbeAttachment {
   std::shared_ptr<const ObjectSurface> surface;
   SurfaceContactParams contact;
   long long surface_revision = 0;  ///< of the cut sheets the contact's surface is split along (ModelSimulation::cut_sheets)
+  std::shared_ptr<const ObjectSurface> split;  ///< `surface` split along them (null before any cut)
+  /// With levels of detail (set by LevelsOfDetail): the object's model, which carries the surface and along
+  /// whose points it is split, and the active set the simulation's model is; null without.
+  const Model* object_model = nullptr;
+  const ActiveSet* active_set = nullptr;
 };
 
 /// The probe's contact with `surface` (of the object) over `model`'s points: the whole surface, or with
@@ -135,6 +141,10 @@ class ModelSimulation {
   std::vector<BladeSweep> blade_strips_;  ///< a blade's strips this step
   CutSheets cut_sheets_;
   std::vector<index_t> sheet_points_;     ///< the points near a sheet being recorded (kept: no allocation per step)
+  /// The pairs the cuts severed, kept for the layer above when it asks (levels of detail carry them to the
+  /// object), and drained by it.
+  bool log_severed_ = false;
+  std::vector<std::array<index_t, 2>> severed_log_;
   std::optional<std::array<Vec3, 4>> sheet_edge_;  ///< the last sheet's end edge: where it is now, and mapped back
   std::unique_ptr<Solver> solver_impl_;
   StepInputs inputs_;
@@ -143,9 +153,11 @@ class ModelSimulation {
   std::optional<ProbeAttachment> probe_;
   std::unique_ptr<HeldTool> held_tool_;
   /// The probe's contact with the surface split along the sheets of a revision, being made on a worker
-  /// thread in real time (declared last: destroyed first, it waits for the worker, which reads model_).
+  /// thread in real time (declared last: destroyed first, it waits for the worker, which reads model_ or,
+  /// with levels of detail, the object's model, and then moves to the next active model's simulation).
   struct SplitContact {
-    SurfaceContact contact;
+    std::shared_ptr<const ObjectSurface> surface;  ///< over the object's points
+    std::optional<SurfaceContact> contact;         ///< over the model's, made with it without levels of detail
     long long revision = 0;
     double seconds = 0;
   };

@@ -36,18 +36,19 @@ const StepReport& Simulation::step() {
   if (!scripted_cuts_.empty()) apply_scripted_cuts();
   // the tools, the solver, the finite check and the diagnostics
   const StepReport& report = sim.step();
-  if (lod_) lod_->mark_stale();
+  if (lod_) {
+    lod_->carry_cuts();  // a blade's cut in the active set reaches the object
+    lod_->mark_stale();
+  }
   return report;
 }
 
-void Simulation::add_scripted_cut(const CutSpec& cut) {
-  if (lod_) throw Error("cut: not yet with levels of detail (a cut in the active set does not reach the object)");
-  scripted_cuts_.push_back({cut, 0.0});
-}
+void Simulation::add_scripted_cut(const CutSpec& cut) { scripted_cuts_.push_back({cut, 0.0}); }
 
-CutReport Simulation::cut(const BladeSweep& sweep) {
-  if (lod_) throw Error("cut: not yet with levels of detail (a cut in the active set does not reach the object)");
-  return object_->cut(sweep);
+CutReport Simulation::cut(std::span<const BladeSweep> sweeps) {
+  CutReport report = core().cut(sweeps);
+  if (lod_) lod_->carry_cuts();
+  return report;
 }
 
 void Simulation::apply_scripted_cuts() {
@@ -72,7 +73,7 @@ void Simulation::apply_scripted_cuts() {
     const BladeSweep strip{at(0, c.done), at(1, c.done), at(0, share), at(1, share)};
     if (c.done > 0) {
       const std::array<BladeSweep, 2> both{trail, strip};
-      object_->cut(both);
+      cut(both);
     } else {
       cut(strip);
     }
@@ -80,7 +81,7 @@ void Simulation::apply_scripted_cuts() {
   }
   // a piece the cuts set free has no equilibrium: say so before the static solve fails on it
   if (spec.kind == SolverKind::STATIC) {
-    const Model& model = this->model();
+    const Model& model = lod_ ? lod_->settled_object_model() : object_->model();
     std::vector<index_t> piece_of;
     const std::vector<index_t> size = piece_sizes(model, piece_of);
     std::vector<char> held(size.size(), 0);
@@ -115,8 +116,6 @@ void Simulation::attach_probe(const ProbeParams& params, double coupling_stiffne
                               std::shared_ptr<const ObjectSurface> surface) {
   ModelSimulation& sim = core();
   if (sim.solver().kind == SolverKind::STATIC) throw Error("probe: needs a dynamic solver (explicit or implicit)");
-  if (params.mode == ProbeMode::CUT && lod_)
-    throw Error("probe: a blade does not cut with levels of detail yet (a cut in the active set does not reach the object)");
   if (params.mode == ProbeMode::CUT && !(params.length > 0))
     throw Error("probe: a blade is a capsule whose axis is its edge: give it a length");
   if (sim.held_tool()) throw Error("probe: the simulation already holds a tool (one tool at a time)");
@@ -134,7 +133,7 @@ void Simulation::attach_probe(const ProbeParams& params, double coupling_stiffne
   if (surface)
     on_surface.emplace(probe_surface_contact(*surface, contact, probe_shape(params), sim.model(), lod_ ? &lod_->active_set() : nullptr));
   sim.probe().emplace(ProbeAttachment{ProbeTool(sim.model(), params, coupling_stiffness, max_force, std::move(on_surface)),
-                                      asynchronous_lod, std::move(surface), contact});
+                                      asynchronous_lod, std::move(surface), contact, 0, nullptr, nullptr, nullptr});
   sim.inputs() = StepInputs{};
 }
 
@@ -178,9 +177,6 @@ void Simulation::grabbed_points(std::vector<index_t>& out) const {
 
 void Simulation::enable_lod(const LodParams& params, const Vec3& contact) {
   if (lod_) throw Error("lod: levels of detail are already on");
-  const bool blade = object_->probe() && object_->probe()->tool.blade();
-  if (!scripted_cuts_.empty() || !object_->model().severed.empty() || blade)
-    throw Error("lod: not yet with cuts (a cut in the active set does not reach the object)");
   lod_ = std::make_unique<LevelsOfDetail>(std::move(*object_), params, contact);
   object_.reset();
 }
@@ -294,16 +290,18 @@ RunSummary Simulation::summary() {
   if (lod_) lod_->fill(s.lod);
   s.tool = tool_summary();
   if (d.cuts > 0 || !scripted_cuts_.empty()) {
+    // the object's cut (with levels of detail every cut of an active set reaches it)
+    const Model& object = lod_ ? lod_->settled_object_model() : model;
     s.cut.present = true;
     s.cut.sweeps = d.cuts;
-    s.cut.cut_pairs = model.diagnostics.severed_pairs;
+    s.cut.cut_pairs = object.diagnostics.severed_pairs;
     s.cut.max_update_ms = 1e3 * d.max_cut_seconds;
     s.cut.mean_update_ms = d.cuts > 0 ? 1e3 * d.cut_seconds / static_cast<double>(d.cuts) : 0.0;
     s.cut.sheet_triangles = static_cast<long long>(cut_sheets().triangles.size());
     s.cut.surface_splits = d.surface_splits;
     s.cut.max_split_ms = 1e3 * d.max_split_seconds;
     std::vector<index_t> piece_of;
-    s.cut.piece_points = piece_sizes(model, piece_of);
+    s.cut.piece_points = piece_sizes(object, piece_of);
   }
   return s;
 }

@@ -79,11 +79,13 @@ class Simulation {
 
   /// A scripted blade from now on (a scene's [[cut]]): every dynamic step first cuts where the trail its edge has
   /// swept by the end of the step crosses the object (so material that moved back over the trail is cut too);
-  /// a static solve first cuts its whole sweep. Throws Error with levels of detail.
+  /// a static solve first cuts its whole sweep.
   void add_scripted_cut(const CutSpec& cut);
-  /// Cut now, between steps, where `sweep` crosses the object at its current positions (ModelSimulation::cut).
-  /// Throws Error with levels of detail (not yet: a cut in the active set would not reach the object).
-  CutReport cut(const BladeSweep& sweep);
+  /// Cut now, between steps, where the sweeps cross the object at its current positions (ModelSimulation::cut).
+  /// With levels of detail the active model is cut, and the cut reaches the object
+  /// (LevelsOfDetail::carry_cuts()); the report is the active model's.
+  CutReport cut(std::span<const BladeSweep> sweeps);
+  CutReport cut(const BladeSweep& sweep) { return cut(std::span<const BladeSweep>(&sweep, 1)); }
   /// The sheets the cuts swept so far, in the reference configuration (ModelSimulation::cut_sheets): the
   /// object's surface split along them (split_surface()) is the cut object's.
   const CutSheets& cut_sheets() const { return core().cut_sheets(); }

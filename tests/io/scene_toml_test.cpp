@@ -493,8 +493,12 @@ TEST(SceneToml, ReadsScriptedCutsAndNamesTheirErrors) {
   EXPECT_NE(error_of("[0.02, 0.05, 0.05]]", "[0.02, 0.05, -0.01]]", text).find("zero length"), std::string::npos);
   EXPECT_NE(error_of("duration = 0.05", "duration = -1", text).find("cut[0].duration: -1 is out of range"), std::string::npos);
   EXPECT_NE(error_of("start = 0.1", "start = 0.1\nspeed = 2", text).find("cut[0].speed: unknown key"), std::string::npos);
-  EXPECT_NE(error_of("[solver]", "[lod]\nk1 = 1.5\ncontact = [0.0, 0.0, 0.0]\n[solver]", text).find("cut: not yet with levels of detail"),
-            std::string::npos);
+  // with levels of detail too (a cut in the active set reaches the object)
+  std::string with_lod = text;
+  with_lod.replace(with_lod.find("[solver]"), 8, "[lod]\nk1 = 1.5\ncontact = [0.0, 0.0, 0.0]\n[solver]");
+  const Scene cut_lod = parse_scene(with_lod, "t.toml", ".");
+  EXPECT_TRUE(cut_lod.lod.present);
+  EXPECT_EQ(cut_lod.cuts.size(), 1u);
 }
 
 std::string probe_error(const std::string& find, const std::string& replace) {
@@ -513,8 +517,10 @@ TEST(SceneToml, ABladeIsACapsuleThatCutsAndNamesItsErrors) {
   EXPECT_NE(error_of("cut_resistance = 200", "cut_resistance = -1", blade).find("probe.cut_resistance: -1 is out of range"),
             std::string::npos);
   EXPECT_NE(probe_error("mode = \"grab\"", "mode = \"grab\"\ncut_resistance = 5").find("only a blade cuts"), std::string::npos);
-  EXPECT_NE(error_of("[solver]", "[lod]\nk1 = 1.5\n[solver]", blade).find("a blade does not cut with levels of detail"),
-            std::string::npos);
+  std::string blade_lod = blade;
+  blade_lod.replace(blade_lod.find("[solver]"), 8, "[lod]\nk1 = 1.5\n[solver]");
+  const Scene cutting_lod = parse_scene(blade_lod, "t.toml", ".");
+  EXPECT_TRUE(cutting_lod.probe.cut && cutting_lod.lod.present);
 }
 
 TEST(SceneToml, ADevicesProbeHasFrictionButNotOnThePointSpheresOfLevelsOfDetail) {

@@ -75,6 +75,19 @@ TEST(Cut, ABladeThroughTheObjectSeversExactlyTheCrossingPairsAndMakesTwoPieces) 
   for (index_t i = 0; i < model.n_points; ++i) EXPECT_EQ(piece_of[i], model.X(0, i) < x_cut ? 0 : 1);
   // a second pass of the same blade finds nothing left to cut
   EXPECT_EQ(cut(model, model.X, plane_sweep(x_cut, 0.05)).severed_pairs, 0);
+  // the same cut as triangles (a cut's sheets, levels of detail carry cuts by them): the same pairs, each once
+  // (reported as i < j), in the uncut model; none left in the cut one
+  const Model uncut = block();
+  const BladeSweep s = plane_sweep(x_cut, 0.05);
+  const std::array<std::array<Vec3, 3>, 2> sheets{{{s.a0, s.b0, s.b1}, {s.a0, s.b1, s.a1}}};
+  const std::vector<index_t> by_sheets = pairs_crossing_triangles(uncut, uncut.X, sheets);
+  EXPECT_EQ(static_cast<index_t>(by_sheets.size()), expected);
+  for (const index_t e : by_sheets) ASSERT_EQ(model.severed[e], 1);
+  EXPECT_TRUE(pairs_crossing_triangles(model, model.X, sheets).empty());
+  Model again = block();
+  const CutReport listed = sever_pairs(again, by_sheets);
+  EXPECT_EQ(static_cast<index_t>(listed.severed.size()), expected);
+  for (const auto& [i, j] : listed.severed) ASSERT_LT(i, j);
 }
 
 TEST(Cut, APartialSlitKeepsOnePieceAndCutsOnlyWhereTheBladeWent) {

@@ -714,14 +714,8 @@ Scene parse_scene(std::string_view text, const std::string& name, const std::str
   read_array_of_tables(top, "region", [&](TableReader& r) { scene.regions.push_back(read_region(r)); });
   read_array_of_tables(top, "load", [&](TableReader& r) { scene.loads.push_back(read_load(r)); });
   read_array_of_tables(top, "cut", [&](TableReader& r) { scene.cuts.push_back(read_cut(r)); });
-  if (scene.probe.cut && scene.lod.present)
-    throw Error(fmt::format("{}:{}: probe.mode: a blade does not cut with levels of detail yet (a cut in the active set does not reach the object)",
-                            name, scene.probe.line));
   if (scene.probe.cut && scene.probe.held())
     throw Error(fmt::format("{}:{}: probe.mode: a blade cuts as the device moves it, not held at a position", name, scene.probe.line));
-  if (!scene.cuts.empty() && scene.lod.present)
-    throw Error(fmt::format("{}:{}: cut: not yet with levels of detail (a cut in the active set does not reach the object)", name,
-                            scene.cuts.front().line));
   read_array_of_tables(top, "refine", [&](TableReader& r) { scene.refine.push_back(read_refine(r, scene.object)); });
   if (!scene.refine.empty() && scene.lod.present)
     throw Error(fmt::format("{}:{}: refine: not yet with levels of detail ([lod] thins a uniform sampling)", name, scene.refine.front().line));

@@ -226,6 +226,33 @@ ActiveSet build_active_set(const Model& full, const Selection& selection, const 
   return a;
 }
 
+CutReport cut_as_object(ActiveSet& a, const Model& full, std::span<const std::array<Vec3, 3>> sheets) {
+  std::vector<index_t> pairs = pairs_crossing_triangles(a.model, a.model.X, sheets);
+  if (!full.severed.empty()) {
+    // the object's points that lost a pair; an active pair between two of them is looked up in the object
+    const Csr& object = full.neighbours;
+    std::vector<char> lost(static_cast<std::size_t>(full.n_points), 0);
+    for (index_t i = 0; i < full.n_points; ++i)
+      for (index_t e = object.begin(i); e < object.end(i) && !lost[i]; ++e) lost[i] = full.severed[e];
+    const Csr& nbr = a.model.neighbours;
+    for (index_t k = 0; k < a.model.n_points; ++k) {
+      const index_t i = a.full_of[k];
+      if (!lost[i]) continue;
+      for (index_t e = nbr.begin(k); e < nbr.end(k); ++e) {
+        const index_t j = a.full_of[nbr.index[e]];
+        if (nbr.index[e] < k || !lost[j]) continue;
+        for (index_t f = object.begin(i); f < object.end(i); ++f)
+          if (object.index[f] == j) {
+            if (full.severed[f]) pairs.push_back(e);
+            break;
+          }
+      }
+    }
+  }
+  if (pairs.empty()) return {};
+  return sever_pairs(a.model, pairs);
+}
+
 State ActiveSet::restrict_state(const State& full) const {
   State s;
   const index_t n = static_cast<index_t>(full_of.size());

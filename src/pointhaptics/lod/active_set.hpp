@@ -3,6 +3,7 @@
 /// and the maps between its state and the full object's.
 #include <pointhaptics/core/state.hpp>
 #include <pointhaptics/lod/selection.hpp>
+#include <pointhaptics/mechanics/cut.hpp>
 
 #include <vector>
 
@@ -41,5 +42,11 @@ struct ActiveSet {
 
 /// Throws Error if nothing is selected.
 ActiveSet build_active_set(const Model& full, const Selection& selection, const LodParams& params = {});
+
+/// The object's cuts in an active set built from it: its pairs severed where the object's same pair is, and
+/// where their segment crosses one of the cuts' `sheets` (reference configuration): a pair the object does not
+/// have (a widened support's) or one between points the object's cut left apart but that were not both
+/// simulated when it was cut. Returns what it severed (mechanics/cut.hpp).
+CutReport cut_as_object(ActiveSet& active, const Model& full, std::span<const std::array<Vec3, 3>> sheets);
 
 }  // namespace pointhaptics

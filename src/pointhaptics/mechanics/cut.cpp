@@ -62,9 +62,30 @@ std::vector<index_t> pairs_crossing(const Model& model, const Points& x, const B
   return crossing;
 }
 
+std::vector<index_t> pairs_crossing_triangles(const Model& model, const Points& x, std::span<const std::array<Vec3, 3>> triangles) {
+  // a crossing pair has both ends within its length of the triangle: in the reference configuration no pair
+  // is longer than the largest support
+  const double reach = model.support.size() ? model.support.maxCoeff() : model.h;
+  const Csr& nbr = model.neighbours;
+  std::vector<index_t> crossing;
+  for (const std::array<Vec3, 3>& t : triangles) {
+    const Vec3 lo = t[0].cwiseMin(t[1]).cwiseMin(t[2]).array() - reach, hi = t[0].cwiseMax(t[1]).cwiseMax(t[2]).array() + reach;
+    for (index_t i = 0; i < model.n_points; ++i) {
+      if (!((x.col(i).array() >= lo.array()).all() && (x.col(i).array() <= hi.array()).all())) continue;
+      for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
+        const index_t j = nbr.index[e];
+        if (j < i || (!model.severed.empty() && model.severed[e])) continue;
+        if (segment_crossing(x.col(i), x.col(j), t[0], t[1], t[2])) crossing.push_back(e);
+      }
+    }
+  }
+  std::sort(crossing.begin(), crossing.end());  // a pair two triangles cross, once
+  crossing.erase(std::unique(crossing.begin(), crossing.end()), crossing.end());
+  return crossing;
+}
+
 CutReport sever_pairs(Model& model, const std::vector<index_t>& pairs) {
   const Csr& nbr = model.neighbours;
-  if (model.n_passive > 0) throw Error("cut: not on a level-of-detail active set (its cut would not reach the object)");
   if (model.severed.empty()) model.severed.assign(static_cast<std::size_t>(model.n_pairs()), 0);
   CutReport report;
   // the pairs to sever (both directions) and the stencils that lose them
@@ -73,6 +94,7 @@ CutReport sever_pairs(Model& model, const std::vector<index_t>& pairs) {
     if (e < 0 || e >= model.n_pairs()) throw Error(fmt::format("cut: pair {} does not exist (the model has {})", e, model.n_pairs()));
     if (model.severed[e]) continue;
     const index_t i = row_of(nbr, e), j = nbr.index[e];
+    report.severed.push_back({std::min(i, j), std::max(i, j)});
     newly.push_back(e);
     newly.push_back(model.reverse_pair[e]);
     stencils.push_back(i);
@@ -84,6 +106,8 @@ CutReport sever_pairs(Model& model, const std::vector<index_t>& pairs) {
   std::sort(stencils.begin(), stencils.end());
   stencils.erase(std::unique(stencils.begin(), stencils.end()), stencils.end());
   report.cut_points = stencils;
+  std::sort(report.severed.begin(), report.severed.end());  // a pair given in both directions, once
+  report.severed.erase(std::unique(report.severed.begin(), report.severed.end()), report.severed.end());
   // the pairs whose hourglass terms change: those of the refitted stencils (d changes) and their reverses (k
   // changes with the stencil's weight sum)
   std::vector<std::pair<index_t, index_t>> changed;

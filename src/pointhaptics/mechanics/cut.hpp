@@ -9,6 +9,7 @@
 /// material: volumes and masses stay.
 #include <pointhaptics/core/model.hpp>
 
+#include <array>
 #include <limits>
 #include <span>
 #include <vector>
@@ -30,6 +31,12 @@ struct BladeSweep {
 /// points to, so a blade through a lattice plane severs each pair once.
 std::vector<index_t> pairs_crossing(const Model& model, const Points& x, const BladeSweep& sweep);
 
+/// The pairs e = (i, j), i < j, not yet severed, whose segment between the positions `x` crosses one of the
+/// `triangles` (each as three corners): with x = model.X and a cut's sheets in the reference configuration
+/// (cut_surface.hpp), the pairs those cuts part, in any model over the same object (levels of detail carry a
+/// cut of the active set to the object, and the object's cuts to the next active set, by them).
+std::vector<index_t> pairs_crossing_triangles(const Model& model, const Points& x, std::span<const std::array<Vec3, 3>> triangles);
+
 /// The area a number of severed pairs stands for, m^2: in a body of uniform point density rho = 1 / spacing^3
 /// and support h, a plane of area A is crossed by rho^2 A pi h^4 / 4 pairs (a point at distance z from it has
 /// rho pi (h - z)^2 (2h + z) / 3 neighbours beyond it; integrated over z in [0, h]). Counted from the pairs,
@@ -42,6 +49,7 @@ struct CutReport {
   index_t refitted_stencils = 0;  ///< stencils that lost pairs and were refitted
   index_t regularised = 0;        ///< of those, the ones left one-sided or too thin, hence regularised
   std::vector<index_t> cut_points;  ///< the ends of the newly severed pairs, each once
+  std::vector<std::array<index_t, 2>> severed;  ///< the newly severed pairs (i, j), i < j
 };
 
 
@@ -49,7 +57,8 @@ struct CutReport {
 /// on them: the stencils that lost pairs (M_i, d_ij, d_ii), the hourglass coefficients of their pairs and of
 /// the pairs' reverses, the hourglass diagonal's terms of those pairs, and the diagnostics
 /// (regularised_neighbourhoods, isolated_points, severed_pairs). Cost: the affected rows, not the model.
-/// Throws Error for a pair that does not exist, and on a level-of-detail active set (passive points).
+/// Throws Error for a pair that does not exist. On a level-of-detail active set the passive points' stencils
+/// are refitted too (they carry no energy; their pairs' hourglass terms do).
 CutReport sever_pairs(Model& model, const std::vector<index_t>& pairs);
 
 /// sever_pairs() of the pairs_crossing() of every sweep (a blade step's strips), all at the positions x: the
