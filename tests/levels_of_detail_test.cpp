@@ -324,5 +324,42 @@ TEST(LevelsOfDetail, InteractiveRunsFollowTheProbe) {
   EXPECT_GT(lod.last_frame.norm(), 0.0);
 }
 
+// The object's pairs across the plane x = 6.5 cm (between two planes of points) left unsevered
+index_t unsevered_across(const Model& model) {
+  index_t whole = 0;
+  for (index_t i = 0; i < model.n_points; ++i)
+    for (index_t e = model.neighbours.begin(i); e < model.neighbours.end(i); ++e) {
+      const index_t j = model.neighbours.index[e];
+      whole += j > i && (model.X(0, i) < 0.065) != (model.X(0, j) < 0.065) && (model.severed.empty() || !model.severed[e]);
+    }
+  return whole;
+}
+
+TEST(LevelsOfDetail, ACutWhileAReselectionIsBuiltOnAWorkerReachesTheObjectAndTheNewSetOnceItIsBuilt) {
+  Scene scene = block_scene(Vec3::Zero(), 0);
+  scene.solver.kind = SolverKind::EXPLICIT;
+  Simulation sim(build_scene_model(scene), scene.solver, 1);
+  LodParams p;
+  p.k1 = 2.5;  // x h = 5 cm
+  p.k2 = 3.0;
+  sim.enable_lod(p, Vec3(0.03, 0.04, 0.03));
+  ASSERT_GT(unsevered_across(sim.model()), 0);
+  // a re-selection around x = 9 cm built on a worker, and meanwhile a blade down through the plane x = 6.5 cm
+  EXPECT_TRUE(sim.update_lod(Vec3(0.09, 0.04, 0.03), true, true).empty());
+  const BladeSweep blade{Vec3(0.065, 0.05, -0.01), Vec3(0.065, 0.05, 0.07), Vec3(0.065, -0.01, -0.01), Vec3(0.065, -0.01, 0.07)};
+  const CutReport report = sim.cut(blade);
+  EXPECT_GT(report.severed_pairs, 0);
+  EXPECT_EQ(unsevered_across(sim.simulated_model()), 0);
+  // the new set taken over (waiting for it): it and the object are cut all the way through
+  EXPECT_FALSE(sim.update_lod(Vec3(0.09, 0.04, 0.03), true, false).empty());
+  EXPECT_EQ(unsevered_across(sim.simulated_model()), 0);
+  EXPECT_EQ(unsevered_across(sim.model()), 0);
+  std::vector<index_t> piece_of;
+  EXPECT_EQ(connected_pieces(sim.model(), piece_of), 2);
+  EXPECT_EQ(sim.summary().cut.piece_points.size(), 2u);
+  sim.step();
+  EXPECT_TRUE(sim.state().u.allFinite());
+}
+
 }  // namespace
 }  // namespace pointhaptics
