@@ -4,6 +4,7 @@
 #include <pointhaptics/core/workspace.hpp>
 #include <pointhaptics/geometry/sampling.hpp>
 #include <pointhaptics/geometry/shape_surfaces.hpp>
+#include <pointhaptics/mechanics/cut.hpp>
 #include <pointhaptics/mechanics/forces.hpp>
 #include <pointhaptics/mechanics/tangent.hpp>
 #include <pointhaptics/mechanics/tangent_matrix.hpp>
@@ -344,12 +345,77 @@ void haptic_benchmark(benchmark::State& state) {
   state.counters["sim_steps_per_s"] = wall > 0 ? steps / wall : 0.0;
 }
 
+// a blade step near the contact (issue 18): the seed's cantilever at 2.5 mm spacing (10,309 points, E = 1e6 Pa,
+// clamped at x = 0), a blade's edge along z moved down through the plane x = 3.625 cm (between two planes of
+// points) 0.7 mm per update (0.7 m/s at 1 kHz), from 5 mm above the beam to 5 mm below it, then again on a
+// fresh model. Part 0: the whole update (Simulation::cut: the pairs found and severed, the stencils refitted,
+// the stable step checked on a patch, the solver rebuilt, the sheet recorded); 1: the pairs found and severed
+// and the stencils refitted (mechanics/cut.hpp) only; 2: the stable step's check on the patch only
+const std::array<std::string_view, 3> blade_parts = {"update", "sever", "stable_step"};
+
+void blade_benchmark(benchmark::State& state) {
+  const int part = static_cast<int>(state.range(0)), threads = static_cast<int>(state.range(1));
+  static const Scene scene = [] {
+    Scene s;
+    s.path = "blade-bench";
+    s.object.size = Vec3(0.15, 0.03, 0.03);
+    s.object.spacing = 0.0025;
+    s.material.young = 1e6;
+    s.material.poisson = 0.4;
+    s.material.damping = 20;
+    FixedSpec root;
+    root.box = {Vec3(-1, -1, -1), Vec3(0, 1, 1)};
+    s.fixed.push_back(root);
+    s.solver.kind = SolverKind::EXPLICIT;
+    s.solver.dt = 1e-3;
+    return s;
+  }();
+  static const Model model = build_scene_model(scene);
+  const double x = 0.03625, stroke = 0.0007, top = 0.035, bottom = -0.005;
+  std::unique_ptr<Simulation> sim;
+  Model cut_model;
+  double y = top;
+  auto fresh = [&] {
+    if (part == 0) sim = std::make_unique<Simulation>(model, scene.solver, threads);
+    else cut_model = model;
+    y = top;
+  };
+  fresh();
+  long long pairs = 0, updates = 0;
+  for (auto _ : state) {
+    if (y < bottom) {
+      state.PauseTiming();
+      fresh();
+      state.ResumeTiming();
+    }
+    const BladeSweep sweep{Vec3(x, y, -0.01), Vec3(x, y, 0.04), Vec3(x, y - stroke, -0.01), Vec3(x, y - stroke, 0.04)};
+    y -= stroke;
+    if (part == 0) {
+      pairs += sim->cut(sweep).severed_pairs;
+    } else if (part == 1) {  // (an explicit simulation's cut: the hourglass diagonal dropped)
+      pairs += cut(cut_model, cut_model.X, sweep, false).severed_pairs;
+    } else {
+      state.PauseTiming();
+      const CutReport report = cut(cut_model, cut_model.X, sweep, false);
+      state.ResumeTiming();
+      if (!report.cut_points.empty()) benchmark::DoNotOptimize(local_stable_time_step(cut_model, report.cut_points, ModelSimulation::cut_patch_rings, 0.8,
+                                                                                             ModelSimulation::cut_lanczos_steps));
+      pairs += report.severed_pairs;
+    }
+    ++updates;
+  }
+  state.counters["points"] = model.n_points;
+  state.counters["threads"] = threads;
+  state.counters["pairs_per_update"] = updates > 0 ? static_cast<double>(pairs) / static_cast<double>(updates) : 0.0;
+}
+
 // collects each run's counters for the JSON while the console reporter prints the table
 class CollectingReporter : public benchmark::ConsoleReporter {
  public:
   nlohmann::json force = nlohmann::json::array(), step = nlohmann::json::array(), beam = nlohmann::json::array(),
                  haptic = nlohmann::json::array(), materials = nlohmann::json::array(), surface = nlohmann::json::array(),
-                 stiff_cantilever = nlohmann::json::array(), cholesky = nlohmann::json::array(), force_streams = nlohmann::json::array();
+                 stiff_cantilever = nlohmann::json::array(), cholesky = nlohmann::json::array(), force_streams = nlohmann::json::array(),
+                 blade = nlohmann::json::array();
   void ReportRuns(const std::vector<Run>& runs) override {
     ConsoleReporter::ReportRuns(runs);
     for (const Run& run : runs) {
@@ -398,6 +464,16 @@ class CollectingReporter : public benchmark::ConsoleReporter {
                                     {"cg_per_step", static_cast<double>(run.counters.at("cg_per_step").value)},
                                     {"factorisations", static_cast<double>(run.counters.at("factorisations").value)},
                                     {"compute_s_per_simulated_s", static_cast<double>(run.counters.at("compute_s_per_simulated_s").value)}});
+        continue;
+      }
+      if (run.benchmark_name().rfind("blade/", 0) == 0) {
+        const std::string name = run.benchmark_name();
+        const size_t slash = name.find('/', 6);
+        blade.push_back({{"part", name.substr(6, slash - 6)},
+                         {"points", static_cast<long long>(run.counters.at("points").value)},
+                         {"threads", static_cast<int>(run.counters.at("threads").value)},
+                         {"pairs_per_update", static_cast<double>(run.counters.at("pairs_per_update").value)},
+                         {"ms", run.GetAdjustedRealTime() / 1e3}});  // the benchmark's unit is microseconds
         continue;
       }
       if (run.benchmark_name().rfind("cholesky/", 0) == 0) {
@@ -462,6 +538,10 @@ int run_bench_suite(const BenchOptions& options) {
   for (int n : options.sizes)
     benchmark::RegisterBenchmark(fmt::format("cholesky/points:{}", n).c_str(), cholesky_benchmark)
         ->Args({n})->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
+  for (int part = 0; part < static_cast<int>(blade_parts.size()); ++part)
+    for (int t : part == 0 ? options.threads : std::vector<int>{1})
+      benchmark::RegisterBenchmark(fmt::format("blade/{}/points:10309/threads:{}", blade_parts[part], t).c_str(), blade_benchmark)
+          ->Args({part, t})->Unit(benchmark::kMicrosecond)->MinTime(options.min_time)->UseRealTime();
   benchmark::RegisterBenchmark("haptic/points:10000", haptic_benchmark)
       ->Args({10000})->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
   // a bad pattern or one that matches nothing is an error, not an empty table and exit 0
@@ -511,7 +591,7 @@ int run_bench_suite(const BenchOptions& options) {
         nlohmann::json{{"force", reporter.force}, {"step", reporter.step}, {"beam_4x1x1", reporter.beam}, {"haptic", reporter.haptic},
                        {"materials", reporter.materials}, {"surface", reporter.surface},
                        {"stiff_cantilever", reporter.stiff_cantilever}, {"cholesky", reporter.cholesky},
-                       {"force_streams", reporter.force_streams}}.dump(1);
+                       {"force_streams", reporter.force_streams}, {"blade", reporter.blade}}.dump(1);
     try {
       write_text_file(options.json_path, "--json", [&](TextOutput& out) { out.print("{}\n", text); });
     } catch (const Error& e) {

@@ -190,6 +190,30 @@ TEST(Simulation, AfterCutsTheStableStepStaysBelowTheCutModelsLanczosStep) {
   }
 }
 
+TEST(Simulation, AtTenThousandPointsABladesStepsKeepAStableStepBelowTheCutModelsLanczosStep) {
+  // the cantilever at 2.5 mm spacing (10,309 points), a blade drawn down through x = 3.625 cm in strips of
+  // 0.7 mm (a 1 kHz step at 0.7 m/s; `pointhaptics bench --filter blade`), then a chip off an edge (its plane clear of the lattice's points): the step
+  // kept after each few strips against 40 Lanczos steps on the whole cut model
+  Scene scene = read_scene_file(PH_SCENES "/cantilever_cut.toml");
+  scene.object.spacing = 0.0025;
+  Simulation sim(build_scene_model(scene), scene.solver, 2);
+  ASSERT_EQ(sim.model().n_points, 10309);
+  auto check = [&](const char* what) {
+    const double lanczos = stable_time_step(sim.model(), 0.8, 40, 2);
+    EXPECT_LE(sim.stable_dt(), 1.01 * lanczos) << what;
+    std::printf("%s: kept %.4g s, Lanczos on the cut model %.4g s\n", what, sim.stable_dt(), lanczos);
+  };
+  double y = 0.035;
+  for (int strip = 1; strip <= 60; ++strip, y -= 0.0007) {
+    sim.cut(BladeSweep{Vec3(0.03625, y, -0.01), Vec3(0.03625, y, 0.04), Vec3(0.03625, y - 0.0007, -0.01), Vec3(0.03625, y - 0.0007, 0.04)});
+    if (strip % 20 == 0) check("strips");
+  }
+  const index_t chipped = sim.cut(BladeSweep{Vec3(0.14, 0.0401, 0.015), Vec3(0.16, 0.0401, 0.015), Vec3(0.14, 0.0151, 0.04), Vec3(0.16, 0.0151, 0.04)}).severed_pairs;
+  ASSERT_GT(chipped, 0);
+  std::printf("the chip: %lld pairs\n", static_cast<long long>(chipped));
+  check("a chip");
+}
+
 TEST(Simulation, AScriptedBladeThroughTheRootDropsTheFreePieceAndLeavesTheStump) {
   // scenes/cantilever_cut.toml: the blade passes x = 3.375 cm from t = 0.2 s to 0.25 s; damping c = 20 / s
   const Scene scene = read_scene_file(PH_SCENES "/cantilever_cut.toml");

@@ -23,7 +23,7 @@ LodBuild build_lod(const Model& full, const LodParams& params, const Vec3& centr
   std::mt19937_64 rng(params.seed);  // a fresh generator: every point keeps its draw across selections
   b.selection = select_points(full, centre, params, rng);
   b.active = build_active_set(full, b.selection, params);
-  cut_as_object(b.active, full, sheets);  // before its stable step: a cut stencil can be stiffer
+  cut_as_object(b.active, full, sheets, solver != SolverKind::EXPLICIT);  // before its stable step: a cut stencil can be stiffer
   b.object_cuts = object_cuts;
   b.centre = centre;
   if (solver == SolverKind::EXPLICIT) b.stable_dt = stable_time_step(b.active.model, 0.8, 20);
@@ -92,7 +92,7 @@ void LevelsOfDetail::carry_cuts() {
 
 void LevelsOfDetail::apply_object_cuts() {
   if (object_cuts_.empty()) return;
-  if (sever_pairs(full_, object_cuts_).severed_pairs > 0) {
+  if (sever_pairs(full_, object_cuts_, solver_.kind != SolverKind::EXPLICIT).severed_pairs > 0) {
     ++object_cuts_made_;
     object_state_current_ = false;  // (the state is the same; kept simple: recomputed when asked)
   }
@@ -195,9 +195,10 @@ std::vector<index_t> LevelsOfDetail::take_over(LodBuild build, bool built_here) 
   // the cuts made while it was built: on the object now (nothing reads it), and on the new set
   carry_cuts();
   if (build.object_cuts != object_cuts_made_) {
-    const CutReport late = cut_as_object(next, full_, active_->cut_sheets_.triangles);
+    const CutReport late = cut_as_object(next, full_, active_->cut_sheets_.triangles, solver_.kind != SolverKind::EXPLICIT);
     if (late.severed_pairs > 0 && build.stable_dt > 0)
-      build.stable_dt = std::min(build.stable_dt, local_stable_time_step(next.model, late.cut_points, 1, 0.8, 12));
+      build.stable_dt = std::min(build.stable_dt, local_stable_time_step(next.model, late.cut_points, ModelSimulation::cut_patch_rings, 0.8,
+                                                                         ModelSimulation::cut_lanczos_steps));
   }
   std::vector<index_t> new_index(first ? 0 : static_cast<std::size_t>(active_->model().n_points), -1);
   double energy_before = 0;

@@ -49,14 +49,15 @@ void ModelSimulation::set_state(const State& state) {
 CutReport ModelSimulation::cut(std::span<const BladeSweep> sweeps) {
   const auto start = std::chrono::steady_clock::now();
   cut_positions_ = model_.X + state_.u;  // allocates only the first time
-  const CutReport report = pointhaptics::cut(model_, cut_positions_, sweeps);
+  // (explicit dynamics drops the hourglass diagonal: only Newton's preconditioner reads it)
+  const CutReport report = pointhaptics::cut(model_, cut_positions_, sweeps, solver_.kind != SolverKind::EXPLICIT);
   if (log_severed_) severed_log_.insert(severed_log_.end(), report.severed.begin(), report.severed.end());
   if (report.severed_pairs > 0) {
     // a one-sided or thin stencil can be stiffer than a whole one: Lanczos on a patch around the cut's points
     // (the model's tangent restricted to it) finds the modes the cut made in a few steps, at the patch's cost
     // (elsewhere the model is as it was); implicit and static steps do not depend on the stable step
     if (solver_.kind == SolverKind::EXPLICIT)
-      stable_dt_ = std::min(stable_dt_, local_stable_time_step(model_, report.cut_points, cut_patch_rings, 0.8, cut_lanczos_steps));
+      stable_dt_ = std::min(stable_dt_, local_stable_time_step(model_, report.cut_points, cut_patch_rings, 0.8, cut_lanczos_steps, n_threads_));
     solver_impl_ = make_solver(model_, solver_, stable_dt_);
   }
   // (also when this sweep severed nothing: pairs cross a blade's path unevenly, and a strip left out would

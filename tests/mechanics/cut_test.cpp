@@ -90,6 +90,21 @@ TEST(Cut, ABladeThroughTheObjectSeversExactlyTheCrossingPairsAndMakesTwoPieces) 
   for (const auto& [i, j] : listed.severed) ASSERT_LT(i, j);
 }
 
+TEST(Cut, AnExplicitSimulationsCutDropsTheHourglassDiagonalAndChangesNothingElse) {
+  Model kept = block(), dropped = block();
+  const CutReport a = cut(kept, kept.X, plane_sweep(0.025, 0.02));
+  const CutReport b = cut(dropped, dropped.X, plane_sweep(0.025, 0.02), false);
+  EXPECT_EQ(a.severed_pairs, b.severed_pairs);
+  EXPECT_EQ(kept.hg_diagonal.size(), kept.n_points);
+  EXPECT_EQ(dropped.hg_diagonal.size(), 0);
+  EXPECT_EQ(kept.d, dropped.d);
+  EXPECT_EQ(kept.d_self, dropped.d_self);
+  EXPECT_EQ(kept.hg_coef, dropped.hg_coef);
+  // a later cut of the dropped one does not bring it back half-made
+  cut(dropped, dropped.X, plane_sweep(0.035, 0.05));
+  EXPECT_EQ(dropped.hg_diagonal.size(), 0);
+}
+
 TEST(Cut, APartialSlitKeepsOnePieceAndCutsOnlyWhereTheBladeWent) {
   Model model = block();
   const CutReport report = cut(model, model.X, plane_sweep(0.025, 0.015));  // y from -1 to 1.5 cm of 0..3 cm

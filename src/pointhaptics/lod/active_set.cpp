@@ -226,7 +226,7 @@ ActiveSet build_active_set(const Model& full, const Selection& selection, const 
   return a;
 }
 
-CutReport cut_as_object(ActiveSet& a, const Model& full, std::span<const std::array<Vec3, 3>> sheets) {
+CutReport cut_as_object(ActiveSet& a, const Model& full, std::span<const std::array<Vec3, 3>> sheets, bool keep_hourglass_diagonal) {
   std::vector<index_t> pairs = pairs_crossing_triangles(a.model, a.model.X, sheets);
   if (!full.severed.empty()) {
     // the object's points that lost a pair; an active pair between two of them is looked up in the object
@@ -250,7 +250,7 @@ CutReport cut_as_object(ActiveSet& a, const Model& full, std::span<const std::ar
     }
   }
   if (pairs.empty()) return {};
-  return sever_pairs(a.model, pairs);
+  return sever_pairs(a.model, pairs, keep_hourglass_diagonal);
 }
 
 State ActiveSet::restrict_state(const State& full) const {

@@ -47,6 +47,7 @@ ActiveSet build_active_set(const Model& full, const Selection& selection, const 
 /// where their segment crosses one of the cuts' `sheets` (reference configuration): a pair the object does not
 /// have (a widened support's) or one between points the object's cut left apart but that were not both
 /// simulated when it was cut. Returns what it severed (mechanics/cut.hpp).
-CutReport cut_as_object(ActiveSet& active, const Model& full, std::span<const std::array<Vec3, 3>> sheets);
+CutReport cut_as_object(ActiveSet& active, const Model& full, std::span<const std::array<Vec3, 3>> sheets,
+                        bool keep_hourglass_diagonal = true);
 
 }  // namespace pointhaptics

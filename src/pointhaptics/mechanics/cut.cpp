@@ -45,15 +45,18 @@ std::vector<index_t> pairs_crossing(const Model& model, const Points& x, const B
   hi.array() += reach + (near_edge ? sweep.edge_reach : 0.0);
   auto inside = [&](index_t i) { return (x.col(i).array() >= lo.array()).all() && (x.col(i).array() <= hi.array()).all(); };
   const Csr& nbr = model.neighbours;
+  const std::array<CrossingTriangle, 2> swept{CrossingTriangle(sweep.a0, sweep.b0, sweep.b1), CrossingTriangle(sweep.a0, sweep.b1, sweep.a1)};
   std::vector<index_t> crossing;
   for (index_t i = 0; i < model.n_points; ++i) {
     if (!inside(i)) continue;
+    const Vec3 p = x.col(i);
+    const std::array<double, 2> side_p{swept[0].side(p), swept[1].side(p)};
     for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
       const index_t j = nbr.index[e];
       if (j < i || (!model.severed.empty() && model.severed[e])) continue;
-      const Vec3 p = x.col(i), q = x.col(j);
-      std::optional<Vec3> at = segment_crossing(p, q, sweep.a0, sweep.b0, sweep.b1);
-      if (!at) at = segment_crossing(p, q, sweep.a0, sweep.b1, sweep.a1);
+      const Vec3 q = x.col(j);
+      std::optional<Vec3> at;
+      for (int t = 0; t < 2 && !at; ++t) at = swept[t].crossing(p, q, side_p[t], swept[t].side(q));
       if (at && (sweep.edge_reach == std::numeric_limits<double>::infinity() ||
                  distance_to_segment(*at, sweep.a1, sweep.b1) <= sweep.edge_reach))
         crossing.push_back(e);
@@ -69,13 +72,16 @@ std::vector<index_t> pairs_crossing_triangles(const Model& model, const Points& 
   const Csr& nbr = model.neighbours;
   std::vector<index_t> crossing;
   for (const std::array<Vec3, 3>& t : triangles) {
+    const CrossingTriangle sheet(t[0], t[1], t[2]);
     const Vec3 lo = t[0].cwiseMin(t[1]).cwiseMin(t[2]).array() - reach, hi = t[0].cwiseMax(t[1]).cwiseMax(t[2]).array() + reach;
     for (index_t i = 0; i < model.n_points; ++i) {
       if (!((x.col(i).array() >= lo.array()).all() && (x.col(i).array() <= hi.array()).all())) continue;
+      const Vec3 p = x.col(i);
+      const double side_p = sheet.side(p);
       for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
         const index_t j = nbr.index[e];
         if (j < i || (!model.severed.empty() && model.severed[e])) continue;
-        if (segment_crossing(x.col(i), x.col(j), t[0], t[1], t[2])) crossing.push_back(e);
+        if (sheet.crossing(p, x.col(j), side_p, sheet.side(x.col(j)))) crossing.push_back(e);
       }
     }
   }
@@ -84,7 +90,7 @@ std::vector<index_t> pairs_crossing_triangles(const Model& model, const Points& 
   return crossing;
 }
 
-CutReport sever_pairs(Model& model, const std::vector<index_t>& pairs) {
+CutReport sever_pairs(Model& model, const std::vector<index_t>& pairs, bool keep_hourglass_diagonal) {
   const Csr& nbr = model.neighbours;
   if (model.severed.empty()) model.severed.assign(static_cast<std::size_t>(model.n_pairs()), 0);
   CutReport report;
@@ -119,7 +125,9 @@ CutReport sever_pairs(Model& model, const std::vector<index_t>& pairs) {
   std::sort(changed.begin(), changed.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
   changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
 
-  add_hourglass_diagonal(model, changed, -1.0, model.hg_diagonal);
+  if (!keep_hourglass_diagonal) model.hg_diagonal.resize(0);
+  const bool diagonal = model.hg_diagonal.size() == model.n_points;
+  if (diagonal) add_hourglass_diagonal(model, changed, -1.0, model.hg_diagonal);
   ModelDiagnostics& diag = model.diagnostics;
   std::vector<double> w;
   auto row_weights = [&](index_t i) {
@@ -154,7 +162,7 @@ CutReport sever_pairs(Model& model, const std::vector<index_t>& pairs) {
     return std::lower_bound(weight_sum.begin(), weight_sum.end(), i, [](const auto& a, index_t b) { return a.first < b; })->second;
   };
   for (const auto& [i, e] : changed) model.hg_coef[e] = hourglass_coefficient(model, i, e, sum_of(i), sum_of(nbr.index[e]));
-  add_hourglass_diagonal(model, changed, 1.0, model.hg_diagonal);
+  if (diagonal) add_hourglass_diagonal(model, changed, 1.0, model.hg_diagonal);
   return report;
 }
 
@@ -163,13 +171,13 @@ double cut_area(const Model& model, index_t severed_pairs) {
   return static_cast<double>(severed_pairs) * 4.0 * std::pow(s, 6) / (std::numbers::pi * std::pow(model.h, 4));
 }
 
-CutReport cut(Model& model, const Points& x, std::span<const BladeSweep> sweeps) {
+CutReport cut(Model& model, const Points& x, std::span<const BladeSweep> sweeps, bool keep_hourglass_diagonal) {
   std::vector<index_t> pairs;
   for (const BladeSweep& sweep : sweeps) {
     const std::vector<index_t> crossing = pairs_crossing(model, x, sweep);
     pairs.insert(pairs.end(), crossing.begin(), crossing.end());  // a pair two strips cross is severed once
   }
-  return sever_pairs(model, pairs);
+  return sever_pairs(model, pairs, keep_hourglass_diagonal);
 }
 
 index_t connected_pieces(const Model& model, std::vector<index_t>& piece_of) {

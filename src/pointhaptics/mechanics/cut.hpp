@@ -58,14 +58,16 @@ struct CutReport {
 /// the pairs' reverses, the hourglass diagonal's terms of those pairs, and the diagnostics
 /// (regularised_neighbourhoods, isolated_points, severed_pairs). Cost: the affected rows, not the model.
 /// Throws Error for a pair that does not exist. On a level-of-detail active set the passive points' stencils
-/// are refitted too (they carry no energy; their pairs' hourglass terms do).
-CutReport sever_pairs(Model& model, const std::vector<index_t>& pairs);
+/// are refitted too (they carry no energy; their pairs' hourglass terms do). With `keep_hourglass_diagonal`
+/// false the hourglass diagonal is dropped instead (Model::hg_diagonal empty): only Newton's block-Jacobi
+/// preconditioner reads it, and keeping it exact was a third of a blade step's update in explicit dynamics.
+CutReport sever_pairs(Model& model, const std::vector<index_t>& pairs, bool keep_hourglass_diagonal = true);
 
 /// sever_pairs() of the pairs_crossing() of every sweep (a blade step's strips), all at the positions x: the
 /// stencils they touch are refitted once.
-CutReport cut(Model& model, const Points& x, std::span<const BladeSweep> sweeps);
-inline CutReport cut(Model& model, const Points& x, const BladeSweep& sweep) {
-  return cut(model, x, std::span<const BladeSweep>(&sweep, 1));
+CutReport cut(Model& model, const Points& x, std::span<const BladeSweep> sweeps, bool keep_hourglass_diagonal = true);
+inline CutReport cut(Model& model, const Points& x, const BladeSweep& sweep, bool keep_hourglass_diagonal = true) {
+  return cut(model, x, std::span<const BladeSweep>(&sweep, 1), keep_hourglass_diagonal);
 }
 
 /// The object's connected pieces over its unsevered pairs: piece_of[i] in [0, count), numbered in the order of

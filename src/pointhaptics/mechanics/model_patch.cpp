@@ -33,21 +33,25 @@ std::vector<index_t> neighbourhood(const Model& model, const std::vector<index_t
 ModelPatch model_patch(const Model& model, const std::vector<index_t>& free) {
   const std::vector<index_t> inner = neighbourhood(model, free, 0);
   // two rings: a free point's force comes from the stencils that reach it (one ring), and their hourglass
-  // pairs (energies/hourglass.hpp) reach one ring further
-  const std::vector<index_t> all = neighbourhood(model, inner, 2);
+  // pairs (energies/hourglass.hpp) reach one ring further. The outer ring is passive (Model::n_passive): its
+  // stencils hold no free point, and its pairs' terms reach the free points only through the inner ring's
+  // gradients, which the inner ring's own stencils carry (a pair's energy is charged from both ends)
+  const std::vector<index_t> first_ring = neighbourhood(model, inner, 1), all = neighbourhood(model, inner, 2);
   ModelPatch patch;
   patch.n_free = static_cast<index_t>(inner.size());
   patch.full_of = inner;
   std::vector<index_t> patch_of(static_cast<std::size_t>(model.n_points), -1);
   for (std::size_t k = 0; k < inner.size(); ++k) patch_of[static_cast<std::size_t>(inner[k])] = static_cast<index_t>(k);
-  for (const index_t i : all)
-    if (patch_of[static_cast<std::size_t>(i)] < 0) {
-      patch_of[static_cast<std::size_t>(i)] = static_cast<index_t>(patch.full_of.size());
-      patch.full_of.push_back(i);
-    }
+  for (const std::vector<index_t>* ring : {&first_ring, &all})
+    for (const index_t i : *ring)
+      if (patch_of[static_cast<std::size_t>(i)] < 0) {
+        patch_of[static_cast<std::size_t>(i)] = static_cast<index_t>(patch.full_of.size());
+        patch.full_of.push_back(i);
+      }
   const index_t n = static_cast<index_t>(patch.full_of.size());
   Model& m = patch.model;
   m.n_points = n;
+  m.n_passive = static_cast<index_t>(all.size() - first_ring.size());
   m.spacing = model.spacing;
   m.h = model.h;
   m.extent = model.extent;
@@ -80,25 +84,27 @@ ModelPatch model_patch(const Model& model, const std::vector<index_t>& free) {
   for (index_t k = 0; k < patch.n_free; ++k) m.fixed[static_cast<std::size_t>(k)] = model.fixed[static_cast<std::size_t>(patch.full_of[static_cast<std::size_t>(k)])];
   if (!model.material_of.empty())
     for (const index_t i : patch.full_of) m.material_of.push_back(model.material_of[static_cast<std::size_t>(i)]);
-  // the pairs within the patch, rows in the model's order (sorted, as the patch's indices keep it within a row
-  // only if renumbered monotonically: sort each row by the patch index)
+  // the pairs within the patch, each row sorted by the patch's index: the free points, the inner ring and the
+  // outer ring are each numbered in the model's order, so a row (in the model's order) is sorted by taking
+  // its free neighbours, then its inner ring's, then its outer ring's
+  const index_t inner_end = static_cast<index_t>(first_ring.size());
+  auto part_of = [&](index_t k) { return k < patch.n_free ? 0 : k < inner_end ? 1 : 2; };
   std::vector<index_t> pair_of;  // patch pair -> the model's
   m.neighbours.offset.assign(1, 0);
+  m.neighbours.index.reserve(static_cast<std::size_t>(n) * static_cast<std::size_t>(model.neighbours.row_size(patch.full_of[0]) + 1));
   for (index_t k = 0; k < n; ++k) {
     const index_t i = patch.full_of[static_cast<std::size_t>(k)];
-    const std::size_t row_start = pair_of.size();
-    for (index_t e = model.neighbours.begin(i); e < model.neighbours.end(i); ++e)
-      if (patch_of[static_cast<std::size_t>(model.neighbours.index[e])] >= 0) pair_of.push_back(e);
-    std::sort(pair_of.begin() + static_cast<std::ptrdiff_t>(row_start), pair_of.end(), [&](index_t a, index_t b) {
-      return patch_of[static_cast<std::size_t>(model.neighbours.index[a])] < patch_of[static_cast<std::size_t>(model.neighbours.index[b])];
-    });
-    for (std::size_t p = row_start; p < pair_of.size(); ++p)
-      m.neighbours.index.push_back(patch_of[static_cast<std::size_t>(model.neighbours.index[pair_of[p]])]);
+    for (int part = 0; part < 3; ++part)
+      for (index_t e = model.neighbours.begin(i); e < model.neighbours.end(i); ++e) {
+        const index_t l = patch_of[static_cast<std::size_t>(model.neighbours.index[e])];
+        if (l >= 0 && part_of(l) == part) {
+          pair_of.push_back(e);
+          m.neighbours.index.push_back(l);
+        }
+      }
     m.neighbours.offset.push_back(static_cast<index_t>(m.neighbours.index.size()));
   }
   const index_t pairs = static_cast<index_t>(pair_of.size());
-  std::vector<index_t> patch_pair(static_cast<std::size_t>(model.n_pairs()), -1);
-  for (index_t p = 0; p < pairs; ++p) patch_pair[static_cast<std::size_t>(pair_of[static_cast<std::size_t>(p)])] = p;
   m.d.resize(3, pairs);
   m.hg_coef.resize(model.hg_coef.size() == model.n_pairs() ? pairs : 0);
   m.reverse_pair.resize(static_cast<std::size_t>(pairs));
@@ -108,8 +114,16 @@ ModelPatch model_patch(const Model& model, const std::vector<index_t>& free) {
     m.d.col(p) = model.d.col(e);
     if (m.hg_coef.size()) m.hg_coef[p] = model.hg_coef[e];
     if (!m.severed.empty()) m.severed[static_cast<std::size_t>(p)] = model.severed[static_cast<std::size_t>(e)];
-    m.reverse_pair[static_cast<std::size_t>(p)] = patch_pair[static_cast<std::size_t>(model.reverse_pair[static_cast<std::size_t>(e)])];
   }
+  // a pair's reverse: in its other end's row, found by the first end (rows are sorted by the patch's index; a
+  // search per pair, not an array over the model's pairs on every call)
+  for (index_t k = 0; k < n; ++k)
+    for (index_t p = m.neighbours.begin(k); p < m.neighbours.end(k); ++p) {
+      const index_t l = m.neighbours.index[p];
+      const auto row = m.neighbours.index.begin();
+      m.reverse_pair[static_cast<std::size_t>(p)] =
+          static_cast<index_t>(std::lower_bound(row + m.neighbours.begin(l), row + m.neighbours.end(l), k) - row);
+    }
   return patch;
 }
 
