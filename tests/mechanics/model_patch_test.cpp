@@ -58,6 +58,17 @@ TEST(ModelPatch, ItsTangentWithTheRingHeldIsTheModelsRestrictedToItsFreePoints) 
   }
   EXPECT_GT(largest, 0);
   EXPECT_LT(error, 1e-12 * largest);
+  // its pairs: rows sorted, each pair's reverse the model's pair's reverse, the outer ring passive
+  const Csr& rows = patch.model.neighbours;
+  for (index_t k = 0; k < patch.model.n_points; ++k)
+    for (index_t p = rows.begin(k); p < rows.end(k); ++p) {
+      if (p + 1 < rows.end(k)) ASSERT_LT(rows.index[p], rows.index[p + 1]);
+      const index_t r = patch.model.reverse_pair[static_cast<std::size_t>(p)];
+      ASSERT_EQ(rows.index[r], k);
+      ASSERT_EQ(patch.model.reverse_pair[static_cast<std::size_t>(r)], p);
+    }
+  EXPECT_GT(patch.model.n_passive, 0);
+  EXPECT_LT(patch.model.n_passive, patch.model.n_points - patch.n_free);
 }
 
 TEST(ModelPatch, ALocalStableStepIsNoShorterThanTheWholeModelsAndIsItOverTheWholeModel) {

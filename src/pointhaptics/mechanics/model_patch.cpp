@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 
 namespace pointhaptics {
 
@@ -92,16 +93,18 @@ ModelPatch model_patch(const Model& model, const std::vector<index_t>& free) {
   std::vector<index_t> pair_of;  // patch pair -> the model's
   m.neighbours.offset.assign(1, 0);
   m.neighbours.index.reserve(static_cast<std::size_t>(n) * static_cast<std::size_t>(model.neighbours.row_size(patch.full_of[0]) + 1));
+  std::array<std::vector<std::array<index_t, 2>>, 3> parts;  // (patch neighbour, model pair) per part of a row
   for (index_t k = 0; k < n; ++k) {
     const index_t i = patch.full_of[static_cast<std::size_t>(k)];
-    for (int part = 0; part < 3; ++part)
-      for (index_t e = model.neighbours.begin(i); e < model.neighbours.end(i); ++e) {
-        const index_t l = patch_of[static_cast<std::size_t>(model.neighbours.index[e])];
-        if (l >= 0 && part_of(l) == part) {
-          pair_of.push_back(e);
-          m.neighbours.index.push_back(l);
-        }
+    for (index_t e = model.neighbours.begin(i); e < model.neighbours.end(i); ++e)
+      if (const index_t l = patch_of[static_cast<std::size_t>(model.neighbours.index[e])]; l >= 0) parts[part_of(l)].push_back({l, e});
+    for (std::vector<std::array<index_t, 2>>& part : parts) {
+      for (const auto& [l, e] : part) {
+        m.neighbours.index.push_back(l);
+        pair_of.push_back(e);
       }
+      part.clear();
+    }
     m.neighbours.offset.push_back(static_cast<index_t>(m.neighbours.index.size()));
   }
   const index_t pairs = static_cast<index_t>(pair_of.size());
@@ -115,15 +118,12 @@ ModelPatch model_patch(const Model& model, const std::vector<index_t>& free) {
     if (m.hg_coef.size()) m.hg_coef[p] = model.hg_coef[e];
     if (!m.severed.empty()) m.severed[static_cast<std::size_t>(p)] = model.severed[static_cast<std::size_t>(e)];
   }
-  // a pair's reverse: in its other end's row, found by the first end (rows are sorted by the patch's index; a
-  // search per pair, not an array over the model's pairs on every call)
+  // a pair's reverse: the rows are sorted and the neighbourhoods symmetric, so going through the rows in order,
+  // the next unvisited entry of row l is k's (a cursor per row, not an array over the model's pairs per call)
+  std::vector<index_t> cursor(m.neighbours.offset.begin(), m.neighbours.offset.end() - 1);
   for (index_t k = 0; k < n; ++k)
-    for (index_t p = m.neighbours.begin(k); p < m.neighbours.end(k); ++p) {
-      const index_t l = m.neighbours.index[p];
-      const auto row = m.neighbours.index.begin();
-      m.reverse_pair[static_cast<std::size_t>(p)] =
-          static_cast<index_t>(std::lower_bound(row + m.neighbours.begin(l), row + m.neighbours.end(l), k) - row);
-    }
+    for (index_t p = m.neighbours.begin(k); p < m.neighbours.end(k); ++p)
+      m.reverse_pair[static_cast<std::size_t>(p)] = cursor[static_cast<std::size_t>(m.neighbours.index[p])]++;
   return patch;
 }
 
