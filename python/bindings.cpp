@@ -79,6 +79,7 @@ struct PySimulation {
   std::optional<ph::InteractiveResult> last_session;  ///< the last run_scene() with a device's probe, for summary()
   std::optional<ph::ObjectSurface> surface;  ///< built on the first surface_* call
   ph::Points surface_vertices;               ///< its deformed vertices, 3 x m, kept current after every step
+  std::optional<ph::CutSurface> cut;         ///< the surface split along the cuts (cut_surface(); split when they change)
   std::mutex mutex;
 
   // the surface's vertices follow the points (after every step, run or probe, once asked for)
@@ -421,6 +422,26 @@ names the problem.)doc")
           },
           "The object's surface triangles, a (t, 3) integer array of rows of surface_vertices (a copy), counter-clockwise "
           "seen from outside")
+      .def(
+          "cut_surface",
+          [](PySimulation& p) {
+            const auto lock = locked(p);
+            if (!p.cut) p.cut.emplace(p.object_surface());
+            const ph::ObjectSurface& split = p.cut->at(p.sim->model(), p.sim->cut_sheets());
+            const ph::Points y = ph::deformed_surface(split, p.sim->state().u);
+            py::array_t<double> vertices({static_cast<py::ssize_t>(y.cols()), py::ssize_t{3}});
+            auto v = vertices.mutable_unchecked<2>();
+            for (Eigen::Index k = 0; k < y.cols(); ++k)
+              for (int a = 0; a < 3; ++a) v(static_cast<py::ssize_t>(k), a) = y(a, k);
+            py::array_t<std::int64_t> triangles({static_cast<py::ssize_t>(split.mesh.F.size()), py::ssize_t{3}});
+            auto t = triangles.mutable_unchecked<2>();
+            for (std::size_t f = 0; f < split.mesh.F.size(); ++f)
+              for (int k = 0; k < 3; ++k) t(static_cast<py::ssize_t>(f), k) = split.mesh.F[f][static_cast<std::size_t>(k)];
+            return py::make_tuple(vertices, triangles, static_cast<long long>(split.cut_faces));
+          },
+          "The object's surface split along the cuts so far (docs/cutting.md): (vertices, triangles, cut_faces), copies "
+          "at the current state; the last cut_faces triangles are the faces of the cuts. Without cuts, the surface of "
+          "surface_vertices and surface_triangles (whose size stays as it was built: they stay the uncut surface).")
       .def(
           "run_scene",
           [](PySimulation& p) {

@@ -304,3 +304,16 @@ def test_a_scripted_cut_parts_the_beam_and_the_summary_says_so():
     free = sim.reference[:, 0] > 0.034
     assert sim.displacement[free, 1].mean() < -0.05
     assert np.abs(sim.displacement[~free]).max() < 1e-4
+    # the surface split along the cut: the faces of the cut close both pieces, so its volume is the beam's,
+    # and no triangle spans the gap (the uncut surface's do)
+    vertices, triangles, cut_faces = sim.cut_surface()
+    assert cut_faces > 0 and len(vertices) > len(sim.surface_vertices)
+
+    def volume(v, t):
+        return np.einsum("ij,ij->i", v[t[:, 0]], np.cross(v[t[:, 1]], v[t[:, 2]])).sum() / 6
+
+    def longest(v, t):
+        return max(np.linalg.norm(v[t[:, k]] - v[t[:, (k + 1) % 3]], axis=1).max() for k in range(3))
+
+    assert abs(volume(vertices, triangles) - 0.15 * 0.03 * 0.03) < 0.01 * 0.15 * 0.03 * 0.03
+    assert longest(vertices, triangles) < 0.02 < longest(sim.surface_vertices, sim.surface_triangles)
