@@ -62,7 +62,9 @@ TEST(ModelPatch, ItsTangentWithTheRingHeldIsTheModelsRestrictedToItsFreePoints) 
   const Csr& rows = patch.model.neighbours;
   for (index_t k = 0; k < patch.model.n_points; ++k)
     for (index_t p = rows.begin(k); p < rows.end(k); ++p) {
-      if (p + 1 < rows.end(k)) ASSERT_LT(rows.index[p], rows.index[p + 1]);
+      if (p + 1 < rows.end(k)) {
+        ASSERT_LT(rows.index[p], rows.index[p + 1]);
+      }
       const index_t r = patch.model.reverse_pair[static_cast<std::size_t>(p)];
       ASSERT_EQ(rows.index[r], k);
       ASSERT_EQ(patch.model.reverse_pair[static_cast<std::size_t>(r)], p);

@@ -85,14 +85,13 @@ double stable_time_step(const Model& model, double safety, int lanczos_steps, in
   return safety * 2.0 / std::sqrt(omega2);
 }
 
-double local_stable_time_step(const Model& model, const std::vector<index_t>& around, int rings, double safety, int lanczos_steps,
-                              int n_threads) {
+double local_stable_time_step(const Model& model, const std::vector<index_t>& around, int rings, double safety, int lanczos_steps) {
   const ModelPatch patch = model_patch(model, neighbourhood(model, around, rings));
   // the free points come first in the patch, in increasing order, and `around` is among them
   const auto free_end = patch.full_of.begin() + patch.n_free;
   std::vector<index_t> focus;
   for (const index_t i : around) focus.push_back(static_cast<index_t>(std::lower_bound(patch.full_of.begin(), free_end, i) - patch.full_of.begin()));
-  return stable_time_step(patch.model, safety, lanczos_steps, n_threads, focus);
+  return stable_time_step(patch.model, safety, lanczos_steps, 1, focus);
 }
 
 double stable_time_step_with_springs(double stable_dt, double spring_stiffness, double min_mass, double safety) {

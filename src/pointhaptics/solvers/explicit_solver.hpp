@@ -22,9 +22,8 @@ double stable_time_step(const Model& model, double safety = 0.8, int lanczos_ste
 /// at the cost of the patch. The patch's tangent is the model's restricted to it, so its modes are the model's
 /// held at the patch's edge: a mode that reaches beyond the patch is found slower than it is, and `rings` must
 /// cover the change's reach (tests/simulation_test.cpp checks it against Lanczos on the whole model).
-/// n_threads: of its products (1: the caller's thread only).
 double local_stable_time_step(const Model& model, const std::vector<index_t>& around, int rings, double safety = 0.8,
-                              int lanczos_steps = 12, int n_threads = 1);
+                              int lanczos_steps = 12);
 
 /// The older, cheaper estimate: safety x a / c_p with a the smallest point distance and c_p the p-wave
 /// speed sqrt((lambda + 2 mu + k_v + alpha E) / rho) of the densest point. Used when Lanczos cannot run.
