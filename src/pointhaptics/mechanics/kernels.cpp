@@ -9,23 +9,17 @@ namespace {
 constexpr double pi = std::numbers::pi;
 }
 
-namespace {
-// integer powers by multiplication: std::pow was a tenth of a cut's refit (kernels are evaluated per pair)
-constexpr double square(double x) { return x * x; }
-constexpr double cube(double x) { return x * x * x; }
-}  // namespace
-
 double kernel_value(KernelType type, double r, double h) {
   if (r >= h) return 0.0;
   const double q = r / h;
   switch (type) {
     case KernelType::POLY6: {  // seed Eq. 3
       const double a = h * h - r * r;
-      return 315.0 / (64.0 * pi * cube(cube(h))) * a * a * a;
+      return 315.0 / (64.0 * pi * std::pow(h, 9)) * a * a * a;
     }
     case KernelType::SPIKY: {  // seed Eq. 4
       const double a = h - r;
-      return 15.0 / (pi * square(cube(h))) * a * a * a;
+      return 15.0 / (pi * std::pow(h, 6)) * a * a * a;
     }
     case KernelType::VISCOSITY:  // seed Eq. 5
       return 15.0 / (2.0 * pi * h * h * h) * (-0.5 * q * q * q + q * q + 0.5 / q - 1.0);
@@ -43,11 +37,11 @@ double kernel_derivative(KernelType type, double r, double h) {
   switch (type) {
     case KernelType::POLY6: {
       const double a = h * h - r * r;
-      return 315.0 / (64.0 * pi * cube(cube(h))) * 3.0 * a * a * (-2.0 * r);
+      return 315.0 / (64.0 * pi * std::pow(h, 9)) * 3.0 * a * a * (-2.0 * r);
     }
     case KernelType::SPIKY: {
       const double a = h - r;
-      return -15.0 / (pi * square(cube(h))) * 3.0 * a * a;
+      return -15.0 / (pi * std::pow(h, 6)) * 3.0 * a * a;
     }
     case KernelType::VISCOSITY:
       return 15.0 / (2.0 * pi * h * h * h) * (-1.5 * q * q + 2.0 * q - 0.5 / (q * q)) / h;
