@@ -1,15 +1,15 @@
 #include <pointhaptics/levels_of_detail.hpp>
 
 #include <pointhaptics/core/error.hpp>
+#include <pointhaptics/mechanics/cut.hpp>
 #include <pointhaptics/mechanics/energy.hpp>
 #include <pointhaptics/solvers/explicit_solver.hpp>
-#include <pointhaptics/mechanics/cut.hpp>
 
 #include <algorithm>
 #include <chrono>
-#include <span>
 #include <cmath>
 #include <random>
+#include <span>
 
 namespace pointhaptics {
 namespace {
@@ -92,10 +92,7 @@ void LevelsOfDetail::carry_cuts() {
 
 void LevelsOfDetail::apply_object_cuts() {
   if (object_cuts_.empty()) return;
-  if (sever_pairs(full_, object_cuts_, solver_.kind != SolverKind::EXPLICIT).severed_pairs > 0) {
-    ++object_cuts_made_;
-    object_state_current_ = false;  // (the state is the same; kept simple: recomputed when asked)
-  }
+  if (sever_pairs(full_, object_cuts_, solver_.kind != SolverKind::EXPLICIT).severed_pairs > 0) ++object_cuts_made_;
   object_cuts_.clear();
 }
 
