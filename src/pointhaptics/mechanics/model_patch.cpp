@@ -37,7 +37,8 @@ ModelPatch model_patch(const Model& model, const std::vector<index_t>& free) {
   // pairs (energies/hourglass.hpp) reach one ring further. The outer ring is passive (Model::n_passive): its
   // stencils hold no free point, and its pairs' terms reach the free points only through the inner ring's
   // gradients, which the inner ring's own stencils carry (a pair's energy is charged from both ends)
-  const std::vector<index_t> first_ring = neighbourhood(model, inner, 1), all = neighbourhood(model, inner, 2);
+  // (the outer ring grown from the inner one: its search is not made twice)
+  const std::vector<index_t> first_ring = neighbourhood(model, inner, 1), all = neighbourhood(model, first_ring, 1);
   ModelPatch patch;
   patch.n_free = static_cast<index_t>(inner.size());
   patch.full_of = inner;
