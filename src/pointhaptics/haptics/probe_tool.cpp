@@ -3,7 +3,6 @@
 #include <pointhaptics/haptics/coupling.hpp>
 
 #include <algorithm>
-#include <array>
 
 namespace pointhaptics {
 
@@ -73,35 +72,15 @@ ContactModel ProbeTool::surface_model(const Model& model, const State& state, co
   return contact_model_of(surface_->load(model, state.u, same_u), state.time, p);
 }
 
-Vec3 ProbeTool::slide_on_surface(const Vec3& from, const Vec3& to) {
-  // per vertex, not the deepest one's depth: a bar set by the deepest vertex (one the surface's smooth carry
-  // could not bring out of a probe of 1.5 spacings) let the others sink to it, and a sliding probe went under
-  // the surface of a soft dome
-  const Eigen::Quaterniond orientation = surface_->pose().orientation;
-  surface_->set_pose(ToolPose{from, orientation});
-  surface_->penetrations(depth_before_);
-  const double floor = allowed_penetration * contact_.params().radius;
-  const auto excess_at = [&](const Vec3& p) {
-    surface_->set_pose(ToolPose{p, orientation});
-    return surface_->deepening(depth_before_, floor);
-  };
-  Vec3 move = to - from;
-  // the directions that blocked the move, orthonormal: the move keeps only its part across all of them. Without
-  // sliding, a probe pressed into a soft, coarse dome whose surface could not take its shape stopped where it
-  // was while the hand went on 2 cm sideways
-  std::array<Vec3, 3> blocked;
-  for (int n_blocked = 0; n_blocked < 3; ++n_blocked) {
-    const SurfaceContact::Deepening there = excess_at(from + move);
-    if (!(there.excess > 0)) return from + move;
-    Vec3 n = there.direction;
-    for (int k = 0; k < n_blocked; ++k) n -= n.dot(blocked[static_cast<std::size_t>(k)]) * blocked[static_cast<std::size_t>(k)];
-    if (!(n.norm() > 1e-9) || !(move.dot(n) > 0)) break;  // not a new direction, or not toward the vertex
-    n.normalize();
-    blocked[static_cast<std::size_t>(n_blocked)] = n;
-    move -= move.dot(n) * n;
-  }
-  for (int halving = 0; halving < 6 && excess_at(from + move).excess > 0; ++halving) move *= 0.5;
-  return excess_at(from + move).excess > 0 ? from : Vec3(from + move);
+double ProbeTool::penetration_at(const Model& model, const State& state, const Vec3& p) {
+  surface_->set_pose(ToolPose{p, surface_->pose().orientation});
+  return surface_->load(model, state.u, true).penetration;
+}
+
+Vec3 ProbeTool::stop_at_surface(const Model& model, const State& state, const Vec3& from, Vec3 to) {
+  const double allowed = std::max(allowed_penetration * contact_.params().radius, penetration_at(model, state, from));
+  for (int halving = 0; halving < 6 && penetration_at(model, state, to) > allowed; ++halving) to = from + 0.5 * (to - from);
+  return penetration_at(model, state, to) > allowed ? from : to;
 }
 
 void ProbeTool::place(const Model& model, const State& state, const Vec3& device, bool button, const Eigen::Quaterniond& orientation) {
@@ -134,7 +113,7 @@ void ProbeTool::place(const Model& model, const State& state, const Vec3& device
     // pass the surface and push it out from within
     const double longest = 0.25 * contact_.params().radius;
     if (pushing_surface() && (next - p).norm() > longest) next = p + (next - p) * (longest / (next - p).norm());
-    if (pushing_surface()) next = slide_on_surface(p, next);
+    if (pushing_surface()) next = stop_at_surface(model, state, p, next);
     const bool settled = (next - p).norm() < 1e-9 + 1e-6 * contact_.params().radius;
     p = next;
     if (settled) break;

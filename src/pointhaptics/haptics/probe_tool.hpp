@@ -85,11 +85,11 @@ class ProbeTool final : public DynamicForces {
 
  private:
   bool pushing_surface() const;
-  /// The god-object's rule: the probe's move from `from` toward `to` may take no surface vertex deeper inside
-  /// it than allowed_penetration x radius, nor one deeper than that already any deeper. A blocked move slides:
-  /// its part toward the vertex that blocks it is taken out (up to three such directions, as a proxy slides
-  /// along the planes it meets), and what is left is halved until it is allowed, or no move at all.
-  Vec3 slide_on_surface(const Vec3& from, const Vec3& to);
+  /// The deepest surface vertex inside the probe at p, the surface as the step found it (evaluated already).
+  double penetration_at(const Model& model, const State& state, const Vec3& p);
+  /// The god-object's rule: the probe's move from `from` toward `to`, halved until no surface vertex is deeper
+  /// inside it than allowed_penetration x radius (or than at `from`, if deeper there), or no move at all.
+  Vec3 stop_at_surface(const Model& model, const State& state, const Vec3& from, Vec3 to);
   /// The local model of the surface contact at the probe position p (u as in the last evaluation when same_u).
   ContactModel surface_model(const Model& model, const State& state, const Vec3& p, bool same_u);
   /// The stiffness the tool feels with the object free to give (issue 16, item 4): K = B^T H^-1 B - sum_v H_v,
@@ -130,7 +130,6 @@ class ProbeTool final : public DynamicForces {
   Mat3 held_K_ = Mat3::Zero();
   Points scratch_;
   std::vector<index_t> surface_touched_;
-  std::vector<double> depth_before_;  // each surface vertex's depth inside the probe before a move (kept)
   /// the compliance solves: relative tolerance and CG iterations of a direction's turn (warm-started, the rest
   /// of the convergence comes over the next turns)
   static constexpr double compliance_tolerance = 1e-2;

@@ -268,26 +268,6 @@ ToolLoad SurfaceContact::load(const Model&, const Points& u, bool same_u) {
   return for_each_pressing([](index_t, const ToolDistance&, double) {});
 }
 
-void SurfaceContact::penetrations(std::vector<double>& out) const {
-  out.assign(static_cast<std::size_t>(y_.cols()), 0.0);  // allocates only to grow
-  const double far = reach(shape_);
-  for (index_t v = 0; v < y_.cols(); ++v)
-    if ((y_.col(v) - pose_.position).squaredNorm() <= far * far)
-      out[static_cast<std::size_t>(v)] = std::max(tool_distance(shape_, pose_, y_.col(v)).penetration(shape_), 0.0);
-}
-
-SurfaceContact::Deepening SurfaceContact::deepening(const std::vector<double>& before, double floor) const {
-  Deepening out;
-  const double far = reach(shape_);
-  for (index_t v = 0; v < y_.cols(); ++v) {
-    if ((y_.col(v) - pose_.position).squaredNorm() > far * far) continue;
-    const ToolDistance d = tool_distance(shape_, pose_, y_.col(v));
-    const double excess = d.penetration(shape_) - std::max(before[static_cast<std::size_t>(v)], floor);
-    if (excess > out.excess) out = {excess, d.normal};
-  }
-  return out;
-}
-
 ToolLoad SurfaceContact::advance_multipliers(double rate, double max_force) {
   const double far = reach(shape_);
   Vec3 pressing = Vec3::Zero();

@@ -97,16 +97,6 @@ class SurfaceContact final : public EnergyTerm {
   /// The load on the tool at u (its multipliers and penalty as they are); same_u: u is the last evaluation's,
   /// whose carried surface is reused (the probe's placement tries several positions on one state).
   ToolLoad load(const Model& model, const Points& u, bool same_u = false);
-  /// How deep each vertex is inside the tool at its pose, m (0 outside), the surface as last evaluated.
-  void penetrations(std::vector<double>& out) const;
-  /// The vertex that went deepest beyond max(before_v, floor) at the tool's pose, against `before` of
-  /// penetrations(): how far beyond (<= 0: none), and the unit direction from the tool's core toward it
-  /// (moving the tool along it takes the vertex deeper).
-  struct Deepening {
-    double excess = 0;
-    Vec3 direction = Vec3::Zero();
-  };
-  Deepening deepening(const std::vector<double>& before, double floor) const;
   /// The load of the last add_forces(), which computes it on the way.
   const ToolLoad& last_load() const { return last_load_; }
   /// The point that carries most of each vertex pressing on the tool at the last evaluation (out is cleared).
@@ -125,9 +115,7 @@ class SurfaceContact final : public EnergyTerm {
   /// the tool then.
   ToolLoad advance_multipliers(double rate, double max_force);
   double friction() const { return friction_; }
-  /// The contact's stiffness on one point, N/m (explicit stable step): max_j sum_v k_v w_vj^2, the largest
-  /// diagonal of its stiffness on the points (an estimate, not a strict bound: the largest eigenvalue is above
-  /// it where a vertex is carried by several points).
+  /// Upper bound of the contact's stiffness on one point, N/m (explicit stable step): max_j sum_v k_v w_vj^2.
   double max_point_stiffness() const { return max_point_stiffness_; }
   /// The deformed vertices of the last evaluation.
   const Points& vertices() const { return y_; }
