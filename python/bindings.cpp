@@ -559,15 +559,16 @@ names the problem.)doc")
               p.carry_surface();
             }
             if (p.sim->diagnostics().failed) throw ph::Error(p.sim->diagnostics().failure);
-            // the columns of --force-log: t, x, y, z, vx, vy, vz, buttons, fx, fy, fz
-            py::array_t<double> log({static_cast<py::ssize_t>(r.log.size()), py::ssize_t{11}});
+            // the columns of --force-log: t, x, y, z, vx, vy, vz, buttons, fx, fy, fz, tx, ty, tz
+            py::array_t<double> log({static_cast<py::ssize_t>(r.log.size()), py::ssize_t{14}});
             auto w = log.mutable_unchecked<2>();
             for (std::size_t k = 0; k < r.log.size(); ++k) {
               const ph::HapticLogRow& row = r.log[k];
-              const double v[11] = {row.t,          row.position.x(), row.position.y(), row.position.z(),
+              const double v[14] = {row.t,          row.position.x(), row.position.y(), row.position.z(),
                                     row.velocity.x(), row.velocity.y(), row.velocity.z(), static_cast<double>(row.buttons),
-                                    row.force.x(),  row.force.y(),    row.force.z()};
-              for (int c = 0; c < 11; ++c) w(static_cast<py::ssize_t>(k), c) = v[c];
+                                    row.force.x(),  row.force.y(),    row.force.z(),    row.torque.x(),
+                                    row.torque.y(), row.torque.z()};
+              for (int c = 0; c < 14; ++c) w(static_cast<py::ssize_t>(k), c) = v[c];
             }
             py::dict d;
             d["log"] = log;
@@ -581,7 +582,8 @@ names the problem.)doc")
           py::arg("real_time") = false,
           "Drive a spherical probe (radius in m; mode push or grab) with a virtual hand through keyframes "
           "[t, x, y, z] or [t, x, y, z, button] (s, m; device frame, whose origin is two radii above the object's top "
-          "centre) for `duration` s. This advances the simulation by `duration`. Returns a dict: log, an (ticks, 11) "
-          "array with the columns of --force-log (t, x, y, z, vx, vy, vz, buttons, fx, fy, fz; s, m, m/s, bit mask, N), "
+          "centre) for `duration` s. This advances the simulation by `duration`. Returns a dict: log, an (ticks, 14) "
+          "array with the columns of --force-log (t, x, y, z, vx, vy, vz, buttons, fx, fy, fz, tx, ty, tz; s, m, m/s, bit "
+          "mask, N, N m), "
           "ticks, max_force (N), max_contacts and simulation_steps. Deterministic (simulated time) unless real_time.");
 }

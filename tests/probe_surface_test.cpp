@@ -147,8 +147,9 @@ TEST(ProbeOnSurface, WithLevelsOfDetailTheProbeTouchesTheActiveSetsSurface) {
 
 // A capsule posed by the device (issue 16, item 1): 20 mm long, 5 mm in radius, lying along x and tilted
 // by `tilt` (its +x end lower for tilt > 0), pressed in until its lowest point is 1 mm below the top face.
-// The end pressed deeper pushes back harder: the torque about the tool's centre turns it back level.
-ToolSummary press_capsule(double tilt) {
+// The end pressed deeper pushes back harder: the torque about the tool's centre turns it back level. With a
+// device that renders torque (max_torque > 0, N m), `rendered` gets the last torque commanded to it.
+ToolSummary press_capsule(double tilt, double max_torque = 0, Vec3* rendered = nullptr) {
   Block block("explicit");
   Simulation& sim = block.sim;
   const ObjectSurface& surface = block.surface;
@@ -157,7 +158,11 @@ ToolSummary press_capsule(double tilt) {
   VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), false},
                                    {0.3, Vec3(0, centre - (0.02 + 2 * R), 0), false},
                                    {0.5, Vec3(0, centre - (0.02 + 2 * R), 0), false}}),
-                       known_device_specs("touch"));
+                       [&] {
+                         DeviceSpecs specs = known_device_specs("touch");
+                         specs.max_torque = max_torque;
+                         return specs;
+                       }());
   InteractiveOptions o = probe_options(surface, 0.5);
   o.probe.radius = radius;
   o.probe.length = length;
@@ -165,8 +170,9 @@ ToolSummary press_capsule(double tilt) {
   o.probe.orientation = Eigen::AngleAxisd(-tilt, Vec3::UnitZ()) * Eigen::AngleAxisd(0.5 * M_PI, Vec3::UnitY());
   ToolSummary tool;
   o.after_step = [&](long long) { tool = sim.tool_summary(); };
-  run_interactive(sim, device, o);
+  const InteractiveResult r = run_interactive(sim, device, o);
   EXPECT_FALSE(sim.diagnostics().failed) << sim.diagnostics().failure;
+  if (rendered) *rendered = r.log.back().torque;
   return tool;
 }
 
@@ -187,6 +193,15 @@ TEST(ProbeOnSurface, ATiltedCapsulePressesWithItsLowerEndAndFeelsTheTorque) {
   EXPECT_GT(right.torque.z(), 0.2 * lever);
   EXPECT_LT(left.torque.z(), -0.2 * lever);
   EXPECT_NEAR(right.torque.z(), -left.torque.z(), 0.05 * right.torque.z());
+  // the hand feels it on a device that renders torque (issue 16, item 1), and nothing on the Touch
+  Vec3 rendered = Vec3::Constant(NAN), on_touch = Vec3::Constant(NAN);
+  const ToolSummary six_dof = press_capsule(0.15, 0.1, &rendered);
+  press_capsule(0.15, 0.0, &on_touch);
+  std::printf("rendered torque (%.3g, %.3g, %.3g) N m, the tool's (%.3g, %.3g, %.3g) N m\n", rendered.x(), rendered.y(), rendered.z(),
+              six_dof.torque.x(), six_dof.torque.y(), six_dof.torque.z());
+  EXPECT_NEAR(rendered.z(), six_dof.torque.z(), 0.05 * six_dof.torque.z());
+  EXPECT_GT(rendered.z(), 0.2 * lever);
+  EXPECT_EQ(on_touch.norm(), 0.0);
 }
 
 // Pressed in, then pushed up and down by 0.5 mm and dragged sideways: the local model the haptic side renders

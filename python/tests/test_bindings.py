@@ -215,7 +215,7 @@ def test_the_probe_pushes_and_the_log_comes_back():
     # press 2.5 cm down from two radii above the middle of the top face, hold
     r = sim.probe([[0, 0, 0, 0, 0], [0.5, 0, -0.025, 0, 0], [1.0, 0, -0.025, 0, 0]], radius=0.01, duration=1.0)
     log = r["log"]
-    assert log.shape == (1000, 11)  # the columns of --force-log: t, x, y, z, vx, vy, vz, buttons, fx, fy, fz
+    assert log.shape == (1000, 14)  # the columns of --force-log: t, x, y, z, vx, vy, vz, buttons, fx, fy, fz, tx, ty, tz
     assert r["max_contacts"] > 0 and r["max_force"] > 0.05
     assert log[-1, 9] > 0  # the object pushes the device up
     assert sim.displacement[:, 1].min() < -0.002

@@ -47,6 +47,7 @@ struct ContactModel {
   Mat3 K = Mat3::Zero();        ///< dF/dp, N/m
   int contacts = 0;             ///< touched or grabbed points
   bool grabbing = false;
+  Vec3 torque = Vec3::Zero();   ///< torque on the tool about p0, N m (held between updates)
 };
 
 /// Contact between the probe and the object, for the simulation thread. Push: every point sphere that

@@ -24,6 +24,7 @@ struct DeviceSpecs {
   double max_stiffness = 400.0;    ///< largest stiffness it renders stably at 1 kHz, N/m
   double max_damping = 3.0;        ///< largest damping it renders stably, N s/m
   double workspace_radius = 0.075; ///< radius of its usable workspace, m
+  double max_torque = 0;           ///< largest continuous torque, N m (0: it renders none)
 };
 
 /// Known devices: "touch" (3D Systems Touch: 3.3 N, 400 N/m, 0.075 m), "omni" (Phantom Omni: 3.3 N,
@@ -51,6 +52,9 @@ class Device {
   virtual DeviceState read(double t) = 0;
   /// Command a force (N) until the next tick. Throws DeviceError when the device fails.
   virtual void command(const Vec3& force) = 0;
+  /// The torque (N m, about the device point, in the device's axes) to render with the next command(), on a
+  /// device whose specs give max_torque > 0; the others have nothing to render it with and ignore it.
+  virtual void set_torque(const Vec3& /*torque*/) {}
   /// Stop: command zero force and release the device (also called after a DeviceError).
   virtual void stop() {}
 };

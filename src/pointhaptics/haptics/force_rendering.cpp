@@ -20,6 +20,19 @@ void ForceRenderer::reset() {
   engaged_ = false;
   since_engaged_ = 0;
   last_.setZero();
+  last_torque_.setZero();
+}
+
+Vec3 ForceRenderer::render_torque(const Vec3& requested) {
+  if (!(specs_.max_torque > 0) || !engaged_ || !requested.allFinite()) return last_torque_ = Vec3::Zero();
+  Vec3 t = requested;
+  if (rules_.ramp_time > 0) t *= std::min(1.0, since_engaged_ / rules_.ramp_time);
+  const double magnitude = t.norm();
+  if (magnitude > specs_.max_torque) t *= specs_.max_torque / magnitude;
+  const double max_change = rules_.max_change * specs_.max_torque / specs_.max_force;
+  const Vec3 change = t - last_torque_;
+  if (change.norm() > max_change) t = last_torque_ + change * (max_change / change.norm());
+  return last_torque_ = t;
 }
 
 Vec3 ForceRenderer::render(const Vec3& requested, const Vec3& device_velocity, double dt) {

@@ -30,7 +30,11 @@ class ForceRenderer {
   ForceRenderer(const DeviceSpecs& specs, const ForceRules& rules = {});
   /// The force to command this tick (N) for the requested one, the device velocity (m/s) and the tick (s).
   Vec3 render(const Vec3& requested, const Vec3& device_velocity, double dt);
-  /// Zero force, disengaged (e.g. after a device error or at the end).
+  /// The torque to command this tick (N m) for the requested one: none before the force engages, then ramped
+  /// in with it, its magnitude clamped to the device's max torque, its change per tick bounded as the force's
+  /// is (the same share of its maximum). Zero for a device that renders no torque.
+  Vec3 render_torque(const Vec3& requested);
+  /// Zero force and torque, disengaged (e.g. after a device error or at the end).
   void reset();
 
   bool engaged() const { return engaged_; }
@@ -43,7 +47,7 @@ class ForceRenderer {
   ForceRules rules_;
   bool engaged_ = false;
   double since_engaged_ = 0;
-  Vec3 last_ = Vec3::Zero();
+  Vec3 last_ = Vec3::Zero(), last_torque_ = Vec3::Zero();
   double energy_ = 0, min_energy_ = 0;
 };
 

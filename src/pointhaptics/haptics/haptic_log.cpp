@@ -13,11 +13,12 @@
 
 namespace pointhaptics {
 
-void print_haptic_log_header(TextOutput& out) { out.print("t,x,y,z,vx,vy,vz,buttons,fx,fy,fz\n"); }
+void print_haptic_log_header(TextOutput& out) { out.print("t,x,y,z,vx,vy,vz,buttons,fx,fy,fz,tx,ty,tz\n"); }
 
 void print_haptic_log_row(TextOutput& out, const HapticLogRow& r) {
-  out.print("{:.6f},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{},{:.9g},{:.9g},{:.9g}\n", r.t, r.position.x(), r.position.y(),
-            r.position.z(), r.velocity.x(), r.velocity.y(), r.velocity.z(), r.buttons, r.force.x(), r.force.y(), r.force.z());
+  out.print("{:.6f},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}\n", r.t, r.position.x(),
+            r.position.y(), r.position.z(), r.velocity.x(), r.velocity.y(), r.velocity.z(), r.buttons, r.force.x(), r.force.y(), r.force.z(),
+            r.torque.x(), r.torque.y(), r.torque.z());
 }
 
 void write_haptic_log(const std::string& path, const std::vector<HapticLogRow>& rows) {
@@ -39,19 +40,23 @@ std::vector<HapticLogRow> read_haptic_log(const std::string& path) {
     if (line_no == 1 && line.rfind("t,", 0) == 0) continue;  // header
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
     std::istringstream fields(line);
-    double v[11];
+    // the torque's three columns came with issue 16: a log without them (11 numbers) reads with none
+    double v[14] = {};
     int n = 0;
-    for (std::string field; n < 12 && std::getline(fields, field, ',');) {
+    for (std::string field; n < 15 && std::getline(fields, field, ',');) {
       char* end = nullptr;
       const double x = std::strtod(field.c_str(), &end);
-      if (end == field.c_str() || (*end != '\0' && *end != '\r') || !std::isfinite(x) || n == 11) {
+      if (end == field.c_str() || (*end != '\0' && *end != '\r') || !std::isfinite(x) || n == 14) {
         n = -1;
         break;
       }
       v[n++] = x;
     }
-    if (n != 11) throw Error(fmt::format("{}:{}: expected 11 finite numbers (t,x,y,z,vx,vy,vz,buttons,fx,fy,fz)", path, line_no));
-    HapticLogRow r{v[0], Vec3(v[1], v[2], v[3]), Vec3(v[4], v[5], v[6]), static_cast<unsigned>(v[7]), Vec3(v[8], v[9], v[10])};
+    if (n != 11 && n != 14)
+      throw Error(fmt::format("{}:{}: expected 14 finite numbers (t,x,y,z,vx,vy,vz,buttons,fx,fy,fz,tx,ty,tz), or the first 11", path,
+                              line_no));
+    HapticLogRow r{v[0], Vec3(v[1], v[2], v[3]), Vec3(v[4], v[5], v[6]), static_cast<unsigned>(v[7]), Vec3(v[8], v[9], v[10]),
+                   Vec3(v[11], v[12], v[13])};
     if (!rows.empty() && !(r.t > rows.back().t)) throw Error(fmt::format("{}:{}: time does not increase", path, line_no));
     rows.push_back(r);
   }

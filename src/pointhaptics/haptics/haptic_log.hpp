@@ -9,7 +9,8 @@
 
 namespace pointhaptics {
 
-/// Header: t,x,y,z,vx,vy,vz,buttons,fx,fy,fz (s, m, m/s, bit mask, N; device frame).
+/// Header: t,x,y,z,vx,vy,vz,buttons,fx,fy,fz,tx,ty,tz (s, m, m/s, bit mask, N, N m; device frame). A log of
+/// the first 11 columns (before the torque's) reads with zero torque.
 void write_haptic_log(const std::string& path, const std::vector<HapticLogRow>& rows);
 /// The same file streamed row by row (a run of any length): the header, then one call per row.
 void print_haptic_log_header(TextOutput& out);

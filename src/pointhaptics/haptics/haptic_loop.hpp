@@ -28,6 +28,7 @@ struct HapticFrame {
   bool button = false;
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  ///< the device's
   Vec3 force = Vec3::Zero();         ///< force commanded to the device, N
+  Vec3 torque = Vec3::Zero();        ///< torque commanded to the device, N m
   long long tick = 0;                ///< ticks so far, this one included (a reader's rate meter)
 };
 
@@ -37,6 +38,7 @@ struct HapticLogRow {
   Vec3 position = Vec3::Zero(), velocity = Vec3::Zero();
   unsigned buttons = 0;
   Vec3 force = Vec3::Zero();
+  Vec3 torque = Vec3::Zero();  ///< commanded, N m (zero on a device that renders none)
 };
 
 struct HapticStats {
@@ -94,6 +96,7 @@ class HapticLoop {
   ForceRenderer renderer_;
   double period_;
   double device_max_force_;  ///< read once: specs() builds a string, which the haptic thread must not
+  double device_max_torque_;
   TripleBuffer<ContactModel> models_;
   TripleBuffer<HapticFrame> frames_;
   SpscRing<HapticLogRow> log_;

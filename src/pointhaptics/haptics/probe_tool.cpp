@@ -62,7 +62,7 @@ namespace {
 
 // the haptic side's local model of a surface contact's load on the probe at p
 ContactModel contact_model_of(const ToolLoad& load, double time, const Vec3& p) {
-  return ContactModel{time, p, load.force, load.stiffness, load.contacts, false};
+  return ContactModel{time, p, load.force, load.stiffness, load.contacts, false, load.torque};
 }
 
 }  // namespace

@@ -115,7 +115,9 @@ class SurfaceContact final : public EnergyTerm {
   /// the tool then.
   ToolLoad advance_multipliers(double rate, double max_force);
   double friction() const { return friction_; }
-  /// Upper bound of the contact's stiffness on one point, N/m (explicit stable step): max_j sum_v k_v w_vj^2.
+  /// The contact's stiffness on one point, N/m (explicit stable step): max_j sum_v k_v w_vj^2, the largest
+  /// diagonal of its stiffness on the points (an estimate, not a strict bound: the largest eigenvalue is above
+  /// it where a vertex is carried by several points).
   double max_point_stiffness() const { return max_point_stiffness_; }
   /// The deformed vertices of the last evaluation.
   const Points& vertices() const { return y_; }
