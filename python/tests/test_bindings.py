@@ -254,7 +254,7 @@ def test_a_stranger_can_find_their_way():
     sim = ph.Simulation.from_scene(scene("beam_probe.toml"), threads=1)
     assert repr(sim).startswith("<pointhaptics.Simulation: ") and "explicit solver" in repr(sim)
     r = sim.probe([[0, 0, 0, 0], [0.2, 0, -0.02, 0]], radius=0.01, duration=0.2)  # 4 values, as in scene files
-    assert r["log"].shape[1] == 11 and abs(sim.time - 0.2) < 1e-9  # probe() advances the simulation
+    assert r["log"].shape[1] == 14 and abs(sim.time - 0.2) < 1e-9  # probe() advances the simulation
     with pytest.raises(ph.Error, match="keyframe 1 has 3 values"):
         sim.probe([[0, 0, 0, 0], [0.2, 0, 0]], duration=0.1)
     assert sim.forces.shape == (sim.n_points, 3)
