@@ -58,7 +58,7 @@ namespace {
 
 DeviceSpecs scene_device_specs(const DeviceSpec& d) {
   if (d.specs != "custom") return known_device_specs(d.specs);
-  return {"custom", d.max_force, d.max_stiffness, d.max_damping, d.workspace_radius};
+  return {"custom", d.max_force, d.max_stiffness, d.max_damping, d.workspace_radius, d.max_torque};
 }
 
 }  // namespace

@@ -366,6 +366,12 @@ TEST(SceneToml, ReadsProbeAndDevice) {
   EXPECT_DOUBLE_EQ(s.probe.origin.x(), 0.07);
   EXPECT_DOUBLE_EQ(s.probe.scale, 2.0);
   EXPECT_EQ(s.device.specs, "omni");
+  EXPECT_EQ(s.device.max_torque, 0.0);
+  // custom specs with a torque (a device with six output degrees of freedom)
+  std::string six_dof = std::string(full_scene) + probe_section;
+  six_dof.replace(six_dof.find("specs = \"omni\""), 14,
+                  "specs = \"custom\"\nmax_force = 3.0\nmax_stiffness = 500.0\nworkspace_radius = 0.1\nmax_torque = 0.05");
+  EXPECT_DOUBLE_EQ(parse_scene(six_dof, "p.toml").device.max_torque, 0.05);
   // a trajectory file is resolved against the scene's folder
   std::string text = std::string(full_scene) + "[probe]\ntrajectory = \"probe.csv\"\n";
   EXPECT_EQ(parse_scene(text, "dir/p.toml", "dir").probe.trajectory, "dir/probe.csv");
@@ -540,6 +546,10 @@ TEST(SceneToml, BadProbeOrDeviceIsANamedError) {
   EXPECT_NE(probe_error("keyframes = [[0.0, 0.0, 0.0, 0.0], [1.0, 0.0, -0.01, 0.0, 1]]", "").find("needs trajectory"),
             std::string::npos);
   EXPECT_NE(probe_error("specs = \"omni\"", "specs = \"custom\"").find("custom specs need"), std::string::npos);
+  const std::string custom = "specs = \"custom\"\nmax_force = 3.0\nmax_stiffness = 500.0\nworkspace_radius = 0.1\n";
+  EXPECT_NE(probe_error("specs = \"omni\"", custom + "max_torque = -0.1").find("device.max_torque: -0.1 is out of range: must lie in [0, 100]"),
+            std::string::npos);
+  EXPECT_NE(probe_error("specs = \"omni\"", "max_torque = 0.1").find("device.max_torque: unknown key"), std::string::npos);
   EXPECT_NE(probe_error("kind = \"virtual\"", "kind = \"replay\"").find("needs log"), std::string::npos);
   EXPECT_NE(probe_error("kind = \"virtual\"", "kind = \"openhaptics\"\nlibary = \"x.so\"").find("device.libary: unknown key"),
             std::string::npos);

@@ -150,6 +150,7 @@ struct DeviceSpec {
   std::string kind = "virtual";            ///< virtual | replay | openhaptics
   std::string specs = "touch";             ///< touch | omni | falcon | custom
   double max_force = 0, max_stiffness = 0, max_damping = 0, workspace_radius = 0;  ///< custom specs
+  double max_torque = 0;  ///< custom specs: the largest torque it renders, N m (0: none)
   std::string log;                         ///< replay: a recorded session (resolved path)
   std::string library = "libHD.so";        ///< openhaptics: the HD library to load
 };

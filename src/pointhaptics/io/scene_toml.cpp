@@ -587,6 +587,7 @@ void read_device(TableReader& r, DeviceSpec& d, const Context& ctx) {
     d.max_stiffness = r.number("max_stiffness", 0.0, [](double x) { return x > 0 && x <= 1e6; }, "must lie in (0, 1e6] (N/m)");
     d.max_damping = r.number("max_damping", 0.0, [](double x) { return x >= 0 && x <= 1e4; }, "must lie in [0, 1e4] (N s/m)");
     d.workspace_radius = r.number("workspace_radius", 0.0, [](double x) { return x > 0 && x <= 10; }, "must lie in (0, 10] (m)");
+    d.max_torque = r.number("max_torque", 0.0, [](double x) { return x >= 0 && x <= 100; }, "must lie in [0, 100] (N m)");
   }
   if (d.kind == "replay") {
     if (!r.find("log")) r.fail_table("log", "a replay device needs log = \"session.csv\" (a recorded force log)");
