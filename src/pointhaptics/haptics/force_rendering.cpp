@@ -23,16 +23,19 @@ void ForceRenderer::reset() {
   last_torque_.setZero();
 }
 
+Vec3 ForceRenderer::limited(Vec3 v, double max, double max_change, const Vec3& last) const {
+  if (rules_.ramp_time > 0) v *= std::min(1.0, since_engaged_ / rules_.ramp_time);
+  const double magnitude = v.norm();
+  if (magnitude > max) v *= max / magnitude;  // keep the direction
+  const Vec3 change = v - last;
+  if (change.norm() > max_change) v = last + change * (max_change / change.norm());
+  return v;
+}
+
 Vec3 ForceRenderer::render_torque(const Vec3& requested) {
   if (!(specs_.max_torque > 0) || !engaged_ || !requested.allFinite()) return last_torque_ = Vec3::Zero();
-  Vec3 t = requested;
-  if (rules_.ramp_time > 0) t *= std::min(1.0, since_engaged_ / rules_.ramp_time);
-  const double magnitude = t.norm();
-  if (magnitude > specs_.max_torque) t *= specs_.max_torque / magnitude;
-  const double max_change = rules_.max_change * specs_.max_torque / specs_.max_force;
-  const Vec3 change = t - last_torque_;
-  if (change.norm() > max_change) t = last_torque_ + change * (max_change / change.norm());
-  return last_torque_ = t;
+  // its change per tick bounded by the same share of its maximum as the force's
+  return last_torque_ = limited(requested, specs_.max_torque, rules_.max_change * specs_.max_torque / specs_.max_force, last_torque_);
 }
 
 Vec3 ForceRenderer::render(const Vec3& requested, const Vec3& device_velocity, double dt) {
@@ -41,16 +44,8 @@ Vec3 ForceRenderer::render(const Vec3& requested, const Vec3& device_velocity, d
     engaged_ = true;
     since_engaged_ = 0;
   }
-  if (!engaged_) {
-    f.setZero();
-  } else {
-    since_engaged_ += dt;
-    if (rules_.ramp_time > 0) f *= std::min(1.0, since_engaged_ / rules_.ramp_time);
-  }
-  const double magnitude = f.norm();
-  if (magnitude > specs_.max_force) f *= specs_.max_force / magnitude;  // keep the direction
-  const Vec3 change = f - last_;
-  if (change.norm() > rules_.max_change) f = last_ + change * (rules_.max_change / change.norm());
+  if (engaged_) since_engaged_ += dt;
+  f = limited(engaged_ ? f : Vec3::Zero(), specs_.max_force, rules_.max_change, last_);
   last_ = f;
   // passivity observer: the hand does work -F.v dt on the environment
   if (device_velocity.allFinite()) energy_ -= f.dot(device_velocity) * dt;

@@ -43,6 +43,9 @@ class ForceRenderer {
   const Vec3& last_force() const { return last_; }
 
  private:
+  /// v ramped in since engaging, its magnitude clamped to max, its change from `last` bounded by max_change.
+  Vec3 limited(Vec3 v, double max, double max_change, const Vec3& last) const;
+
   DeviceSpecs specs_;
   ForceRules rules_;
   bool engaged_ = false;

@@ -20,7 +20,6 @@ HapticLoop::HapticLoop(Device& device, const WorkspaceMapping& mapping, const Co
       renderer_(device.specs(), rules),
       period_(1.0 / rate_hz),
       device_max_force_(device.specs().max_force),
-      device_max_torque_(device.specs().max_torque),
       log_(log_capacity) {
   if (!(rate_hz > 0) || !(mapping.scale > 0) || !(gains.stiffness > 0))
     throw Error("haptic loop: the rate, the workspace scale and the coupling stiffness must be positive");
@@ -44,9 +43,9 @@ bool HapticLoop::tick(double t, double dt) {
     // the coupling pulls the device toward the probe (scene forces are rendered unscaled)
     const Vec3 requested = k * (p - d) + gains_.damping * (vp - vd);
     const Vec3 f = renderer_.render(requested, state.velocity, dt);
-    // the tool's torque from the contact (a capsule pressed off its centre), on a device that renders torque
+    // the tool's torque from the contact (a capsule pressed off its centre): zero on a device that renders none
     const Vec3 torque = renderer_.render_torque(m.contacts > 0 ? m.torque : Vec3::Zero());
-    if (device_max_torque_ > 0) device_.set_torque(torque);
+    device_.set_torque(torque);
     device_.command(f);
     HapticFrame& frame = frames_.back();
     frame.time = t;

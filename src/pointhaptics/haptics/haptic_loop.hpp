@@ -96,7 +96,6 @@ class HapticLoop {
   ForceRenderer renderer_;
   double period_;
   double device_max_force_;  ///< read once: specs() builds a string, which the haptic thread must not
-  double device_max_torque_;
   TripleBuffer<ContactModel> models_;
   TripleBuffer<HapticFrame> frames_;
   SpscRing<HapticLogRow> log_;
