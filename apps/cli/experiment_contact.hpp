@@ -22,6 +22,9 @@ struct ContactOptions {
   /// deep) at spacing R / refine and the surface's edge half that ([[refine]]); 0: uniform samplings only
   int refine = 8;
   double friction = 0.3;             ///< Coulomb's coefficient of the friction run (the first sampling)
+  /// the friction runs' quasi-static drag steps per spacing, one run each (quick: the last only); the last is
+  /// the goal's and also runs refined
+  std::vector<int> drag_steps{8, 16, 32};
   int threads = 0;                   ///< 0: all
   std::string plot_script;           ///< plot_contact.py to use (default: the installed one)
 };

@@ -398,6 +398,9 @@ int main(int argc, char** argv) {
                           "The first spacing once more with points at R / n near the contact ([[refine]]; default 8, 0: none)")->check(CLI::Range(0, 64));
   contact_cmd->add_option("--friction", contact.friction, "Coulomb's coefficient of the friction run (default 0.3)")
       ->check(CLI::Range(0.01, 2.0));
+  contact_cmd->add_option("--drag-steps", contact.drag_steps,
+                          "Quasi-static steps per spacing of the friction runs' drag, one run each (default 8,16,32; --quick: the last)")
+      ->delimiter(',')->check(CLI::Range(1, 256));
   contact_cmd->add_option("--material", contact.material, "The block's material: neo_hookean (default), svk or mooney_rivlin");
   contact_cmd->add_option("--fem-meshes", contact.fem_per_radius,
                           "CalculiX's element sizes at the contact as R / n, the last the reference (default 10,20,40)")
