@@ -113,15 +113,20 @@ TEST(Interactive, OnTheSurfaceTheLoopStaysPassiveBoundedAndFinite) {
                                      {2.0, Vec3(0, -0.045, 0), false},
                                      {4.0, Vec3(0, -0.045, 0), false},
                                      {6.0, Vec3(0, 0, 0), false},
-                                     {7.0, Vec3(0, 0, 0), false}}),
+                                     {8.0, Vec3(0, 0, 0), false}}),
                          known_device_specs("touch"));
-    const InteractiveResult r = run_interactive(sim, device, on_surface(scene, sim, 7.0));
-    std::printf("pressed and withdrawn: max force %.3f N, least energy the hand put in %.3g J\n", r.haptic.max_force_n,
-                r.haptic.min_observed_energy);
+    const InteractiveResult r = run_interactive(sim, device, on_surface(scene, sim, 8.0));
+    std::printf("pressed and withdrawn: max force %.3f N, least energy the hand put in %.3g J, beam %.3g mm from rest, moving at %.3g m/s\n",
+                r.haptic.max_force_n, r.haptic.min_observed_energy, 1e3 * sim.state().u.cwiseAbs().maxCoeff(),
+                sim.state().velocity.cwiseAbs().maxCoeff());
     EXPECT_GT(r.max_contacts, 0);
     EXPECT_GT(r.haptic.max_force_n, 0.1);
     EXPECT_GT(r.haptic.min_observed_energy, -1e-4);
-    EXPECT_LT(sim.state().u.cwiseAbs().maxCoeff(), 2e-3);
+    // two seconds after the hand is back the beam is at rest (0.0044 mm, 0.8 mm/s). Before the explicit step
+    // kept its planned stiffening across steps, a corner of it rang at 1.5-3 mm and 2 m/s for good: sub-steps
+    // that changed with the ringing's phase pumped energy into it
+    EXPECT_LT(sim.state().u.cwiseAbs().maxCoeff(), 5e-5);
+    EXPECT_LT(sim.state().velocity.cwiseAbs().maxCoeff(), 1e-2);
   }
   {
     const Scene scene = seed_beam_scene(20.0, 1e6);

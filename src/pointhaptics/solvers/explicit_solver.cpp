@@ -109,6 +109,7 @@ double min_free_mass(const Model& model) {
 
 namespace {
 const double covered_stiffening = 1.25;  // stiffening the safety factor of stable_time_step() absorbs
+const double stiffening_relax_time = 0.5;  // s: how slowly the planned stiffening falls back (explicit_step)
 }  // namespace
 
 double strain_stiffening(const Model& model, Workspace& ws) {
@@ -129,12 +130,20 @@ double strain_stiffening(const Model& model, Workspace& ws) {
 }
 
 StepReport explicit_step(const Model& model, State& state, Workspace& ws, double dt, double stable_dt,
-                         DynamicForces* forces) {
+                         DynamicForces* forces, double* planned_stiffening) {
   // the rest-state step, shortened by the springs of the state-dependent forces (a probe's contact: issue
   // 21, 1e4 N/m diverged), then where the last force evaluation found the material stretched beyond what
   // its safety factor covers (0.8 leaves omega^2 a margin of 1.56; a quarter is kept for stiffening)
   if (forces) stable_dt = stable_time_step_with_springs(stable_dt, forces->max_point_stiffness(), min_free_mass(model));
-  stable_dt *= std::min(1.0, std::sqrt(covered_stiffening / strain_stiffening(model, ws)));
+  double stiffening = strain_stiffening(model, ws);
+  if (planned_stiffening) {
+    // the plan follows a rise at once and a fall only slowly: a sub-step that followed the stiffening's every
+    // swing changed with the phase of an oscillation and pumped energy into it (parametric resonance: a beam
+    // pressed deep by a probe rang at 2 m/s for good after the hand let go; steady sub-steps let it settle)
+    stiffening = std::max(stiffening, 1 + (*planned_stiffening - 1) * std::exp(-dt / stiffening_relax_time));
+    *planned_stiffening = stiffening;
+  }
+  stable_dt *= std::min(1.0, std::sqrt(covered_stiffening / stiffening));
   const int n_sub = std::max(1, static_cast<int>(std::ceil(dt / stable_dt * (1 - 1e-12))));
   const double h = dt / n_sub;
   const double c = model.material.damping;
@@ -187,7 +196,7 @@ ExplicitSolver::ExplicitSolver(const Model& model, double dt, double stable_dt)
     : dt_(dt), stable_dt_(stable_dt > 0 ? stable_dt : stable_time_step(model)) {}
 
 StepReport ExplicitSolver::step(const Model& model, State& state, Workspace& ws, DynamicForces* forces) {
-  return explicit_step(model, state, ws, dt_, stable_dt_, forces);
+  return explicit_step(model, state, ws, dt_, stable_dt_, forces, &planned_stiffening_);
 }
 
 }  // namespace pointhaptics

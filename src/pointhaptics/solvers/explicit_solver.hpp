@@ -48,9 +48,12 @@ double min_free_mass(const Model& model);
 ///   v <- (v + h M^-1 (f_int + f_ext + f_tools)) / (1 + h c),   u <- u + h v   (c: mass-proportional damping)
 /// Held points follow their prescribed displacement. A displacement that becomes non-finite or grows
 /// beyond 100 times the object's size (divergence) ends the step FAILED, naming the time and the point.
-/// `forces`, if given, are evaluated at every sub-step.
+/// `forces`, if given, are evaluated at every sub-step. `planned_stiffening`, if given, carries the stiffening
+/// the sub-steps were planned for from step to step: it rises with the material's at once and falls back to
+/// it over about half a second, so that the sub-step does not swing with an oscillation's phase (which pumps
+/// energy into it); without it each step plans for the stiffening of its last force evaluation alone.
 StepReport explicit_step(const Model& model, State& state, Workspace& ws, double dt, double stable_dt,
-                         DynamicForces* forces = nullptr);
+                         DynamicForces* forces = nullptr, double* planned_stiffening = nullptr);
 
 /// explicit_step() as a Solver: steps of `dt` below the model's stable step.
 class ExplicitSolver final : public Solver {
@@ -62,6 +65,7 @@ class ExplicitSolver final : public Solver {
 
  private:
   double dt_, stable_dt_;
+  double planned_stiffening_ = 1;  ///< explicit_step()'s, carried across steps
 };
 
 }  // namespace pointhaptics
