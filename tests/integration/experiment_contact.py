@@ -13,7 +13,7 @@ import subprocess
 import sys
 
 exe, out = sys.argv[1], sys.argv[2]
-subprocess.run([exe, "experiment", "contact", "--quick", "--out", out], check=True)
+subprocess.run([exe, "experiment", "contact", "--quick", "--drag-steps", "16", "--out", out], check=True)
 for name in ("contact-force.csv", "contact-calculix.csv", "contact-sliding.csv", "contact-friction.csv", "summary.md", "contact.png"):
     assert os.path.getsize(os.path.join(out, name)) > 100, f"{name} missing or empty"
 with open(os.path.join(out, "contact-force.csv"), newline="") as f:
@@ -45,15 +45,16 @@ ripple = (sum((n - mean) ** 2 for n in normal) / len(normal)) ** 0.5 / mean
 assert ripple < 0.05, ripple
 assert max(r["tangential_n"] for r in sliding) < 0.02 * mean, sliding
 
-# friction (mu = 0.3): nudged, the contact sticks; dragged in quasi-static steps of a 32nd of the spacing, the
-# friction's part of the force is within 5% of mu times the pressure's at every equilibrium of the second spacing
-# (today 1-2% short: a vertex whose pressure grows during a step sticks a little short of its cone)
+# friction (mu = 0.3): nudged, the contact sticks; dragged in quasi-static steps of a 16th of the spacing (the
+# experiment's default 32nd takes twice as long), the friction's part of the force is within 5% of mu times the
+# pressure's at every equilibrium of the second spacing (today 1-3.7% short: a vertex whose pressure grows
+# during a step sticks a little short of its cone; 1-2% at a 32nd)
 with open(os.path.join(out, "contact-friction.csv"), newline="") as f:
     friction = [{k: float(v) for k, v in r.items()} for r in csv.DictReader(f)]
-assert all(r["steps_per_spacing"] == 32 for r in friction), {r["steps_per_spacing"] for r in friction}
+assert all(r["steps_per_spacing"] == 16 for r in friction), {r["steps_per_spacing"] for r in friction}
 assert friction[1]["friction_over_pressure"] < 0.1 * 0.3, friction[1]
 sliding_friction = [r["friction_over_pressure"] for r in friction if r["x_over_spacing"] > 1.0]
-assert len(sliding_friction) == 32 and all(abs(m / 0.3 - 1) < 0.05 for m in sliding_friction), sliding_friction
+assert len(sliding_friction) == 16 and all(abs(m / 0.3 - 1) < 0.05 for m in sliding_friction), sliding_friction
 
 # a static indentation from a scene file: the tool block
 scene = os.path.join(out, "indent.toml")
