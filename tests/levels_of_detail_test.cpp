@@ -207,6 +207,24 @@ TEST(LevelsOfDetail, ATakeOverAddsNoEnergy) {
   EXPECT_EQ(reselected, 4);
 }
 
+TEST(LevelsOfDetail, ATakenOverStateIsSteppedWithTheSubStepsItsStretchNeeds) {
+  // a new active set takes the deformed state over (set_state); its first explicit step planned its sub-steps
+  // for the stiffening its fresh workspace had seen, none, so it took the rest state's sub-step where the probe
+  // had stretched the object (a uniform stretch by half: 2.875 times stiffer, sqrt(1.25 / 2.875) of the step)
+  Scene scene = parse_scene(block);
+  scene.solver.kind = SolverKind::EXPLICIT;
+  scene.fixed.clear();
+  const double stable = Simulation(build_scene_model(scene), scene.solver, 1).stable_dt();
+  scene.solver.dt = 0.99 * stable;
+  Simulation sim(build_scene_model(scene), scene.solver, 1);
+  EXPECT_EQ(sim.step().substeps, 1);
+  State stretched = sim.state();
+  stretched.u.row(0) = 0.5 * sim.model().X.row(0);
+  stretched.velocity.setZero();
+  sim.set_state(stretched);
+  EXPECT_EQ(sim.step().substeps, 2);
+}
+
 TEST(LevelsOfDetail, NoReselectionSoonerThanTheIntervalAfterTheLast) {
   PressedBlock b(0.05);
   const double h = b.sim.model().h;
