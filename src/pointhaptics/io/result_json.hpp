@@ -81,9 +81,10 @@ struct RunSummary {
   std::string failure;          ///< static: why it did not converge (empty when it did)
   bool interrupted = false;     ///< the run was stopped (SIGINT, SIGTERM) before its end: the state reached
   std::vector<Vec3> reactions;  ///< per fixed group, N
-  /// not a physical result, whatever the residual: neighbourhoods inverted (det F <= 0) at the end, steps
-  /// that ended with some, and held groups whose support force opposes their prescribed motion (the body
-  /// pulls a plate that pushes it: a collapse); any of them makes `converged` false
+  /// not a physical result, whatever the residual: neighbourhoods inverted (det F <= 0) at the end, and held
+  /// groups whose support force opposes their prescribed motion (the body pulls a plate that pushes it: a
+  /// collapse); either makes `converged` false. Steps that ended with inverted neighbourhoods are counted
+  /// (a warning: a dynamic run can recover from them)
   long long inverted = 0, inverted_steps = 0;
   std::vector<std::string> collapsed;  ///< the groups' names
   // haptic loop (runs with a probe)
