@@ -216,6 +216,7 @@ std::vector<index_t> LevelsOfDetail::take_over(LodBuild build, bool built_here) 
   // a new simulation of the new active model; what the pipeline carries (diagnostics, inputs, the probe,
   // renumbered: grabbed points follow their new numbers, none at the first selection) moves over
   auto sim = std::make_unique<ModelSimulation>(next.model, solver_, n_threads_, build.stable_dt);
+  sim->solver_impl_->continue_from(*active_->solver_impl_);
   sim->diagnostics_ = std::move(active_->diagnostics_);
   sim->inputs_ = active_->inputs_;
   sim->probe_ = std::move(active_->probe_);

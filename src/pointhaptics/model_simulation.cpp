@@ -64,7 +64,9 @@ CutReport ModelSimulation::cut(std::span<const BladeSweep> sweeps) {
     // thread: the patch is small, and two threads made it slower (0.9 against 1.2 ms a cut at 10k points)
     if (solver_.kind == SolverKind::EXPLICIT)
       stable_dt_ = std::min(stable_dt_, local_stable_time_step(model_, report.cut_points, cut_patch_rings, 0.8, cut_lanczos_steps));
-    solver_impl_ = make_solver(model_, solver_, stable_dt_);
+    std::unique_ptr<Solver> next = make_solver(model_, solver_, stable_dt_);
+    next->continue_from(*solver_impl_);
+    solver_impl_ = std::move(next);
   }
   // (also when this sweep severed nothing: pairs cross a blade's path unevenly, and a strip left out would
   // leave the surface whole across it)

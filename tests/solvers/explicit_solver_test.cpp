@@ -170,6 +170,27 @@ TEST(ExplicitSolver, ThePlannedStiffeningRisesAtOnceAndFallsSlowly) {
   EXPECT_EQ(explicit_step(model, rest, ws, 0.99 * stable, stable).substeps, 1);
 }
 
+TEST(ExplicitSolver, ANewSolverForTheSameObjectContinuesThePlan) {
+  // a level of detail's new active set and a cut make a new solver for the same object: it takes the plan
+  // over, where a fresh one would plan for the rest state at its first step
+  const Model model = free_beam();
+  Workspace ws(model, 1);
+  const double stable = stable_time_step(model);
+  ExplicitSolver first(model, 0.99 * stable, stable);
+  State stretched = State::at_rest(model);
+  stretched.u.row(0) = 0.5 * model.X.row(0);
+  compute_internal_forces(model, stretched.u, ws);
+  EXPECT_EQ(first.step(model, stretched, ws, nullptr).substeps, 2);
+  EXPECT_GT(first.planned_stiffening(), 2.8);
+  ExplicitSolver next(model, 0.99 * stable, stable), fresh(model, 0.99 * stable, stable);
+  next.continue_from(first);
+  EXPECT_DOUBLE_EQ(next.planned_stiffening(), first.planned_stiffening());
+  State rest = State::at_rest(model);
+  compute_internal_forces(model, rest.u, ws);
+  EXPECT_EQ(fresh.step(model, rest, ws, nullptr).substeps, 1);
+  EXPECT_EQ(next.step(model, rest, ws, nullptr).substeps, 2);
+}
+
 TEST(ExplicitSolver, DivergenceIsANamedFailureNotNaN) {
   const Model model = gravity_cantilever(0.0);
   Workspace ws(model, 1);

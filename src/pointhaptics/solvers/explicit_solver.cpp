@@ -195,6 +195,11 @@ StepReport explicit_step(const Model& model, State& state, Workspace& ws, double
 ExplicitSolver::ExplicitSolver(const Model& model, double dt, double stable_dt)
     : dt_(dt), stable_dt_(stable_dt > 0 ? stable_dt : stable_time_step(model)) {}
 
+void ExplicitSolver::continue_from(const Solver& previous) {
+  if (const auto* explicit_previous = dynamic_cast<const ExplicitSolver*>(&previous))
+    planned_stiffening_ = explicit_previous->planned_stiffening_;
+}
+
 StepReport ExplicitSolver::step(const Model& model, State& state, Workspace& ws, DynamicForces* forces) {
   return explicit_step(model, state, ws, dt_, stable_dt_, forces, &planned_stiffening_);
 }

@@ -62,6 +62,9 @@ class ExplicitSolver final : public Solver {
   ExplicitSolver(const Model& model, double dt, double stable_dt = 0);
   StepReport step(const Model& model, State& state, Workspace& ws, DynamicForces* forces) override;
   double stable_dt() const override { return stable_dt_; }
+  void continue_from(const Solver& previous) override;
+  /// The stiffening its next step plans for at least (relaxing), explicit_step()'s planned_stiffening.
+  double planned_stiffening() const { return planned_stiffening_; }
 
  private:
   double dt_, stable_dt_;

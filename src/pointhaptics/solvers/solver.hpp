@@ -64,6 +64,9 @@ class Solver {
   virtual StepReport step(const Model& model, State& state, Workspace& ws, DynamicForces* forces) = 0;
   /// The explicit stable step at rest, s (0 for the others).
   virtual double stable_dt() const { return 0; }
+  /// A solver made for a new model of the same object (a level of detail's new active set, a cut) takes over
+  /// what `previous` carried from step to step about the object's state (explicit: the planned stiffening).
+  virtual void continue_from(const Solver& /*previous*/) {}
 };
 
 /// The solver a spec asks for, for `model`. `stable_dt`: explicit only, the stable step if already known
