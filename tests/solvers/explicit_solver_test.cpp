@@ -21,6 +21,21 @@ Model free_beam(double damping = 0) {
   return build_model(sample_box(Vec3::Zero(), Vec3(0.135, 0.03, 0.03), 0.015), m, KernelParams{});
 }
 
+// a uniform stretch by half along x, evaluated in ws: (3 s^2 - 1) / 2 = 2.875 times stiffer than at rest
+// (s = 1.5); or the rest state, evaluated
+State stretched_by_half(const Model& model, Workspace& ws) {
+  State state = State::at_rest(model);
+  state.u.row(0) = 0.5 * model.X.row(0);
+  compute_internal_forces(model, state.u, ws);
+  return state;
+}
+
+State evaluated_rest(const Model& model, Workspace& ws) {
+  State state = State::at_rest(model);
+  compute_internal_forces(model, state.u, ws);
+  return state;
+}
+
 // the energy an undamped free run keeps, relative error at worst over 10^4 steps
 double energy_drift(double amplitude, double dt_fraction) {
   const Model model = free_beam();
@@ -127,18 +142,14 @@ TEST(ExplicitSolver, AStretchedObjectTakesShorterSubSteps) {
   // now follows the largest stiffening the last force evaluation saw
   const Model model = free_beam();
   Workspace ws(model, 1);
-  State state = State::at_rest(model);
-  compute_internal_forces(model, state.u, ws);
+  evaluated_rest(model, ws);
   EXPECT_DOUBLE_EQ(strain_stiffening(model, ws), 1.0);
-  // a uniform stretch by half along x: (3 s^2 - 1) / 2 with s = 1.5
-  state.u.row(0) = 0.5 * model.X.row(0);
-  compute_internal_forces(model, state.u, ws);
+  State state = stretched_by_half(model, ws);
   EXPECT_NEAR(strain_stiffening(model, ws), (3 * 1.5 * 1.5 - 1) / 2, 1e-9);
   // a step of 0.99 of the rest-state stable step: one sub-step at rest, ceil(0.99 sqrt(2.875)) = 2 stretched
   const double stable = stable_time_step(model);
   EXPECT_EQ(explicit_step(model, state, ws, 0.99 * stable, stable).substeps, 2);
-  State rest = State::at_rest(model);
-  compute_internal_forces(model, rest.u, ws);
+  State rest = evaluated_rest(model, ws);
   EXPECT_EQ(explicit_step(model, rest, ws, 0.99 * stable, stable).substeps, 1);
 }
 
@@ -149,15 +160,12 @@ TEST(ExplicitSolver, ThePlannedStiffeningRisesAtOnceAndFallsSlowly) {
   const Model model = free_beam();
   Workspace ws(model, 1);
   const double stable = stable_time_step(model);
-  State stretched = State::at_rest(model);
-  stretched.u.row(0) = 0.5 * model.X.row(0);
-  compute_internal_forces(model, stretched.u, ws);
+  State stretched = stretched_by_half(model, ws);
   double planned = 1;
   EXPECT_EQ(explicit_step(model, stretched, ws, 0.99 * stable, stable, nullptr, &planned).substeps, 2);
   EXPECT_NEAR(planned, (3 * 1.5 * 1.5 - 1) / 2, 1e-6);  // the stretch's, at once
   // back at rest: the plan still holds the stretch's sub-steps, then relaxes to one
-  State rest = State::at_rest(model);
-  compute_internal_forces(model, rest.u, ws);
+  State rest = evaluated_rest(model, ws);
   EXPECT_EQ(explicit_step(model, rest, ws, 0.99 * stable, stable, nullptr, &planned).substeps, 2);
   EXPECT_GT(planned, 2.8);
   int steps_to_one = 1;
@@ -165,8 +173,8 @@ TEST(ExplicitSolver, ThePlannedStiffeningRisesAtOnceAndFallsSlowly) {
   // 1 + 1.875 e^(-t / 0.5 s) falls to 1.25 / 0.99^2 = 1.2754 at t = 0.96 s
   EXPECT_NEAR(steps_to_one * 0.99 * stable, 0.96, 0.02);
   // without a plan, each step plans for its own last evaluation
-  compute_internal_forces(model, stretched.u, ws);
-  compute_internal_forces(model, rest.u, ws);
+  stretched_by_half(model, ws);
+  rest = evaluated_rest(model, ws);
   EXPECT_EQ(explicit_step(model, rest, ws, 0.99 * stable, stable).substeps, 1);
 }
 
@@ -177,16 +185,13 @@ TEST(ExplicitSolver, ANewSolverForTheSameObjectContinuesThePlan) {
   Workspace ws(model, 1);
   const double stable = stable_time_step(model);
   ExplicitSolver first(model, 0.99 * stable, stable);
-  State stretched = State::at_rest(model);
-  stretched.u.row(0) = 0.5 * model.X.row(0);
-  compute_internal_forces(model, stretched.u, ws);
+  State stretched = stretched_by_half(model, ws);
   EXPECT_EQ(first.step(model, stretched, ws, nullptr).substeps, 2);
   EXPECT_GT(first.planned_stiffening(), 2.8);
   ExplicitSolver next(model, 0.99 * stable, stable), fresh(model, 0.99 * stable, stable);
   next.continue_from(first);
   EXPECT_DOUBLE_EQ(next.planned_stiffening(), first.planned_stiffening());
-  State rest = State::at_rest(model);
-  compute_internal_forces(model, rest.u, ws);
+  State rest = evaluated_rest(model, ws);
   EXPECT_EQ(fresh.step(model, rest, ws, nullptr).substeps, 1);
   EXPECT_EQ(next.step(model, rest, ws, nullptr).substeps, 2);
 }
