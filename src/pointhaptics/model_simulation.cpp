@@ -3,7 +3,6 @@
 #include <pointhaptics/lod/active_surface.hpp>
 
 #include <pointhaptics/core/error.hpp>
-#include <pointhaptics/mechanics/forces.hpp>
 #include <pointhaptics/mechanics/inversion.hpp>
 #include <pointhaptics/solvers/explicit_solver.hpp>
 
@@ -45,10 +44,6 @@ void ModelSimulation::set_state(const State& state) {
   // a viscoelastic history: the state's when it has one for this model, else at rest
   if (state.viscous.rows() == state_.viscous.rows() && state.viscous.cols() == state_.viscous.cols()) state_.viscous = state.viscous;
   else state_.viscous.setZero();
-  // an explicit step plans its sub-steps for the stiffening its workspace's last force evaluation saw: a
-  // new active set taking over a deformed state (levels of detail) had seen none, so its first step took
-  // the rest state's sub-step wherever the probe had stretched the object
-  compute_internal_forces(model_, state_.u, ws_);
 }
 
 CutReport ModelSimulation::cut(std::span<const BladeSweep> sweeps) {

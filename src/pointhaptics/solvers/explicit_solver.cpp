@@ -131,9 +131,17 @@ double strain_stiffening(const Model& model, Workspace& ws) {
 
 StepReport explicit_step(const Model& model, State& state, Workspace& ws, double dt, double stable_dt,
                          DynamicForces* forces, double* planned_stiffening) {
+  // a viscoelastic material: one viscous step over dt, as an implicit step takes it. Its sub-steps see the
+  // stress the step would end with at their u (the relaxed shear modulus and the history's overstress), and
+  // the history joins the state at the step's end: once per step, not per sub-step (it cost 1.4 force loops)
+  const bool viscous = !model.material.prony.empty();
+  if (viscous) begin_viscous_step(model, state, dt, ws);
+  // the first sub-step's forces, at the state the step starts from: its stiffening plans the sub-steps (a
+  // state set from outside, a new active set's, is planned for as it is, not for what the workspace saw last)
+  compute_internal_forces(model, state.u, ws);
   // the rest-state step, shortened by the springs of the state-dependent forces (a probe's contact: issue
-  // 21, 1e4 N/m diverged), then where the last force evaluation found the material stretched beyond what
-  // its safety factor covers (0.8 leaves omega^2 a margin of 1.56; a quarter is kept for stiffening)
+  // 21, 1e4 N/m diverged), then where the material is stretched beyond what its safety factor covers (0.8
+  // leaves omega^2 a margin of 1.56; a quarter is kept for stiffening)
   if (forces) stable_dt = stable_time_step_with_springs(stable_dt, forces->max_point_stiffness(), min_free_mass(model));
   double stiffening = strain_stiffening(model, ws);
   if (planned_stiffening) {
@@ -150,13 +158,8 @@ StepReport explicit_step(const Model& model, State& state, Workspace& ws, double
   const double limit2 = (100 * model.extent) * (100 * model.extent);
   StepReport report;
   double* first_bad = ws.chunk_scalars.data();  // per chunk: the first diverged point, or -1 (no atomics)
-  // a viscoelastic material: one viscous step over dt, as an implicit step takes it. Its sub-steps see the
-  // stress the step would end with at their u (the relaxed shear modulus and the history's overstress), and
-  // the history joins the state at the step's end: once per step, not per sub-step (it cost 1.4 force loops)
-  const bool viscous = !model.material.prony.empty();
-  if (viscous) begin_viscous_step(model, state, dt, ws);
   for (int sub = 0; sub < n_sub; ++sub) {
-    compute_internal_forces(model, state.u, ws);
+    if (sub > 0) compute_internal_forces(model, state.u, ws);
     if (forces) {
       ws.acceleration.setZero();  // scratch for the dynamic forces
       forces->add(model, state, ws.acceleration);

@@ -44,14 +44,14 @@ double min_free_mass(const Model& model);
 
 /// Advance the state by dt with ceil(dt / stable step) equal symplectic Euler sub-steps, the stable step
 /// shortened for the springs of `forces` (stable_time_step_with_springs) and by sqrt(1.25 / strain_stiffening())
-/// where the material is stretched by more than its safety factor covers:
+/// where the material, at the state the step starts from, is stretched by more than its safety factor covers:
 ///   v <- (v + h M^-1 (f_int + f_ext + f_tools)) / (1 + h c),   u <- u + h v   (c: mass-proportional damping)
 /// Held points follow their prescribed displacement. A displacement that becomes non-finite or grows
 /// beyond 100 times the object's size (divergence) ends the step FAILED, naming the time and the point.
 /// `forces`, if given, are evaluated at every sub-step. `planned_stiffening`, if given, carries the stiffening
 /// the sub-steps were planned for from step to step: it rises with the material's at once and falls back to
 /// it over about half a second, so that the sub-step does not swing with an oscillation's phase (which pumps
-/// energy into it); without it each step plans for the stiffening of its last force evaluation alone.
+/// energy into it); without it each step plans for the stiffening of the state it starts from alone.
 StepReport explicit_step(const Model& model, State& state, Workspace& ws, double dt, double stable_dt,
                          DynamicForces* forces = nullptr, double* planned_stiffening = nullptr);
 
