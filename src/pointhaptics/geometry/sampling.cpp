@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <cstdint>
 #include <numbers>
 #include <string>
 
@@ -114,7 +115,9 @@ Eigen::VectorXd clipped_cell_volumes(const Points& X, const std::function<bool(c
   std::array<int, 3> cells{};
   for (int a = 0; a < 3; ++a) cells[a] = std::max(1, static_cast<int>(std::ceil((hi[a] - lo[a]) / fine)));
   const double cell_volume = fine * fine * fine;
-  tbb::combinable<Eigen::VectorXd> partial([n] { return Eigen::VectorXd::Zero(n).eval(); });
+  // cells counted per point: whole numbers, so the threads' partial counts sum to the same whatever their
+  // order (summed volumes differed from run to run in the last digit)
+  tbb::combinable<std::vector<std::int64_t>> partial([n] { return std::vector<std::int64_t>(static_cast<std::size_t>(n), 0); });
   tbb::parallel_for(0, cells[2], [&](int k) {
     auto& local = partial.local();
     for (int j = 0; j < cells[1]; ++j)
@@ -124,10 +127,14 @@ Eigen::VectorXd clipped_cell_volumes(const Points& X, const std::function<bool(c
         index_t nearest;
         double d2;
         tree.index().knnSearch(c.data(), 1, &nearest, &d2);
-        local[nearest] += cell_volume;
+        ++local[static_cast<std::size_t>(nearest)];
       }
   });
-  partial.combine_each([&](const Eigen::VectorXd& v) { volume += v; });
+  std::vector<std::int64_t> count(static_cast<std::size_t>(n), 0);
+  partial.combine_each([&](const std::vector<std::int64_t>& c) {
+    for (std::size_t p = 0; p < count.size(); ++p) count[p] += c[p];
+  });
+  for (index_t p = 0; p < n; ++p) volume[p] = static_cast<double>(count[static_cast<std::size_t>(p)]) * cell_volume;
   const double total = volume.sum();
   if (total > 0) volume *= exact_volume / total;
   return volume;

@@ -6,7 +6,7 @@
 
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/parallel_for.h>
-#include <oneapi/tbb/parallel_reduce.h>
+#include <oneapi/tbb/parallel_reduce.h>  // parallel_deterministic_reduce
 
 #include <vector>
 
@@ -23,7 +23,8 @@ EnergyTerms strain_energy(const Model& model, const Points& u, std::vector<Mat3>
     tbb::parallel_for(tbb::blocked_range<index_t>(0, model.n_points, 512), [&](const tbb::blocked_range<index_t>& range) {
       for (index_t i = range.begin(); i != range.end(); ++i) gradients[i] = displacement_gradient(model, u, i);  // seed Eq. 10
     });
-    return tbb::parallel_reduce(
+    // deterministic: the same split at every run, so the same sum (line searches compare energies)
+    return tbb::parallel_deterministic_reduce(
         tbb::blocked_range<index_t>(0, model.n_points, 512), EnergyTerms{},
         [&](const tbb::blocked_range<index_t>& range, EnergyTerms acc) {
           for (index_t i = range.begin(); i != range.end(); ++i) {

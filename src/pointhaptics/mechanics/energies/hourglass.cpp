@@ -3,7 +3,6 @@
 #include <pointhaptics/mechanics/stencil.hpp>
 
 #include <oneapi/tbb/blocked_range.h>
-#include <oneapi/tbb/enumerable_thread_specific.h>
 #include <oneapi/tbb/parallel_for.h>
 
 #include <cmath>
@@ -61,20 +60,20 @@ void build_hourglass(Model& model, const std::vector<double>& weight_sum) {
   });
   model.hg_diagonal = Eigen::VectorXd::Zero(n);
   if (!(model.material.hourglass > 0)) return;
-  // in parallel over stencils (it took a sixth of a 10^6-point set-up serially): each thread accumulates its
-  // own diagonal, summed at the end (no atomics)
-  struct Scratch {
-    PairWeights pair;
-    std::vector<double> diagonal;
-  };
-  tbb::enumerable_thread_specific<Scratch> scratch([n] { return Scratch{{std::vector<double>(n, 0.0), {}}, std::vector<double>(n, 0.0)}; });
-  tbb::parallel_for(tbb::blocked_range<index_t>(0, n, 2048), [&](const tbb::blocked_range<index_t>& range) {
-    Scratch& local = scratch.local();
-    for (index_t i = range.begin(); i != range.end(); ++i)
-      for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) add_pair_diagonal(model, i, e, 1.0, local.pair, local.diagonal.data());
+  // in parallel over stencils (it took a sixth of a 10^6-point set-up serially): each of a fixed number of
+  // blocks of points accumulates its own diagonal, summed in block order at the end (no atomics; per thread,
+  // the sum's order followed the scheduler, and a run differed from the last in the last digit, which a
+  // chaotic contact then grew to millimetres)
+  constexpr index_t blocks = 8;
+  std::vector<Eigen::VectorXd> diagonals(static_cast<std::size_t>(blocks));
+  tbb::parallel_for(index_t{0}, blocks, [&](index_t b) {
+    Eigen::VectorXd& diagonal = diagonals[static_cast<std::size_t>(b)];
+    diagonal = Eigen::VectorXd::Zero(n);
+    PairWeights pair{std::vector<double>(n, 0.0), {}};
+    for (index_t i = b * n / blocks; i < (b + 1) * n / blocks; ++i)
+      for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) add_pair_diagonal(model, i, e, 1.0, pair, diagonal.data());
   });
-  for (const Scratch& local : scratch)
-    model.hg_diagonal += Eigen::Map<const Eigen::VectorXd>(local.diagonal.data(), n);
+  for (const Eigen::VectorXd& diagonal : diagonals) model.hg_diagonal += diagonal;
 }
 
 void add_hourglass_diagonal(const Model& model, const std::vector<std::pair<index_t, index_t>>& pairs, double sign,
