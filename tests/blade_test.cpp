@@ -107,7 +107,12 @@ const Vec3 cut_top(0.03375, 0.03, 0.015);
 
 // the blade cuts through as above with the probe on the object's surface; the button let go below the beam,
 // it goes round (beside the beam in z), waits in the gap the falling piece leaves, and is pushed 1.4 cm into
-// the stump's cut face at x = 3.375 cm; with levels of detail or without
+// the stump's cut face at x = 3.375 cm; with levels of detail or without.
+// With levels of detail the piece lies outside the active set and does not fall (0.1 mm): there is no gap,
+// and the hand's way in goes through the piece's side (z = 3 cm). The blade (radius 1 mm) passed between that
+// face's vertices and reached the cut face only by going through the piece; its centre is now held on the
+// face (the god-object's test of its path), where no vertex reaches it (the contact is the vertices': a tool
+// thinner than the surface's triangles is held, not pushed back).
 void lifted_blade_stops_at_the_cut_face(bool levels_of_detail) {
   const Scene scene = beam();
   Simulation sim(build_scene_model(scene), scene.solver, 2);
@@ -145,11 +150,17 @@ void lifted_blade_stops_at_the_cut_face(bool levels_of_detail) {
   const index_t uncut = levels_of_detail ? restrict_surface(whole->mesh, whole->map, *sim.active_set()).map.n_vertices()
                                          : whole->map.n_vertices();
   EXPECT_GT(vertices, uncut);
-  // the blade (radius 1 mm) stands on the stump's cut face, pushed back along +x; the hand is 1.4 cm beyond
   const double face = 0.03375 + 0.001;
-  EXPECT_NEAR(probe.x(), face, 0.0015) << probe.transpose();
-  EXPECT_GT(force.x(), 0.5);
-  EXPECT_LT(std::abs(force.y()), 0.2 * force.x());
+  if (levels_of_detail) {
+    // held on the piece's side, not through it
+    EXPECT_GE(probe.z(), 0.03) << probe.transpose();
+    EXPECT_GT(probe.x(), 0.045) << probe.transpose();
+  } else {
+    // the blade (radius 1 mm) stands on the stump's cut face, pushed back along +x; the hand is 1.4 cm beyond
+    EXPECT_NEAR(probe.x(), face, 0.0015) << probe.transpose();
+    EXPECT_GT(force.x(), 0.5);
+    EXPECT_LT(std::abs(force.y()), 0.2 * force.x());
+  }
   std::printf("lifted blade%s: at (%.5f, %.5f, %.5f) m against the face at x = %.5f m, force (%.3g, %.3g, %.3g) N, split in %.2f ms\n",
               levels_of_detail ? " (levels of detail)" : "", probe.x(), probe.y(), probe.z(), face, force.x(), force.y(), force.z(),
               s.cut.max_split_ms);
@@ -157,7 +168,7 @@ void lifted_blade_stops_at_the_cut_face(bool levels_of_detail) {
 
 TEST(Blade, LiftedAfterAStrokeTheBladePushesOnTheSplitSurfaceAndStopsAtTheCutFace) { lifted_blade_stops_at_the_cut_face(false); }
 
-TEST(Blade, WithLevelsOfDetailTheLiftedBladePushesOnTheActiveSetsPartOfTheSplitSurface) { lifted_blade_stops_at_the_cut_face(true); }
+TEST(Blade, WithLevelsOfDetailTheLiftedBladeTouchesTheActiveSetsPartOfTheSplitSurfaceAndIsHeldOnThePiece) { lifted_blade_stops_at_the_cut_face(true); }
 
 TEST(Blade, SawingForASecondStaysFiniteBoundedAndWithinTheDevice) {
   // the blade sawed back and forth along the beam's root region while it sinks, a thousand steps: every step

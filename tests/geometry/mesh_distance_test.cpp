@@ -1,5 +1,6 @@
 // Tests for geometry/mesh_distance: the signed distance to a box's surface mesh equals the box's exact signed
-// distance everywhere (inside, outside, beside faces, edges and corners), and a sphere's mesh is signed right.
+// distance everywhere (inside, outside, beside faces, edges and corners), and a sphere's mesh is signed right;
+// the nearest point within a radius (a moving surface's, without set-up) is MeshDistance's where it sees one.
 #include <pointhaptics/geometry/mesh_distance.hpp>
 #include <pointhaptics/geometry/shape_surfaces.hpp>
 
@@ -51,6 +52,54 @@ TEST(MeshDistance, SignsASpheresMeshRight) {
       EXPECT_NEAR(d, r - 0.05, 0.05 * 0.02) << r;  // the mesh's chords lie within a small part of the radius
     }
   }
+}
+
+// What a moving surface's test sees (nearest_surface_within: the triangles within a radius, the pseudo-normal
+// made on the spot) is what MeshDistance sees with its set-up, near faces, edges and corners, in and out; and
+// nothing beyond the radius.
+TEST(MeshDistance, TheNearestPointWithinARadiusIsSignedAsTheWholeMeshsDistance) {
+  const Vec3 origin(-0.02, 0.0, 0.01), size(0.08, 0.04, 0.05);
+  const TriangleMesh mesh = box_surface(origin, size, 0.007);
+  const MeshDistance distance(mesh);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> unit(-0.2, 1.2);
+  const double radius = 0.01;
+  int seen = 0, inside = 0;
+  for (int k = 0; k < 3000; ++k) {
+    const Vec3 p = origin + Vec3(unit(rng), unit(rng), unit(rng)).cwiseProduct(size);
+    const double exact = distance.signed_distance(p);
+    const std::optional<SurfaceSide> side = nearest_surface_within(p, mesh.V, mesh.F, radius);
+    ASSERT_EQ(side.has_value(), std::abs(exact) < radius) << p.transpose();
+    if (!side) continue;
+    ++seen;
+    inside += exact < 0;
+    ASSERT_NEAR(side->distance, exact, 1e-12) << p.transpose();
+    ASSERT_NEAR((side->point - p).norm(), std::abs(exact), 1e-12);
+  }
+  EXPECT_GT(seen, 500);
+  EXPECT_GT(inside, 100);
+  // just inside and just outside a corner and an edge's middle: the pseudo-normal of a corner, of an edge
+  for (const Vec3& on : {origin, Vec3(origin + Vec3(0.5 * size.x(), 0, 0))}) {
+    const Vec3 in = (origin + 0.5 * size - on).normalized();
+    EXPECT_LT(nearest_surface_within(on + 1e-6 * in, mesh.V, mesh.F, radius)->distance, 0);
+    EXPECT_GT(nearest_surface_within(on - 1e-6 * in, mesh.V, mesh.F, radius)->distance, 0);
+    EXPECT_TRUE(nearest_surface_within(on + 1e-6 * in, mesh.V, mesh.F, radius)->sure);
+  }
+  // a part of the surface (the top face's triangles): in front of and behind a face the sign is sure, beside
+  // its edge or corner, where the part ends, it is not
+  TriangleMesh top = mesh;
+  std::erase_if(top.F, [&](const std::array<index_t, 3>& f) {
+    return mesh.V(1, f[0]) < size.y() - 1e-12 || mesh.V(1, f[1]) < size.y() - 1e-12 || mesh.V(1, f[2]) < size.y() - 1e-12;
+  });
+  ASSERT_GT(top.F.size(), 10u);
+  const Vec3 middle = origin + Vec3(0.31 * size.x(), size.y(), 0.43 * size.z());
+  for (const double off : {-0.002, 0.002}) {
+    const std::optional<SurfaceSide> side = nearest_surface_within(middle + Vec3(0, off, 0), top.V, top.F, radius);
+    EXPECT_TRUE(side->sure);
+    EXPECT_NEAR(side->distance, off, 1e-12);
+  }
+  EXPECT_FALSE(nearest_surface_within(origin + Vec3(-0.001, size.y() - 0.002, 0.5 * size.z()), top.V, top.F, radius)->sure);  // an edge
+  EXPECT_FALSE(nearest_surface_within(origin + Vec3(-0.001, size.y() - 0.002, -0.001), top.V, top.F, radius)->sure);  // a corner
 }
 
 }  // namespace

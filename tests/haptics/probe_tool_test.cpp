@@ -1,9 +1,13 @@
 // Tests for haptics/coupling and haptics/probe_tool: the coupling solve balances the contact model and caps
 // the force at the device's maximum; the probe tool settles where the coupling spring balances the object's
-// contact forces, and its forces, springs and renumbering are those of its contact.
+// contact forces, and its forces, springs and renumbering are those of its contact. On the surface the probe is
+// a god-object: its centre is not taken into the surface between vertices, and it is put back on the surface
+// when the surface flowed over it.
 #include <pointhaptics/haptics/coupling.hpp>
 #include <pointhaptics/haptics/probe_tool.hpp>
 
+#include <pointhaptics/geometry/sampling.hpp>
+#include <pointhaptics/geometry/shape_surfaces.hpp>
 #include <pointhaptics/mechanics/model_builder.hpp>
 
 #include "support/test_models.hpp"
@@ -77,6 +81,59 @@ TEST(ProbeTool, SettlesWhereTheCouplingBalancesTheContactAndActsThroughIt) {
   EXPECT_EQ(tool.contact_model().contacts, 0);
   EXPECT_EQ(tool.contacts_before_step(), m.contacts);
   EXPECT_EQ(f.norm(), 0.0);
+}
+
+// A block 4 x 2 x 4 cm (bottom at y = 0, top at y = 2 cm) and a probe on its surface, of `edge` triangles
+struct SurfaceProbe {
+  Model model;
+  TriangleMesh mesh;
+  ProbeParams params;
+  ProbeTool tool;
+  /// the contact's penalty capped as a simulation caps it (E x spacing per point)
+  SurfaceProbe(double radius, double edge, double k)
+      : model(build_model(sample_box(Vec3::Zero(), Vec3(0.04, 0.02, 0.04), 0.005), MaterialParams{}, KernelParams{})),
+        mesh(box_surface(Vec3::Zero(), Vec3(0.04, 0.02, 0.04), edge)), params(with_radius(radius)),
+        tool(model, params, k, 10.0,
+             SurfaceContact(model, mesh, build_surface_map(model, mesh.V), probe_shape(params), capped(model))) {}
+  static SurfaceContactParams capped(const Model& model) {
+    SurfaceContactParams p;
+    p.max_point_stiffness = model.material.young * model.spacing;
+    return p;
+  }
+  static ProbeParams with_radius(double radius) {
+    ProbeParams p;
+    p.radius = radius;
+    return p;
+  }
+};
+
+// A face of two triangles 4 cm across and a probe of 3 mm: pushed down through the face's middle, no vertex
+// comes inside the probe, and only the test of its centre's path keeps it from going through.
+TEST(ProbeTool, OnTheSurfaceAPushIsNotTakenThroughAFaceBetweenItsVertices) {
+  SurfaceProbe s(0.003, 0.04, 300);
+  const State state = State::at_rest(s.model);
+  const Vec3 above(0.012, 0.02 + 0.004, 0.021), deep(0.012, 0.002, 0.021);
+  s.tool.place(s.model, state, above, false);
+  ASSERT_NEAR((s.tool.probe() - above).norm(), 0.0, 1e-12);  // nothing touched yet
+  for (int step = 0; step < 20; ++step) s.tool.place(s.model, state, deep, false);
+  EXPECT_GE(s.tool.probe().y(), 0.02);  // its centre stopped at the face
+  EXPECT_LT(s.tool.probe().y(), 0.02 + 0.004);  // it moved down to it
+  EXPECT_NEAR(s.tool.probe().x(), 0.012, 1e-9);
+}
+
+// The surface carried over the probe's centre within a step (the block moved 2 R up under it): the probe is
+// put back on the surface instead of being left inside it (where, with no vertex inside it, it sank through).
+TEST(ProbeTool, OnTheSurfaceAProbeTheSurfaceFlowedOverIsPutBackOnIt) {
+  const double radius = 0.004;
+  SurfaceProbe s(radius, 0.005, 300);
+  State state = State::at_rest(s.model);
+  const Vec3 device(0.02, 0.02 + 0.5 * radius, 0.02);
+  s.tool.place(s.model, state, device, false);
+  ASSERT_LT(s.tool.probe().y(), 0.02 + radius);  // on the surface: touching it
+  state.u.row(1).setConstant(2 * radius);  // the top face now 1.5 R above the probe's centre
+  s.tool.place(s.model, state, device, false);
+  EXPECT_GE(s.tool.probe().y(), 0.02 + 2 * radius);
+  EXPECT_TRUE(s.tool.probe().allFinite());
 }
 
 }  // namespace

@@ -230,5 +230,24 @@ TEST(SurfaceContact, FrictionSticksForASmallMoveAndSlidesWithMuTimesTheNormalFor
   EXPECT_NEAR(s.reactions[0].x(), s.tool.force.x(), 1e-3 * s.tool.force.y());
 }
 
+// The god-object's test of a move (SurfaceContact::enters): a segment entering the surface through a face, as
+// it is carried, is seen, one leaving it or beside it is not.
+TEST(SurfaceContact, AMoveIntoTheCarriedSurfaceIsSeenAndOneOutOfItIsNot) {
+  const Block b = block();
+  SurfaceContact contact(b.model, b.surface, build_surface_map(b.model, b.surface.V), ToolShape{ToolKind::SPHERE, 0.002, 0});
+  Points u = Points::Zero(3, b.model.n_points);
+  u.row(1).setConstant(0.01);  // the block carried 1 cm up: its top face at y = 3 cm
+  contact.load(b.model, u);
+  const Vec3 above(0.013, 0.031, 0.017), below(0.013, 0.029, 0.017);
+  EXPECT_TRUE(contact.enters(above, below));
+  EXPECT_FALSE(contact.enters(below, above));
+  EXPECT_FALSE(contact.enters(above, Vec3(0.013, 0.035, 0.017)));
+  EXPECT_FALSE(contact.enters(Vec3(-0.01, 0.031, 0.017), Vec3(-0.01, 0.029, 0.017)));  // beside the block
+  // the reference surface's top (y = 2 cm) is not where the carried one is
+  EXPECT_FALSE(contact.enters(Vec3(0.013, 0.021, 0.017), Vec3(0.013, 0.019, 0.017)));
+  // through the block, in through the top and out through the bottom: it enters
+  EXPECT_TRUE(contact.enters(Vec3(0.013, 0.04, 0.017), Vec3(0.013, 0.0, 0.017)));
+}
+
 }  // namespace
 }  // namespace pointhaptics

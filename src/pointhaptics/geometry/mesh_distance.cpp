@@ -7,10 +7,7 @@
 #include <unordered_map>
 
 namespace pointhaptics {
-namespace {
 
-/// The closest point of triangle (a, b, c) to p, and its feature: 0-2 a corner, 3-5 the edge from corner k - 3
-/// to the next, 6 the face (Ericson, Real-Time Collision Detection, 5.1.5).
 std::pair<Vec3, int> closest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
   const Vec3 ab = b - a, ac = c - a, ap = p - a;
   const double d1 = ab.dot(ap), d2 = ac.dot(ap);
@@ -31,7 +28,71 @@ std::pair<Vec3, int> closest_on_triangle(const Vec3& p, const Vec3& a, const Vec
   return {a + ab * (vb * denominator) + ac * (vc * denominator), 6};
 }
 
-}  // namespace
+double corner_angle(const std::array<Vec3, 3>& v, int k) {
+  const Vec3 e1 = (v[static_cast<std::size_t>((k + 1) % 3)] - v[static_cast<std::size_t>(k)]).normalized();
+  const Vec3 e2 = (v[static_cast<std::size_t>((k + 2) % 3)] - v[static_cast<std::size_t>(k)]).normalized();
+  return std::acos(std::clamp(e1.dot(e2), -1.0, 1.0));
+}
+
+std::optional<SurfaceSide> nearest_surface_within(const Vec3& p, const Points& V, const std::vector<std::array<index_t, 3>>& F,
+                                                  double radius) {
+  const auto corners = [&](const std::array<index_t, 3>& f) { return std::array<Vec3, 3>{V.col(f[0]), V.col(f[1]), V.col(f[2])}; };
+  double best = radius * radius;
+  std::size_t nearest = F.size();
+  int feature = 0;
+  Vec3 point = Vec3::Zero();
+  for (std::size_t t = 0; t < F.size(); ++t) {
+    const std::array<Vec3, 3> v = corners(F[t]);
+    // most triangles are far: their boxes, widened by the radius, miss p
+    if (((v[0].cwiseMin(v[1]).cwiseMin(v[2]).array() - radius) > p.array()).any() ||
+        ((v[0].cwiseMax(v[1]).cwiseMax(v[2]).array() + radius) < p.array()).any())
+      continue;
+    const auto [q, f] = closest_on_triangle(p, v[0], v[1], v[2]);
+    if ((p - q).squaredNorm() >= best) continue;
+    best = (p - q).squaredNorm();
+    nearest = t;
+    feature = f;
+    point = q;
+  }
+  if (nearest == F.size()) return std::nullopt;
+  // the feature's pseudo-normal: the face's normal, the sum of an edge's two faces' normals, or the
+  // angle-weighted sum of a corner's faces' normals (those faces are all nearer than the radius)
+  const std::array<index_t, 3>& near = F[nearest];
+  Vec3 normal = Vec3::Zero();
+  int faces = 0;
+  // a corner's faces' other corners: each twice when its faces close around it (no allocation: a tool's step
+  // asks; a corner of more than 32 faces is taken as not closed)
+  std::array<index_t, 64> around{};
+  std::size_t n_around = 0;
+  for (std::size_t t = 0; t < F.size(); ++t) {
+    const std::array<index_t, 3>& f = F[t];
+    int shared = 0, corner = -1;
+    for (int k = 0; k < 3; ++k) {
+      const index_t v = f[static_cast<std::size_t>(k)];
+      if (feature >= 3 && feature < 6 && (v == near[static_cast<std::size_t>(feature - 3)] || v == near[static_cast<std::size_t>((feature - 2) % 3)]))
+        ++shared;
+      if (feature < 3 && v == near[static_cast<std::size_t>(feature)]) corner = k;
+    }
+    const bool counts = feature == 6 ? t == nearest : feature < 3 ? corner >= 0 : shared == 2;
+    if (!counts) continue;
+    const std::array<Vec3, 3> v = corners(f);
+    const Vec3 n = (v[1] - v[0]).cross(v[2] - v[0]).normalized();
+    normal += feature < 3 ? corner_angle(v, corner) * n : n;
+    ++faces;
+    if (feature < 3 && n_around + 2 <= around.size()) {
+      around[n_around++] = f[static_cast<std::size_t>((corner + 1) % 3)];
+      around[n_around++] = f[static_cast<std::size_t>((corner + 2) % 3)];
+    }
+  }
+  bool sure = feature == 6 || (feature < 6 && faces == 2);
+  if (feature < 3) {
+    std::sort(around.begin(), around.begin() + static_cast<std::ptrdiff_t>(n_around));
+    sure = n_around >= 6 && n_around == 2 * static_cast<std::size_t>(faces);
+    for (std::size_t k = 0; sure && k < n_around; k += 2) sure = around[k] == around[k + 1] && (k + 2 >= n_around || around[k + 2] != around[k]);
+  }
+  const double distance = std::sqrt(best);
+  return SurfaceSide{point, (p - point).dot(normal) < 0 ? -distance : distance, sure};
+}
 
 MeshDistance::MeshDistance(const TriangleMesh& mesh) : mesh_(mesh) {
   const std::size_t n_faces = mesh.F.size();
@@ -53,8 +114,7 @@ MeshDistance::MeshDistance(const TriangleMesh& mesh) : mesh_(mesh) {
     for (int k = 0; k < 3; ++k) {
       // (Eigen's vectors start uninitialised: the map's new entries are made zero first)
       edge_sum.try_emplace(key(f[k], f[(k + 1) % 3]), Vec3::Zero()).first->second += n;
-      const Vec3 e1 = (v[(k + 1) % 3] - v[k]).normalized(), e2 = (v[(k + 2) % 3] - v[k]).normalized();
-      vertex_normal_[static_cast<std::size_t>(f[k])] += std::acos(std::clamp(e1.dot(e2), -1.0, 1.0)) * n;
+      vertex_normal_[static_cast<std::size_t>(f[k])] += corner_angle({v[0], v[1], v[2]}, k) * n;
     }
   }
   for (std::size_t t = 0; t < n_faces; ++t)

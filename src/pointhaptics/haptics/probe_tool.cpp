@@ -79,8 +79,18 @@ double ProbeTool::penetration_at(const Model& model, const State& state, const V
 
 Vec3 ProbeTool::stop_at_surface(const Model& model, const State& state, const Vec3& from, Vec3 to) {
   const double allowed = std::max(allowed_penetration * contact_.params().radius, penetration_at(model, state, from));
-  for (int halving = 0; halving < 6 && penetration_at(model, state, to) > allowed; ++halving) to = from + 0.5 * (to - from);
-  return penetration_at(model, state, to) > allowed ? from : to;
+  // penetration_at() carries the surface to the state: enters() sees it as the step found it
+  const auto refused = [&](const Vec3& p) { return penetration_at(model, state, p) > allowed || surface_->enters(from, p); };
+  for (int halving = 0; halving < 6 && refused(to); ++halving) to = from + 0.5 * (to - from);
+  return refused(to) ? from : to;
+}
+
+Vec3 ProbeTool::back_on_surface(const Vec3& p) const {
+  const ToolShape& shape = surface_->shape();
+  const std::optional<SurfaceSide> side = surface_->side_of(p, 2 * shape.radius + shape.length);
+  if (!side || side->distance >= 0 || !side->sure) return p;
+  // just outside (on the surface itself a move along it could count as entering)
+  return side->point + (side->point - p) * (1e-3 * shape.radius / -side->distance);
 }
 
 void ProbeTool::place(const Model& model, const State& state, const Vec3& device, bool button, const Eigen::Quaterniond& orientation) {
@@ -102,10 +112,14 @@ void ProbeTool::place(const Model& model, const State& state, const Vec3& device
     return;
   }
   Vec3 p = probe_.allFinite() ? probe_ : device;
+  if (pushing_surface()) {
+    surface_->load(model, state.u);  // the surface carried to the step's start, for every placement below
+    if (probe_.allFinite()) p = back_on_surface(p);
+  }
   for (int it = 0; it < 8; ++it) {
     scratch_.setZero();
     // the state is the same at every iteration: the positions (and their grid) are made once
-    const ContactModel local = pushing_surface() ? surface_model(model, state, p, it > 0)
+    const ContactModel local = pushing_surface() ? surface_model(model, state, p, true)
                                                  : contact_.apply(model, state.u, p, button, state.time, scratch_, it > 0);
     Vec3 next = coupled_probe(local, device, k_, max_force_);
     // on the surface the probe moves at most a quarter radius per iteration (2 radii a step, far above a

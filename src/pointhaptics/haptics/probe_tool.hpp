@@ -88,8 +88,14 @@ class ProbeTool final : public DynamicForces {
   /// The deepest surface vertex inside the probe at p, the surface as the step found it (evaluated already).
   double penetration_at(const Model& model, const State& state, const Vec3& p);
   /// The god-object's rule: the probe's move from `from` toward `to`, halved until no surface vertex is deeper
-  /// inside it than allowed_penetration x radius (or than at `from`, if deeper there), or no move at all.
+  /// inside it than allowed_penetration x radius (or than at `from`, if deeper there) and its centre's path
+  /// does not enter the surface (SurfaceContact::enters()), or no move at all.
   Vec3 stop_at_surface(const Model& model, const State& state, const Vec3& from, Vec3 to);
+  /// p, or the nearest point of the surface (as the step found it) if p is inside it: a soft, coarse object
+  /// pressed hard can flow over the probe's centre within a step, its vertices passing the probe's sides and a
+  /// triangle its centre, and a probe left inside sank through the object (scenes/half_sphere_lod.toml
+  /// without [lod]). Put back, the god-object is outside again and its moves are kept there.
+  Vec3 back_on_surface(const Vec3& p) const;
   /// The local model of the surface contact at the probe position p (u as in the last evaluation when same_u).
   ContactModel surface_model(const Model& model, const State& state, const Vec3& p, bool same_u);
   /// The stiffness the tool feels with the object free to give (issue 16, item 4): K = B^T H^-1 B - sum_v H_v,

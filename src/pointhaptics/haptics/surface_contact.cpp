@@ -1,6 +1,7 @@
 #include <pointhaptics/haptics/surface_contact.hpp>
 
 #include <pointhaptics/core/error.hpp>
+#include <pointhaptics/geometry/segment_crossing.hpp>
 
 #include <fmt/format.h>
 
@@ -11,7 +12,7 @@ namespace pointhaptics {
 
 SurfaceContact::SurfaceContact(const Model& model, const TriangleMesh& mesh, SurfaceMap map, const ToolShape& shape,
                                const SurfaceContactParams& params)
-    : Y_(mesh.V), y_(mesh.V), map_(std::move(map)), shape_(shape) {
+    : Y_(mesh.V), y_(mesh.V), triangles_(mesh.F), map_(std::move(map)), shape_(shape) {
   if (!(shape.radius > 0) || !std::isfinite(shape.radius)) throw Error("tool: radius must be positive (m)");
   if (!(shape.length >= 0) || !std::isfinite(shape.length)) throw Error("tool: length must be >= 0 (m)");
   if (map_.n_vertices() != Y_.cols()) throw Error("tool: the surface map is for another surface");
@@ -251,6 +252,19 @@ void SurfaceContact::advance_anchor(index_t v, const ToolDistance& d) {
   a.tau = t.norm() > cone ? Vec3(cone / t.norm() * t) : t;
   if (t.norm() > cone) a.local = pose_.orientation.conjugate() * (y_.col(v) - pose_.position);
   a.tangent = tangent;
+}
+
+bool SurfaceContact::enters(const Vec3& from, const Vec3& to) const {
+  const Vec3 low = from.cwiseMin(to), high = from.cwiseMax(to);
+  for (const auto& t : triangles_) {
+    const Vec3 a = y_.col(t[0]), b = y_.col(t[1]), c = y_.col(t[2]);
+    // most triangles are far from a move of a fraction of the tool's radius: their boxes miss the move's
+    if ((a.cwiseMax(b).cwiseMax(c).array() < low.array()).any() || (a.cwiseMin(b).cwiseMin(c).array() > high.array()).any()) continue;
+    const CrossingTriangle triangle(a, b, c);
+    const double side_from = triangle.side(from), side_to = triangle.side(to);
+    if (side_from >= 0 && side_to < 0 && triangle.crossing(from, to, side_from, side_to)) return true;
+  }
+  return false;
 }
 
 void SurfaceContact::pressing_points(std::vector<index_t>& out) const {

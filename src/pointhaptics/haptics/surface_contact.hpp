@@ -18,11 +18,14 @@
 /// cone, the anchor then moving to the vertex); the solve is done when no sticking vertex strays from its
 /// anchor, and no sliding one's force changes, by more than the tolerance's worth of penalty.
 #include <pointhaptics/core/model.hpp>
+#include <pointhaptics/geometry/mesh_distance.hpp>
 #include <pointhaptics/geometry/triangle_mesh.hpp>
 #include <pointhaptics/haptics/tool_shape.hpp>
 #include <pointhaptics/mechanics/surface_map.hpp>
 #include <pointhaptics/solvers/newton.hpp>
 
+#include <array>
+#include <optional>
 #include <vector>
 
 namespace pointhaptics {
@@ -121,6 +124,12 @@ class SurfaceContact final : public EnergyTerm {
   double max_point_stiffness() const { return max_point_stiffness_; }
   /// The deformed vertices of the last evaluation.
   const Points& vertices() const { return y_; }
+  /// Whether the segment from-to enters the surface as the last evaluation carried it: crosses a triangle
+  /// from its outer side to its inner one. The tool's core may not (the god-object's rule): a tool that has
+  /// pushed a coarse surface's vertices aside can hold none inside it, and so pass through unseen.
+  bool enters(const Vec3& from, const Vec3& to) const;
+  /// Where p is seen from the surface as the last evaluation carried it (nearest_surface_within()).
+  std::optional<SurfaceSide> side_of(const Vec3& p, double radius) const { return nearest_surface_within(p, y_, triangles_, radius); }
   const SurfaceMap& map() const { return map_; }
 
  private:
@@ -160,6 +169,7 @@ class SurfaceContact final : public EnergyTerm {
   ToolLoad for_each_pressing(const Pressing& pressing) const;
 
   Points Y_, y_;
+  std::vector<std::array<index_t, 3>> triangles_;  // the surface's, counter-clockwise seen from outside
   SurfaceMap map_;
   ToolShape shape_;
   ToolPose pose_, previous_pose_;
