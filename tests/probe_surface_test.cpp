@@ -6,6 +6,7 @@
 #include <pointhaptics/interactive.hpp>
 #include <pointhaptics/io/scene_toml.hpp>
 #include <pointhaptics/scene_builder.hpp>
+#include <pointhaptics/scene_session.hpp>
 
 #include <gtest/gtest.h>
 
@@ -308,6 +309,46 @@ TEST(ProbeOnSurface, WithFrictionTheProbeRestsWhereTheHandPushesInsideTheConeAnd
               1e3 * slides.device_x, slides.felt.x(), slides.felt.y(), slides.sliding_ratio);
   EXPECT_GT(slides.probe_x, 0.5 * slides.device_x);
   EXPECT_NEAR(slides.sliding_ratio, mu, 0.05 * mu);
+}
+
+// The soft, coarse dome of scenes/half_sphere_lod.toml without [lod] (E = 1e4 Pa, spacing 4 mm, a 6 mm probe:
+// 1.5 spacings per radius) pressed 8 mm and slid 2 cm aside. The surface, pushed apart by the probe, flowed
+// over its centre within a step at 1.7 s, and the probe, inside with no vertex in it, sank through and stayed
+// under the dome (5.5 mm inside at the end). Now it is put back on the surface: its centre ends outside, and
+// is found inside at the end of a step only as the surface flows over it (then put back at the next).
+TEST(ProbeOnSurface, OnASoftCoarseDomeTheProbeStaysOnTheSurfaceAsTheHandSlidesAside) {
+  Scene scene = read_scene_file(PH_SCENES "/half_sphere_lod.toml");
+  scene.lod = LodSpec{};
+  SessionOptions options;
+  options.threads = 1;
+  SceneSession session = open_scene(std::move(scene), options);
+  Simulation& sim = *session.simulation;
+  InteractiveOptions o = session.interactive;
+  o.real_time = false;
+  ASSERT_TRUE(o.surface);
+  const double radius = o.probe.radius;
+  long long steps = 0, inside = 0;
+  double deepest = 0;  // the probe's centre's furthest inside the surface at a step's end, m
+  Vec3 probe = Vec3::Constant(NAN);
+  o.after_step = [&](long long) {  // (the probe is detached when the run ends)
+    ++steps;
+    ASSERT_TRUE(sim.probe() && sim.probe()->surface_contact());
+    probe = sim.probe()->probe();
+    const std::optional<SurfaceSide> side = sim.probe()->surface_contact()->side_of(probe, 2 * radius);
+    if (!side || !side->sure || side->distance >= 0) return;
+    ++inside;
+    deepest = std::min(deepest, side->distance);
+  };
+  run_interactive(sim, *session.device, o);
+  ASSERT_FALSE(sim.diagnostics().failed) << sim.diagnostics().failure;
+  std::printf("soft dome: the probe's centre inside the surface at %lld of %lld steps' ends, at most %.2f mm; ends at (%.1f, %.1f, %.1f) mm\n",
+              inside, steps, -1e3 * deepest, 1e3 * probe.x(), 1e3 * probe.y(), 1e3 * probe.z());
+  EXPECT_EQ(steps, 2000);
+  EXPECT_LT(inside, steps / 20);  // 50 (294 before)
+  EXPECT_GT(deepest, -0.5 * radius);  // 1.8 mm (6.1 mm before)
+  // and the probe followed the hand aside (2 cm) on the dome's top (its top at y = 5 cm)
+  EXPECT_GT(probe.x(), 0.01);
+  EXPECT_GT(probe.y(), 0.04);
 }
 
 }  // namespace
