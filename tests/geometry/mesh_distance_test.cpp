@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <vector>
 
 namespace pointhaptics {
 namespace {
@@ -17,15 +18,25 @@ double box_signed_distance(const Vec3& p, const Vec3& lo, const Vec3& hi) {
   return q.cwiseMax(0.0).norm() + std::min(q.maxCoeff(), 0.0);
 }
 
+// the box both tests measure against, and points around it: each coordinate from `from` to `to` of its size
+const Vec3 origin(-0.02, 0.0, 0.01), size(0.08, 0.04, 0.05);
+const TriangleMesh& box_mesh() {
+  static const TriangleMesh mesh = box_surface(origin, size, 0.007);
+  return mesh;
+}
+std::vector<Vec3> points_around_the_box(double from, double to, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> unit(from, to);
+  std::vector<Vec3> points(3000);
+  for (Vec3& p : points) p = origin + Vec3(unit(rng), unit(rng), unit(rng)).cwiseProduct(size);
+  return points;
+}
+
 TEST(MeshDistance, EqualsABoxsExactSignedDistanceInsideOutsideAndNearEdgesAndCorners) {
-  const Vec3 origin(-0.02, 0.0, 0.01), size(0.08, 0.04, 0.05);
-  const TriangleMesh mesh = box_surface(origin, size, 0.007);
+  const TriangleMesh& mesh = box_mesh();
   const MeshDistance distance(mesh);
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> unit(-0.3, 1.3);
   int inside = 0;
-  for (int k = 0; k < 3000; ++k) {
-    const Vec3 p = origin + Vec3(unit(rng), unit(rng), unit(rng)).cwiseProduct(size);
+  for (const Vec3& p : points_around_the_box(-0.3, 1.3, 7)) {
     const double exact = box_signed_distance(p, origin, origin + size);
     ASSERT_NEAR(distance.signed_distance(p), exact, 1e-12) << p.transpose();
     inside += exact < 0;
@@ -58,15 +69,11 @@ TEST(MeshDistance, SignsASpheresMeshRight) {
 // made on the spot) is what MeshDistance sees with its set-up, near faces, edges and corners, in and out; and
 // nothing beyond the radius.
 TEST(MeshDistance, TheNearestPointWithinARadiusIsSignedAsTheWholeMeshsDistance) {
-  const Vec3 origin(-0.02, 0.0, 0.01), size(0.08, 0.04, 0.05);
-  const TriangleMesh mesh = box_surface(origin, size, 0.007);
+  const TriangleMesh& mesh = box_mesh();
   const MeshDistance distance(mesh);
-  std::mt19937 rng(11);
-  std::uniform_real_distribution<double> unit(-0.2, 1.2);
   const double radius = 0.01;
   int seen = 0, inside = 0;
-  for (int k = 0; k < 3000; ++k) {
-    const Vec3 p = origin + Vec3(unit(rng), unit(rng), unit(rng)).cwiseProduct(size);
+  for (const Vec3& p : points_around_the_box(-0.2, 1.2, 11)) {
     const double exact = distance.signed_distance(p);
     const std::optional<SurfaceSide> side = nearest_surface_within(p, mesh.V, mesh.F, radius);
     ASSERT_EQ(side.has_value(), std::abs(exact) < radius) << p.transpose();
