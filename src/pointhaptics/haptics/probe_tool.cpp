@@ -81,8 +81,12 @@ Vec3 ProbeTool::stop_at_surface(const Model& model, const State& state, const Ve
   const double allowed = std::max(allowed_penetration * contact_.params().radius, penetration_at(model, state, from));
   // penetration_at() carries the surface to the state: enters() sees it as the step found it
   const auto refused = [&](const Vec3& p) { return penetration_at(model, state, p) > allowed || surface_->enters(from, p); };
-  for (int halving = 0; halving < 6 && refused(to); ++halving) to = from + 0.5 * (to - from);
-  return refused(to) ? from : to;
+  // each try once (a try costs a pass over the surface's vertices and one over its triangles)
+  for (int halving = 0;; ++halving) {
+    if (!refused(to)) return to;
+    if (halving == 6) return from;
+    to = from + 0.5 * (to - from);
+  }
 }
 
 Vec3 ProbeTool::back_on_surface(const Vec3& p) const {
