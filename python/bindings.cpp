@@ -553,8 +553,8 @@ names the problem.)doc")
             {
               py::gil_scoped_release release;
               const std::lock_guard<std::mutex> lock(p.mutex);
-              // the probe pushes on the object's surface (with levels of detail on the point spheres, as scenes do)
-              if (!p.sim->lod_enabled()) o.surface = std::make_shared<const ph::ObjectSurface>(p.object_surface());
+              // the probe pushes on the object's surface (with levels of detail, on the part the active set carries)
+              o.surface = std::make_shared<const ph::ObjectSurface>(p.object_surface());
               r = ph::run_interactive(*p.sim, device, o);
               p.carry_surface();
             }

@@ -34,10 +34,8 @@ SceneSession open_scene(Scene scene, const SessionOptions& options) {
                             contact);
   } else if (scene.probe.present) {
     s.interactive = scene_interactive_options(scene, s.simulation->model());
-    // the probe pushes on the object's surface; with levels of detail on the point spheres: the surface's part
-    // an active set carries (Simulation::attach_probe) diverged in a slow real-time run (tests/integration/
-    // realtime_lod_soak.py), which the point spheres pass
-    if (!scene.lod.present) s.interactive.surface = std::make_shared<const ObjectSurface>(build_object_surface(scene, s.simulation->model()));
+    // the probe pushes on the object's surface (with levels of detail, on the part the active set carries)
+    s.interactive.surface = std::make_shared<const ObjectSurface>(build_object_surface(scene, s.simulation->model()));
     if (options.make_device) s.device = make_scene_device(scene);
   }
   s.scene = std::move(scene);

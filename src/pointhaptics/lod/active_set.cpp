@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 namespace pointhaptics {
 
@@ -35,9 +36,13 @@ void take_selected(const Selection& selection, ActiveSet& a) {
   if (a.n_selected == 0) throw Error("lod: no point of the selection lies in its bands");
 }
 
-// Phase 2, every unselected point by its nearest selected one (a k-d tree over the selected): inside the
-// bands it is absorbed by it and follows it; beyond them, within the widest support, it is a candidate for
-// the frozen ring. Returns, per object point, the selected point that absorbs it (-1: none).
+// How many selected points an absorbed point's displacement is blended from (the nearest of them absorbs it).
+constexpr int followed_count = 5;
+
+// Phase 2, every unselected point by its nearest selected ones (a k-d tree over the selected): inside the
+// bands it is absorbed by the nearest and follows the nearest few (ActiveSet::followed); beyond them, within
+// the widest support, it is a candidate for the frozen ring. Returns, per object point, the selected point
+// that absorbs it (-1: none).
 std::vector<index_t> absorb_and_find_ring(const Model& full, const Selection& selection, const LodParams& params, ActiveSet& a) {
   const index_t n_full = full.n_points;
   const double reach = params.max_widening * full.h;
@@ -45,28 +50,55 @@ std::vector<index_t> absorb_and_find_ring(const Model& full, const Selection& se
   Points selected_X(3, a.n_selected);
   for (index_t k = 0; k < a.n_selected; ++k) selected_X.col(k) = full.X.col(a.full_of[k]);
   const KdTree tree(selected_X);
-  std::vector<index_t> absorbed_by(n_full, -1), nearest_of(n_full, -1);
-  std::vector<double> nearest_d2(n_full, 0.0);
+  constexpr std::size_t m = followed_count;
+  std::vector<index_t> nearest_of(m * static_cast<std::size_t>(n_full), -1);
+  std::vector<double> nearest_d2(m * static_cast<std::size_t>(n_full), 0.0);
+  std::vector<unsigned char> found(static_cast<std::size_t>(n_full), 0);
   // the searches in parallel (each writes its own entries), the bookkeeping after, in index order
   tbb::parallel_for(tbb::blocked_range<index_t>(0, n_full, 1024), [&](const tbb::blocked_range<index_t>& range) {
     for (index_t j = range.begin(); j != range.end(); ++j) {
       if (a.active_of[j] >= 0) continue;
       if (selection.band[j] < 0 && (full.X.col(j) - selection.centre).squaredNorm() > candidate_radius * candidate_radius)
         continue;  // beyond the reach of any selected point
-      tree.index().knnSearch(full.X.col(j).data(), 1, &nearest_of[j], &nearest_d2[j]);
+      const std::size_t at = m * static_cast<std::size_t>(j);
+      found[j] = static_cast<unsigned char>(
+          tree.index().knnSearch(full.X.col(j).data(), selection.band[j] >= 0 ? m : 1, &nearest_of[at], &nearest_d2[at]));
     }
   });
+  std::vector<index_t> absorbed_by(n_full, -1);
+  a.followed.offset.assign(static_cast<std::size_t>(n_full) + 1, 0);
   for (index_t j = 0; j < n_full; ++j) {
-    const index_t nearest = nearest_of[j];
-    if (nearest < 0) continue;
-    if (selection.band[j] >= 0) {
-      absorbed_by[j] = nearest;
-      a.follows[j] = nearest;
-      a.follow_offset.col(j) = full.X.col(j) - selected_X.col(nearest);
-    } else if (nearest_d2[j] < reach * reach) {
+    const std::size_t at = m * static_cast<std::size_t>(j);
+    if (found[j] > 0 && selection.band[j] >= 0) {
+      absorbed_by[j] = nearest_of[at];
+      // weights (1 - r / r_m)^2 within the distance r_m to the last one found: they fall to zero there, so
+      // the blend changes continuously from point to point (a point's nearest selected one alone jumps
+      // between neighbours that follow different points, and with their gradients told apart by the
+      // dynamics a neighbourhood of followers could come out inverted, to start inverted when a later
+      // selection simulates it)
+      const double r_last = std::sqrt(nearest_d2[at + found[j] - 1]);
+      double sum = 0;
+      const std::size_t first = a.followed_weight.size();
+      for (std::size_t q = 0; q < found[j]; ++q) {
+        const double w = r_last > 0 ? std::pow(1 - std::sqrt(nearest_d2[at + q]) / r_last, 2) : 0.0;
+        if (w <= 0) continue;
+        a.followed.index.push_back(nearest_of[at + q]);
+        a.followed_weight.push_back(w);
+        a.followed_offset.push_back(full.X.col(j) - selected_X.col(nearest_of[at + q]));
+        sum += w;
+      }
+      if (sum > 0) {
+        for (std::size_t e = first; e < a.followed_weight.size(); ++e) a.followed_weight[e] /= sum;
+      } else {  // as far from each: the nearest alone
+        a.followed.index.push_back(nearest_of[at]);
+        a.followed_weight.push_back(1.0);
+        a.followed_offset.push_back(full.X.col(j) - selected_X.col(nearest_of[at]));
+      }
+    } else if (found[j] > 0 && nearest_d2[at] < reach * reach) {
       a.active_of[j] = static_cast<index_t>(a.full_of.size());  // a ring candidate
       a.full_of.push_back(j);
     }
+    a.followed.offset[static_cast<std::size_t>(j) + 1] = a.followed.n_entries();
   }
   return absorbed_by;
 }
@@ -214,8 +246,6 @@ ActiveSet build_active_set(const Model& full, const Selection& selection, const 
   if (static_cast<index_t>(selection.band.size()) != full.n_points) throw Error("lod: the selection is for another model");
   ActiveSet a;
   a.active_of.assign(full.n_points, -1);
-  a.follows.assign(full.n_points, -1);
-  a.follow_offset = Points::Zero(3, full.n_points);
   take_selected(selection, a);
   const std::vector<index_t> absorbed_by = absorb_and_find_ring(full, selection, params, a);
   ActiveCloud cloud = gather_cloud(full, a, absorbed_by);
@@ -275,7 +305,7 @@ void ActiveSet::prolong_state(const State& active, State& full) const {
     full.velocity.col(full_of[k]) = active.velocity.col(k);
     if (full.viscous.rows() && full.viscous.rows() == active.viscous.rows()) full.viscous.col(full_of[k]) = active.viscous.col(k);
   }
-  // first-order MLS from the followed point: exact for any affine field. Each selected point's gradients
+  // first-order MLS from each followed point, blended: exact for any affine field. Each selected point's gradients
   // once (a point has several followers), into buffers kept for the next call
   gradient_cache_.resize(2 * static_cast<std::size_t>(n_selected));
   tbb::parallel_for(tbb::blocked_range<index_t>(0, n_selected, 256), [&](const tbb::blocked_range<index_t>& range) {
@@ -284,17 +314,23 @@ void ActiveSet::prolong_state(const State& active, State& full) const {
       gradient_cache_[2 * k + 1] = displacement_gradient(model, active.velocity, k);
     }
   });
-  for (index_t j = 0; j < static_cast<index_t>(follows.size()); ++j) {
-    const index_t k = follows[j];
-    if (k < 0) {
+  for (index_t j = 0; j < followed.n_rows(); ++j) {
+    if (followed.row_size(j) == 0) {
       // not simulated: it stays where it was left, at rest. A velocity kept from when it was last simulated
       // would come back when a later selection takes it in again: energy from nowhere (issue 21)
       if (active_of[j] < 0) full.velocity.col(j).setZero();
       continue;
     }
-    const Vec3 dX = follow_offset.col(j);
-    full.u.col(j) = active.u.col(k) + gradient_cache_[2 * k] * dX;
-    full.velocity.col(j) = active.velocity.col(k) + gradient_cache_[2 * k + 1] * dX;
+    Vec3 u = Vec3::Zero(), v = Vec3::Zero();
+    for (index_t e = followed.begin(j); e < followed.end(j); ++e) {
+      const index_t k = followed.index[e];
+      const double w = followed_weight[static_cast<std::size_t>(e)];
+      const Vec3& dX = followed_offset[static_cast<std::size_t>(e)];
+      u += w * (active.u.col(k) + gradient_cache_[2 * k] * dX);
+      v += w * (active.velocity.col(k) + gradient_cache_[2 * k + 1] * dX);
+    }
+    full.u.col(j) = u;
+    full.velocity.col(j) = v;
   }
   full.time = active.time;
 }

@@ -11,8 +11,9 @@ namespace pointhaptics {
 
 /// The model over the selected points (design.md's reading of seed §3):
 /// - each unselected point inside the selection bands gives its volume, mass and external load to its
-///   nearest selected point (so the active set keeps the region's mass and load), and follows it:
-///   u_j = u_i + G_i (X_j - X_i), first-order MLS from that point;
+///   nearest selected point (so the active set keeps the region's mass and load), and follows the nearest
+///   few: u_j = sum_i w_ji (u_i + G_i (X_j - X_i)), first-order MLS from each, blended by weights that fall to
+///   zero at the last of them (so that neighbouring followers move together);
 /// - unselected points beyond the last band that a selected point's support reaches, and their own
 ///   neighbours, form a frozen ring, held at their current displacement (or their prescribed one), so the
 ///   active set is supported by the rest of the object as it is, not left floating; held points that the
@@ -24,15 +25,16 @@ struct ActiveSet {
   index_t n_selected = 0;             ///< simulated points: the selected ones inside the bands
   std::vector<index_t> full_of;       ///< active index -> full index
   std::vector<index_t> active_of;     ///< full index -> active index, or -1
-  std::vector<index_t> follows;       ///< full index -> the active point an absorbed point follows, or -1
-  Points follow_offset;               ///< full index -> X_j - X_followed (3 x n_full; zero where none)
+  Csr followed;                       ///< full index -> the selected points an absorbed point follows (empty: none)
+  std::vector<double> followed_weight;  ///< per entry of followed: its weight (a row sums to 1)
+  std::vector<Vec3> followed_offset;    ///< per entry of followed: X_j - X_followed
   index_t widened = 0;                ///< selected points whose support was widened
   double build_ms = 0;
 
   /// The active state from the full one (selected and frozen points copy theirs).
   State restrict_state(const State& full) const;
   /// Write the active state back: active points (selected and ring) copy, absorbed points follow by
-  /// first-order MLS, unsimulated points keep their displacement and are at rest (zero velocity). No allocation after the first call; not for two
+  /// blended first-order MLS, unsimulated points keep their displacement and are at rest (zero velocity). No allocation after the first call; not for two
   /// threads at once (it keeps the selected points' gradients in a buffer).
   void prolong_state(const State& active, State& full) const;
 
