@@ -10,10 +10,12 @@ ActiveSurface restrict_surface(const TriangleMesh& mesh, const SurfaceMap& map, 
   std::vector<index_t> kept(static_cast<std::size_t>(m), -1);
   for (index_t v = 0; v < m; ++v) {
     if (map.points.row_size(v) == 0) continue;
-    // the point that carries most of the vertex in the object
+    // the point that carries most of the vertex in the object: simulated, held in the ring, or absorbed by
+    // a simulated one (left out, the absorbed points of a thinned band made holes in the part a few
+    // millimetres from the contact, through which the probe's centre passed unseen)
     const auto first = map.weight.begin() + map.points.begin(v), last = map.weight.begin() + map.points.end(v);
     const index_t nearest = map.points.index[static_cast<std::size_t>(std::max_element(first, last) - map.weight.begin())];
-    if (active.active_of[static_cast<std::size_t>(nearest)] < 0) continue;
+    if (active.active_of[static_cast<std::size_t>(nearest)] < 0 && active.followed.row_size(nearest) == 0) continue;
     kept[static_cast<std::size_t>(v)] = static_cast<index_t>(out.vertex_of.size());
     out.vertex_of.push_back(v);
   }

@@ -1,7 +1,8 @@
 #pragma once
 /// @file The part of an object's surface that a level-of-detail active set carries (issue 16: the probe
 /// touches the surface with levels of detail too). A vertex stays when the point that carries most of it in
-/// the object is in the active model (selected, or in the frozen ring around them); the kept vertices are
+/// the object is in the active model (selected, or in the frozen ring around them) or absorbed by a selected
+/// one (so a thinned band leaves no hole); the kept vertices are
 /// carried by the active model's own moving least squares (its points, with their widened supports where
 /// the selection thinned them: build_surface_map), as the absorbed points follow the selected ones. The
 /// triangles among kept vertices stay. The selection is centred on the contact and reaches bands beyond the
