@@ -180,8 +180,18 @@ std::vector<index_t> LevelsOfDetail::update(const Vec3& contact, bool onset, boo
   if (!asynchronous)
     return take_over(build_lod(full_, params_, snap(contact), solver_.kind, active_->cut_sheets_.triangles, object_cuts_made_), true);
   // the worker only reads the object's model: a cut meanwhile reaches it once the build is done (carry_cuts())
-  pending_ = std::async(std::launch::async, build_lod, std::cref(full_), params_, snap(contact), solver_.kind,
-                        active_->cut_sheets_.triangles, object_cuts_made_);
+  // and, with a probe on the surface, the part of it the new active set carries
+  const std::optional<ProbeAttachment>& probe = active_->probe();
+  std::shared_ptr<const ObjectSurface> surface = probe && probe->surface ? (probe->split ? probe->split : probe->surface) : nullptr;
+  pending_ = std::async(std::launch::async, [&full = full_, params = params_, at = snap(contact), kind = solver_.kind,
+                                             sheets = active_->cut_sheets_.triangles, cuts = object_cuts_made_, surface] {
+    LodBuild build = build_lod(full, params, at, kind, sheets, cuts);
+    if (surface) {
+      build.part = restrict_surface(surface->mesh, surface->map, build.active);
+      build.part_of = surface;
+    }
+    return build;
+  });
   return {};
 }
 
@@ -231,9 +241,12 @@ std::vector<index_t> LevelsOfDetail::take_over(LodBuild build, bool built_here) 
     probe.object_model = &full_;
     probe.active_set = &active_set_;  // (next, once moved there below)
     std::optional<SurfaceContact> surface;
-    if (probe.surface)
-      surface.emplace(probe_surface_contact(probe.split ? *probe.split : *probe.surface, probe.contact,
-                                            probe_shape(probe.tool.contact().params()), active_->model(), &next));
+    const std::shared_ptr<const ObjectSurface>& current = probe.split ? probe.split : probe.surface;
+    const ToolShape shape = probe_shape(probe.tool.contact().params());
+    if (current && build.part && build.part_of == current)  // made by the worker (a cut split none since)
+      surface.emplace(probe_surface_contact(std::move(*build.part), probe.contact, shape, active_->model()));
+    else if (current)
+      surface.emplace(probe_surface_contact(*current, probe.contact, shape, active_->model(), &next));
     probe.tool.remap(active_->model(), new_index, std::move(surface));
   }
   active_->set_state(state);

@@ -20,7 +20,10 @@ namespace pointhaptics {
 SurfaceContact probe_surface_contact(const ObjectSurface& surface, const SurfaceContactParams& params, const ToolShape& shape,
                                      const Model& model, const ActiveSet* active) {
   if (!active) return SurfaceContact(model, surface.mesh, surface.map, shape, params);
-  ActiveSurface part = restrict_surface(surface.mesh, surface.map, *active);
+  return probe_surface_contact(restrict_surface(surface.mesh, surface.map, *active), params, shape, model);
+}
+
+SurfaceContact probe_surface_contact(ActiveSurface part, const SurfaceContactParams& params, const ToolShape& shape, const Model& model) {
   SurfaceContact contact(model, part.mesh, std::move(part.map), shape, params);
   contact.set_vertex_ids(std::move(part.vertex_of));
   return contact;

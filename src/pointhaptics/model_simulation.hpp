@@ -7,6 +7,7 @@
 #include <pointhaptics/haptics/held_tool.hpp>
 #include <pointhaptics/haptics/probe_tool.hpp>
 #include <pointhaptics/lod/active_set.hpp>
+#include <pointhaptics/lod/active_surface.hpp>
 #include <pointhaptics/mechanics/cut.hpp>
 #include <pointhaptics/cut_surface.hpp>
 #include <pointhaptics/object_surface.hpp>
@@ -76,6 +77,8 @@ struct ProbeAttachment {
 /// levels of detail (`active`: the active set `model` is) the part of it that the active set carries.
 SurfaceContact probe_surface_contact(const ObjectSurface& surface, const SurfaceContactParams& params, const ToolShape& shape,
                                      const Model& model, const ActiveSet* active);
+/// The same with the part already made (restrict_surface(), on the worker that built the active set).
+SurfaceContact probe_surface_contact(ActiveSurface part, const SurfaceContactParams& params, const ToolShape& shape, const Model& model);
 
 class ModelSimulation {
  public:
