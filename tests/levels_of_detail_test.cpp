@@ -303,7 +303,7 @@ TEST(LevelsOfDetail, AWorkersReselectionGivesTheProbeThePartOfTheSurfaceItsActiv
   ASSERT_FALSE(new_index.empty()) << "the new active set never took over";
   const SurfaceContact* contact = sim.probe()->surface_contact();
   ASSERT_NE(contact, nullptr);
-  const ActiveSurface in_place = restrict_surface(surface->mesh, surface->map, *sim.active_set());
+  const ActiveSurface in_place = restrict_surface(surface->mesh, surface->map, *sim.active_set(), scene.probe.radius);
   ASSERT_GT(in_place.map.n_vertices(), 0);
   EXPECT_EQ(contact->map().n_vertices(), in_place.map.n_vertices());
   EXPECT_EQ(contact->map().points.index, in_place.map.points.index);

@@ -183,11 +183,12 @@ std::vector<index_t> LevelsOfDetail::update(const Vec3& contact, bool onset, boo
   // and, with a probe on the surface, the part of it the new active set carries
   const std::optional<ProbeAttachment>& probe = active_->probe();
   std::shared_ptr<const ObjectSurface> surface = probe && probe->surface ? (probe->split ? probe->split : probe->surface) : nullptr;
+  const double reach = probe ? tool_reach(probe_shape(probe->tool.contact().params())) : 0.0;
   pending_ = std::async(std::launch::async, [&full = full_, params = params_, at = snap(contact), kind = solver_.kind,
-                                             sheets = active_->cut_sheets_.triangles, cuts = object_cuts_made_, surface] {
+                                             sheets = active_->cut_sheets_.triangles, cuts = object_cuts_made_, surface, reach] {
     LodBuild build = build_lod(full, params, at, kind, sheets, cuts);
     if (surface) {
-      build.part = restrict_surface(surface->mesh, surface->map, build.active);
+      build.part = restrict_surface(surface->mesh, surface->map, build.active, reach);
       build.part_of = surface;
     }
     return build;

@@ -20,7 +20,7 @@ namespace pointhaptics {
 SurfaceContact probe_surface_contact(const ObjectSurface& surface, const SurfaceContactParams& params, const ToolShape& shape,
                                      const Model& model, const ActiveSet* active) {
   if (!active) return SurfaceContact(model, surface.mesh, surface.map, shape, params);
-  return probe_surface_contact(restrict_surface(surface.mesh, surface.map, *active), params, shape, model);
+  return probe_surface_contact(restrict_surface(surface.mesh, surface.map, *active, tool_reach(shape)), params, shape, model);
 }
 
 SurfaceContact probe_surface_contact(ActiveSurface part, const SurfaceContactParams& params, const ToolShape& shape, const Model& model) {

@@ -48,17 +48,10 @@ SurfaceContact::SurfaceContact(const Model& model, const TriangleMesh& mesh, Sur
 
 void SurfaceContact::evaluate(const Points& u) { carry_surface(map_, Y_, u, y_); }
 
-namespace {
-
-// a vertex further from the tool's position than this cannot touch it
-double reach(const ToolShape& shape) { return shape.radius + 0.5 * shape.length; }
-
-}  // namespace
-
 double SurfaceContact::energy(const Model&, const Points& u) {
   evaluate(u);
   double e = 0;
-  const double far = reach(shape_);
+  const double far = tool_reach(shape_);
   for (index_t v = 0; v < y_.cols(); ++v) {
     const double lambda = lambda_[static_cast<std::size_t>(v)], k = penalty_[static_cast<std::size_t>(v)];
     if (lambda == 0 && (y_.col(v) - pose_.position).squaredNorm() > far * far) continue;
@@ -103,7 +96,7 @@ Vec3 SurfaceContact::friction_force(index_t v) const {
 template <class Pressing>
 ToolLoad SurfaceContact::for_each_pressing(const Pressing& pressing) const {
   ToolLoad out;
-  const double far = reach(shape_);
+  const double far = tool_reach(shape_);
   for (index_t v = 0; v < y_.cols(); ++v) {
     const double lambda = lambda_[static_cast<std::size_t>(v)], k = penalty_[static_cast<std::size_t>(v)];
     if (lambda == 0 && (y_.col(v) - pose_.position).squaredNorm() > far * far) continue;
@@ -283,7 +276,7 @@ ToolLoad SurfaceContact::load(const Model&, const Points& u, bool same_u) {
 }
 
 ToolLoad SurfaceContact::advance_multipliers(double rate, double max_force) {
-  const double far = reach(shape_);
+  const double far = tool_reach(shape_);
   Vec3 pressing = Vec3::Zero();
   for (index_t v = 0; v < y_.cols(); ++v) {
     double& lambda = lambda_[static_cast<std::size_t>(v)];

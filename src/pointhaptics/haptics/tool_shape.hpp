@@ -19,6 +19,9 @@ struct ToolShape {
   double length = 0;      ///< capsule: its axis segment (the cylinder's length), m, along the tool's local z
 };
 
+/// How far from the tool's position a point can touch it, m: its radius plus half its axis.
+inline double tool_reach(const ToolShape& shape) { return shape.radius + 0.5 * shape.length; }
+
 struct ToolPose {
   Vec3 position = Vec3::Zero();                                     ///< the core's midpoint, m
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  ///< tool to scene axes

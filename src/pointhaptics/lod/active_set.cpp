@@ -246,6 +246,8 @@ ActiveSet build_active_set(const Model& full, const Selection& selection, const 
   if (static_cast<index_t>(selection.band.size()) != full.n_points) throw Error("lod: the selection is for another model");
   ActiveSet a;
   a.active_of.assign(full.n_points, -1);
+  a.centre = selection.centre;
+  a.core_radius = selection.core_radius;
   take_selected(selection, a);
   const std::vector<index_t> absorbed_by = absorb_and_find_ring(full, selection, params, a);
   ActiveCloud cloud = gather_cloud(full, a, absorbed_by);

@@ -29,6 +29,8 @@ struct ActiveSet {
   std::vector<double> followed_weight;  ///< per entry of followed: its weight (a row sums to 1)
   std::vector<Vec3> followed_offset;    ///< per entry of followed: X_j - X_followed
   index_t widened = 0;                ///< selected points whose support was widened
+  Vec3 centre = Vec3::Zero();         ///< the selection's contact point (reference configuration, m)
+  double core_radius = 0;             ///< the selection's T_r2, m
   double build_ms = 0;
 
   /// The active state from the full one (selected and frozen points copy theirs).

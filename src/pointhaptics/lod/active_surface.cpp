@@ -1,15 +1,18 @@
 #include <pointhaptics/lod/active_surface.hpp>
 
 #include <algorithm>
+#include <cmath>
 
 namespace pointhaptics {
 
-ActiveSurface restrict_surface(const TriangleMesh& mesh, const SurfaceMap& map, const ActiveSet& active) {
+ActiveSurface restrict_surface(const TriangleMesh& mesh, const SurfaceMap& map, const ActiveSet& active, double reach) {
   ActiveSurface out;
   const index_t m = map.n_vertices();
+  const double region = 2 * active.core_radius + 2 * reach;
   std::vector<index_t> kept(static_cast<std::size_t>(m), -1);
   for (index_t v = 0; v < m; ++v) {
     if (map.points.row_size(v) == 0) continue;
+    if (std::isfinite(region) && (mesh.V.col(v) - active.centre).norm() > region) continue;
     // the point that carries most of the vertex in the object: simulated, held in the ring, or absorbed by
     // a simulated one (left out, the absorbed points of a thinned band made holes in the part a few
     // millimetres from the contact, through which the probe's centre passed unseen)

@@ -11,6 +11,7 @@
 #include <pointhaptics/lod/active_set.hpp>
 #include <pointhaptics/mechanics/surface_map.hpp>
 
+#include <limits>
 #include <vector>
 
 namespace pointhaptics {
@@ -21,6 +22,11 @@ struct ActiveSurface {
   std::vector<index_t> vertex_of;  ///< kept vertex -> the object surface's vertex
 };
 
-ActiveSurface restrict_surface(const TriangleMesh& mesh, const SurfaceMap& map, const ActiveSet& active);
+/// With a tool's reach (its radius plus half its length, m), only the vertices within 2 T_r2 + 2 reach of the
+/// selection's contact point (reference configuration): the probe stays within half a support of it until the
+/// next selection, and a part of the whole surface (the 100k half-sphere's bands reach the whole object) made
+/// the contact carry every vertex of it at each evaluation, four times the point spheres' step.
+ActiveSurface restrict_surface(const TriangleMesh& mesh, const SurfaceMap& map, const ActiveSet& active,
+                               double reach = std::numeric_limits<double>::infinity());
 
 }  // namespace pointhaptics

@@ -57,6 +57,7 @@ Selection select_points(const Model& model, const Vec3& c, const LodParams& para
   Selection s;
   s.centre = c;
   s.outer_radius = params.levels.empty() ? tr2 : params.levels.back().distance * h;
+  s.core_radius = tr2;
   const std::size_t n_bands = 2 + params.levels.size();
   s.band.assign(model.n_points, -1);
   s.band_count.assign(n_bands, 0);

@@ -25,6 +25,7 @@ struct Selection {
   double milliseconds = 0;                ///< time the selection took
   Vec3 centre = Vec3::Zero();             ///< the contact point it was made around, m
   double outer_radius = 0;                ///< of the last band, m (no point beyond it is in a band)
+  double core_radius = 0;                 ///< T_r2, m: every point within it is simulated or absorbed by one that is
 };
 
 /// Select the points around the contact point c (reference configuration, m) as the seed does: for each
