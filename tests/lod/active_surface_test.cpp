@@ -13,6 +13,23 @@
 namespace pointhaptics {
 namespace {
 
+// The distance from `contact` to the midpoint of the part's nearest open edge (one triangle only), m, and
+// how many open edges lie within `within` of it.
+std::pair<double, int> open_edges_near(const TriangleMesh& mesh, const Vec3& contact, double within) {
+  std::map<std::pair<index_t, index_t>, int> uses;
+  for (const auto& t : mesh.F)
+    for (int k = 0; k < 3; ++k) ++uses[{std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])}];
+  double nearest = 1e9;
+  int near = 0;
+  for (const auto& [edge, n] : uses) {
+    if (n != 1) continue;
+    const double d = (0.5 * (mesh.V.col(edge.first) + mesh.V.col(edge.second)) - contact).norm();
+    nearest = std::min(nearest, d);
+    near += d < within;
+  }
+  return {nearest, near};
+}
+
 TEST(ActiveSurface, ThePartIsWholeAroundTheContactThroughTheThinnedBand) {
   // the shipped half-sphere (4353 points, spacing 4 mm, h = 8 mm): every point within T_r1 = h of the top
   // selected, 80% within T_r2 = 1.5 h. Vertices carried mostly by an absorbed point of that band were left out
@@ -28,20 +45,10 @@ TEST(ActiveSurface, ThePartIsWholeAroundTheContactThroughTheThinnedBand) {
   const ObjectSurface& surface = *s.interactive.surface;
   const ActiveSurface part = restrict_surface(surface.mesh, surface.map, active);
   ASSERT_GT(part.mesh.F.size(), 100u);
-  // the part's open edges (one triangle only) near the contact
-  std::map<std::pair<index_t, index_t>, int> uses;
-  for (const auto& t : part.mesh.F)
-    for (int k = 0; k < 3; ++k) ++uses[{std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])}];
+  // the part's open edges near the contact
   const Vec3 contact = sim.lod_selection()->centre;
   const double within = 1.5 * sim.model().h;  // T_r2
-  int open_near = 0;
-  double nearest_open = 1e9;
-  for (const auto& [edge, n] : uses) {
-    if (n != 1) continue;
-    const double d = (0.5 * (part.mesh.V.col(edge.first) + part.mesh.V.col(edge.second)) - contact).norm();
-    nearest_open = std::min(nearest_open, d);
-    open_near += d < within;
-  }
+  const auto [nearest_open, open_near] = open_edges_near(part.mesh, contact, within);
   std::printf("the part: %zu triangles; its nearest open edge %.1f mm from the contact (T_r2 = %.1f mm)\n", part.mesh.F.size(),
               1e3 * nearest_open, 1e3 * within);
   EXPECT_EQ(open_near, 0);
@@ -49,14 +56,9 @@ TEST(ActiveSurface, ThePartIsWholeAroundTheContactThroughTheThinnedBand) {
   // smaller (a part of the whole surface made the 100k half-sphere's step four times the point spheres')
   const double reach = s.scene.probe.radius;
   const ActiveSurface near = restrict_surface(surface.mesh, surface.map, active, reach);
-  double farthest = 0, nearest_open_near = 1e9;
+  double farthest = 0;
   for (Eigen::Index v = 0; v < near.mesh.V.cols(); ++v) farthest = std::max(farthest, (near.mesh.V.col(v) - contact).norm());
-  std::map<std::pair<index_t, index_t>, int> near_uses;
-  for (const auto& t : near.mesh.F)
-    for (int k = 0; k < 3; ++k) ++near_uses[{std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])}];
-  for (const auto& [edge, n] : near_uses)
-    if (n == 1)
-      nearest_open_near = std::min(nearest_open_near, (0.5 * (near.mesh.V.col(edge.first) + near.mesh.V.col(edge.second)) - contact).norm());
+  const double nearest_open_near = open_edges_near(near.mesh, contact, within).first;
   std::printf("kept to the contact's region: %zu triangles, the farthest vertex %.1f mm away, the nearest open edge %.1f mm\n",
               near.mesh.F.size(), 1e3 * farthest, 1e3 * nearest_open_near);
   EXPECT_LE(farthest, 2 * active.core_radius + 2 * reach + 1e-12);

@@ -76,23 +76,24 @@ std::vector<index_t> absorb_and_find_ring(const Model& full, const Selection& se
       // between neighbours that follow different points, and with their gradients told apart by the
       // dynamics a neighbourhood of followers could come out inverted, to start inverted when a later
       // selection simulates it)
+      const auto follow = [&](index_t k, double w) {
+        a.followed.index.push_back(k);
+        a.followed_weight.push_back(w);
+        a.followed_offset.push_back(full.X.col(j) - selected_X.col(k));
+      };
       const double r_last = std::sqrt(nearest_d2[at + found[j] - 1]);
       double sum = 0;
       const std::size_t first = a.followed_weight.size();
       for (std::size_t q = 0; q < found[j]; ++q) {
         const double w = r_last > 0 ? std::pow(1 - std::sqrt(nearest_d2[at + q]) / r_last, 2) : 0.0;
         if (w <= 0) continue;
-        a.followed.index.push_back(nearest_of[at + q]);
-        a.followed_weight.push_back(w);
-        a.followed_offset.push_back(full.X.col(j) - selected_X.col(nearest_of[at + q]));
+        follow(nearest_of[at + q], w);
         sum += w;
       }
       if (sum > 0) {
         for (std::size_t e = first; e < a.followed_weight.size(); ++e) a.followed_weight[e] /= sum;
       } else {  // as far from each: the nearest alone
-        a.followed.index.push_back(nearest_of[at]);
-        a.followed_weight.push_back(1.0);
-        a.followed_offset.push_back(full.X.col(j) - selected_X.col(nearest_of[at]));
+        follow(nearest_of[at], 1.0);
       }
     } else if (found[j] > 0 && nearest_d2[at] < reach * reach) {
       a.active_of[j] = static_cast<index_t>(a.full_of.size());  // a ring candidate
