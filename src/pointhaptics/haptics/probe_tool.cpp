@@ -3,6 +3,7 @@
 #include <pointhaptics/haptics/coupling.hpp>
 
 #include <algorithm>
+#include <optional>
 
 namespace pointhaptics {
 
@@ -77,16 +78,33 @@ double ProbeTool::penetration_at(const Model& model, const State& state, const V
   return surface_->load(model, state.u, true).penetration;
 }
 
-Vec3 ProbeTool::stop_at_surface(const Model& model, const State& state, const Vec3& from, Vec3 to) {
+Vec3 ProbeTool::stop_at_surface(const Model& model, const State& state, const Vec3& from, const Vec3& to) {
+  // on the surface the probe moves at most a quarter radius per iteration (2 radii a step, far above a
+  // hand's speed): its local model knows only the vertices it touches where it is, and a longer jump could
+  // pass the surface and push it out from within
+  const double longest = 0.25 * contact_.params().radius;
+  const auto limited = [&](const Vec3& move) { return move.norm() > longest ? Vec3(move * (longest / move.norm())) : move; };
   const double allowed = std::max(allowed_penetration * contact_.params().radius, penetration_at(model, state, from));
   // penetration_at() carries the surface to the state: enters() sees it as the step found it
   const auto refused = [&](const Vec3& p) { return penetration_at(model, state, p) > allowed || surface_->enters(from, p); };
   // each try once (a try costs a pass over the surface's vertices and one over its triangles)
-  for (int halving = 0;; ++halving) {
-    if (!refused(to)) return to;
-    if (halving == 6) return from;
-    to = from + 0.5 * (to - from);
-  }
+  const auto furthest = [&](const Vec3& move) -> std::optional<Vec3> {
+    Vec3 target = from + limited(move);
+    for (int halving = 0; halving <= 6; ++halving, target = from + 0.5 * (target - from))
+      if (!refused(target)) return target;
+    return std::nullopt;
+  };
+  if (const std::optional<Vec3> moved = furthest(to - from)) return *moved;
+  // refused all the way: the move's part along the contact, as a god-object slides on its constraint. With a
+  // vertex deeper than allowed (a surface coarser than the probe: the soft dome's 4 mm points under a 6 mm
+  // probe leave one 1.6-1.9 mm inside), every move with a part into the surface deepens it, and the probe was
+  // held where it stood while the hand went 18 mm aside. The plane is the contact force's, not the deepest
+  // vertex's: sliding on that one let the probe dig in, a vertex 4-5 mm inside (of 6) as it slid.
+  const Vec3 pushed = surface_model(model, state, from, true).f0;  // on the tool, out of the object
+  if (!(pushed.norm() > 0)) return from;
+  const Vec3 normal = pushed.normalized();
+  const Vec3 along = (to - from) - (to - from).dot(normal) * normal;
+  return furthest(along).value_or(from);
 }
 
 Vec3 ProbeTool::back_on_surface(const Vec3& p) const {
@@ -129,8 +147,6 @@ void ProbeTool::place(const Model& model, const State& state, const Vec3& device
     // on the surface the probe moves at most a quarter radius per iteration (2 radii a step, far above a
     // hand's speed): its local model knows only the vertices it touches where it is, and a longer jump could
     // pass the surface and push it out from within
-    const double longest = 0.25 * contact_.params().radius;
-    if (pushing_surface() && (next - p).norm() > longest) next = p + (next - p) * (longest / (next - p).norm());
     if (pushing_surface()) next = stop_at_surface(model, state, p, next);
     const bool settled = (next - p).norm() < 1e-9 + 1e-6 * contact_.params().radius;
     p = next;
@@ -138,6 +154,7 @@ void ProbeTool::place(const Model& model, const State& state, const Vec3& device
   }
   probe_ = p;
   if (surface_) surface_->set_pose(ToolPose{p, surface_->pose().orientation});
+
 }
 
 void ProbeTool::add(const Model& model, const State& state, Points& f) {

@@ -72,6 +72,8 @@ class ProbeTool final : public DynamicForces {
   void remap(const Model& model, const std::vector<index_t>& new_index, std::optional<SurfaceContact> surface);
 
   const Vec3& probe() const { return probe_; }
+  /// Where the device put the hand at the last placement (the probe's goal), m.
+  const Vec3& device() const { return device_; }
   /// The local contact model of the last force evaluation, for the haptic side.
   const ContactModel& contact_model() const { return last_; }
   /// Its stiffness against the held object (the contact's own, before the object's compliance is taken in).
@@ -87,10 +89,11 @@ class ProbeTool final : public DynamicForces {
   bool pushing_surface() const;
   /// The deepest surface vertex inside the probe at p, the surface as the step found it (evaluated already).
   double penetration_at(const Model& model, const State& state, const Vec3& p);
-  /// The god-object's rule: the probe's move from `from` toward `to`, halved until no surface vertex is deeper
-  /// inside it than allowed_penetration x radius (or than at `from`, if deeper there) and its centre's path
-  /// does not enter the surface (SurfaceContact::enters()), or no move at all.
-  Vec3 stop_at_surface(const Model& model, const State& state, const Vec3& from, Vec3 to);
+  /// The god-object's rule: the probe's move from `from` toward `to` (at most a quarter radius), halved until
+  /// no surface vertex is deeper inside it than allowed_penetration x radius (or than at `from`, if deeper
+  /// there) and its centre's path does not enter the surface (SurfaceContact::enters()); if every halving is
+  /// refused, the same with the move's part across the contact's force (a slide along the surface), or no move.
+  Vec3 stop_at_surface(const Model& model, const State& state, const Vec3& from, const Vec3& to);
   /// p, or the nearest point of the surface (as the step found it) if p is inside it: a soft, coarse object
   /// pressed hard can flow over the probe's centre within a step, its vertices passing the probe's sides and a
   /// triangle its centre, and a probe left inside sank through the object (scenes/half_sphere_lod.toml
