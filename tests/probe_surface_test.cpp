@@ -311,11 +311,7 @@ TEST(ProbeOnSurface, WithFrictionTheProbeRestsWhereTheHandPushesInsideTheConeAnd
   EXPECT_NEAR(slides.sliding_ratio, mu, 0.05 * mu);
 }
 
-// The soft, coarse dome of scenes/half_sphere_lod.toml without [lod] (E = 1e4 Pa, spacing 4 mm, a 6 mm probe:
-// 1.5 spacings per radius) pressed 8 mm and slid 2 cm aside. The surface, pushed apart by the probe, flowed
-// over its centre within a step at 1.7 s, and the probe, inside with no vertex in it, sank through and stayed
-// under the dome (5.5 mm inside at the end). Now it is put back on the surface: its centre ends outside, and
-// is found inside at the end of a step only as the surface flows over it (then put back at the next).
+// What the probe did on the soft dome (the test below), step by step.
 struct DomeRun {
   long long steps = 0, inside = 0;  // steps, and those at whose end the probe's centre is inside the surface
   double deepest = 0;               // the probe's centre's furthest inside the surface at a step's end, m
@@ -324,9 +320,9 @@ struct DomeRun {
   Vec3 probe = Vec3::Constant(NAN);  // at the end
 };
 
-DomeRun press_and_slide_on_the_soft_dome(bool levels_of_detail) {
+DomeRun press_and_slide_on_the_soft_dome() {
   Scene scene = read_scene_file(PH_SCENES "/half_sphere_lod.toml");
-  if (!levels_of_detail) scene.lod = LodSpec{};
+  scene.lod = LodSpec{};
   SessionOptions options;
   options.threads = 1;
   SceneSession session = open_scene(std::move(scene), options);
@@ -348,9 +344,9 @@ DomeRun press_and_slide_on_the_soft_dome(bool levels_of_detail) {
   };
   run_interactive(sim, *session.device, o);
   EXPECT_FALSE(sim.diagnostics().failed) << sim.diagnostics().failure;
-  std::printf("soft dome%s: the probe's centre inside the surface at %lld of %lld steps' ends, at most %.2f mm; ends at (%.1f, %.1f, %.1f) mm; "
+  std::printf("soft dome: the probe's centre inside the surface at %lld of %lld steps' ends, at most %.2f mm; ends at (%.1f, %.1f, %.1f) mm; "
               "at most %.1f mm behind the hand as it slides\n",
-              levels_of_detail ? " (levels of detail)" : "", run.inside, run.steps, -1e3 * run.deepest, 1e3 * run.probe.x(),
+              run.inside, run.steps, -1e3 * run.deepest, 1e3 * run.probe.x(),
               1e3 * run.probe.y(), 1e3 * run.probe.z(), 1e3 * run.behind);
   return run;
 }
@@ -361,7 +357,7 @@ DomeRun press_and_slide_on_the_soft_dome(bool levels_of_detail) {
 // under the dome (5.5 mm inside at the end). Now it is put back on the surface: its centre ends outside, and
 // is found inside at the end of a step only as the surface flows over it (then put back at the next).
 TEST(ProbeOnSurface, OnASoftCoarseDomeTheProbeStaysOnTheSurfaceAsTheHandSlidesAside) {
-  const DomeRun run = press_and_slide_on_the_soft_dome(false);
+  const DomeRun run = press_and_slide_on_the_soft_dome();
   EXPECT_EQ(run.steps, 2000);
   EXPECT_LT(run.inside, run.steps / 20);  // 78 (294 before)
   EXPECT_GT(run.deepest, -0.5 * run.radius);  // 2.0 mm (6.1 mm before)

@@ -148,9 +148,6 @@ void ProbeTool::place(const Model& model, const State& state, const Vec3& device
     const ContactModel local = pushing_surface() ? surface_model(model, state, p, true)
                                                  : contact_.apply(model, state.u, p, button, state.time, scratch_, it > 0);
     Vec3 next = coupled_probe(local, device, k_, max_force_);
-    // on the surface the probe moves at most a quarter radius per iteration (2 radii a step, far above a
-    // hand's speed): its local model knows only the vertices it touches where it is, and a longer jump could
-    // pass the surface and push it out from within
     if (pushing_surface()) next = stop_at_surface(model, state, p, next);
     const bool settled = (next - p).norm() < 1e-9 + 1e-6 * contact_.params().radius;
     p = next;
@@ -158,7 +155,6 @@ void ProbeTool::place(const Model& model, const State& state, const Vec3& device
   }
   probe_ = p;
   if (surface_) surface_->set_pose(ToolPose{p, surface_->pose().orientation});
-
 }
 
 void ProbeTool::add(const Model& model, const State& state, Points& f) {

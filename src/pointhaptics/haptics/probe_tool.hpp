@@ -92,7 +92,8 @@ class ProbeTool final : public DynamicForces {
   /// The god-object's rule: the probe's move from `from` toward `to` (at most a quarter radius), halved until
   /// no surface vertex is deeper inside it than allowed_penetration x radius (or than at `from`, if deeper
   /// there) and its centre's path does not enter the surface (SurfaceContact::enters()); if every halving is
-  /// refused, the same with the move's part across the contact's force (a slide along the surface), or no move.
+  /// refused and the move goes mostly along the surface, the same with its part across the contact's force
+  /// (a slide along the surface); else no move.
   Vec3 stop_at_surface(const Model& model, const State& state, const Vec3& from, const Vec3& to);
   /// p, or the nearest point of the surface (as the step found it) if p is inside it: a soft, coarse object
   /// pressed hard can flow over the probe's centre within a step, its vertices passing the probe's sides and a
