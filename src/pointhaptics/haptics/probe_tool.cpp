@@ -73,9 +73,9 @@ ContactModel ProbeTool::surface_model(const Model& model, const State& state, co
   return contact_model_of(surface_->load(model, state.u, same_u), state.time, p);
 }
 
-double ProbeTool::penetration_at(const Model& model, const State& state, const Vec3& p) {
+ToolLoad ProbeTool::load_at(const Model& model, const State& state, const Vec3& p) {
   surface_->set_pose(ToolPose{p, surface_->pose().orientation});
-  return surface_->load(model, state.u, true).penetration;
+  return surface_->load(model, state.u, true);
 }
 
 Vec3 ProbeTool::stop_at_surface(const Model& model, const State& state, const Vec3& from, const Vec3& to) {
@@ -84,9 +84,10 @@ Vec3 ProbeTool::stop_at_surface(const Model& model, const State& state, const Ve
   // pass the surface and push it out from within
   const double longest = 0.25 * contact_.params().radius;
   const auto limited = [&](const Vec3& move) { return move.norm() > longest ? Vec3(move * (longest / move.norm())) : move; };
-  const double allowed = std::max(allowed_penetration * contact_.params().radius, penetration_at(model, state, from));
-  // penetration_at() carries the surface to the state: enters() sees it as the step found it
-  const auto refused = [&](const Vec3& p) { return penetration_at(model, state, p) > allowed || surface_->enters(from, p); };
+  // load_at() carries the surface to the state: enters() sees it as the step found it
+  const ToolLoad here = load_at(model, state, from);
+  const double allowed = std::max(allowed_penetration * contact_.params().radius, here.penetration);
+  const auto refused = [&](const Vec3& p) { return load_at(model, state, p).penetration > allowed || surface_->enters(from, p); };
   // each try once (a try costs a pass over the surface's vertices and one over its triangles)
   const auto furthest = [&](const Vec3& move) -> std::optional<Vec3> {
     Vec3 target = from + limited(move);
@@ -100,9 +101,8 @@ Vec3 ProbeTool::stop_at_surface(const Model& model, const State& state, const Ve
   // probe leave one 1.6-1.9 mm inside), every move with a part into the surface deepens it, and the probe was
   // held where it stood while the hand went 18 mm aside. The plane is the contact force's, not the deepest
   // vertex's: sliding on that one let the probe dig in, a vertex 4-5 mm inside (of 6) as it slid.
-  const Vec3 pushed = surface_model(model, state, from, true).f0;  // on the tool, out of the object
-  if (!(pushed.norm() > 0)) return from;
-  const Vec3 normal = pushed.normalized();
+  if (!(here.force.norm() > 0)) return from;
+  const Vec3 normal = here.force.normalized();  // the force on the tool, out of the object
   const Vec3 along = (to - from) - (to - from).dot(normal) * normal;
   // only a hand going mostly along the surface: pressed straight into it, the force's plane tilts as the
   // surface rings, and sliding on it let the probe wander (1.9 mm off the soft dome's apex in 0.6 s with

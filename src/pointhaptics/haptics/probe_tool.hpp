@@ -87,8 +87,9 @@ class ProbeTool final : public DynamicForces {
 
  private:
   bool pushing_surface() const;
-  /// The deepest surface vertex inside the probe at p, the surface as the step found it (evaluated already).
-  double penetration_at(const Model& model, const State& state, const Vec3& p);
+  /// The surface contact's load on the probe at p (its deepest vertex inside, its force), the surface as the
+  /// step found it (evaluated already).
+  ToolLoad load_at(const Model& model, const State& state, const Vec3& p);
   /// The god-object's rule: the probe's move from `from` toward `to` (at most a quarter radius), halved until
   /// no surface vertex is deeper inside it than allowed_penetration x radius (or than at `from`, if deeper
   /// there) and its centre's path does not enter the surface (SurfaceContact::enters()); if every halving is
