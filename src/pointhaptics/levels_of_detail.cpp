@@ -245,7 +245,7 @@ std::vector<index_t> LevelsOfDetail::take_over(LodBuild build, bool built_here) 
     const std::shared_ptr<const ObjectSurface>& current = probe.split ? probe.split : probe.surface;
     const ToolShape shape = probe_shape(probe.tool.contact().params());
     if (current && build.part && build.part_of == current)  // made by the worker (a cut split none since)
-      surface.emplace(probe_surface_contact(std::move(*build.part), probe.contact, shape, active_->model()));
+      surface.emplace(probe_surface_contact(std::move(*build.part), probe.contact, shape, active_->model(), next));
     else if (current)
       surface.emplace(probe_surface_contact(*current, probe.contact, shape, active_->model(), &next));
     probe.tool.remap(active_->model(), new_index, std::move(surface));

@@ -20,12 +20,27 @@ namespace pointhaptics {
 SurfaceContact probe_surface_contact(const ObjectSurface& surface, const SurfaceContactParams& params, const ToolShape& shape,
                                      const Model& model, const ActiveSet* active) {
   if (!active) return SurfaceContact(model, surface.mesh, surface.map, shape, params);
-  return probe_surface_contact(restrict_surface(surface.mesh, surface.map, *active, tool_reach(shape)), params, shape, model);
+  return probe_surface_contact(restrict_surface(surface.mesh, surface.map, *active, tool_reach(shape)), params, shape, model, *active);
 }
 
-SurfaceContact probe_surface_contact(ActiveSurface part, const SurfaceContactParams& params, const ToolShape& shape, const Model& model) {
-  SurfaceContact contact(model, part.mesh, std::move(part.map), shape, params);
+SurfaceContact probe_surface_contact(ActiveSurface part, const SurfaceContactParams& params, const ToolShape& shape, const Model& model,
+                                     const ActiveSet& active) {
+  // with the whole surface's stiffness per point, lowered below per point rather than uniformly: a thinned
+  // band's point carries the vertices of the points it absorbed, and lowering the whole part until it met the cap
+  // made the contact at the probe 12x softer than the whole surface's (the probe sank in and was held)
+  SurfaceContactParams own = params;
+  if (params.object_point_stiffness) own.max_point_stiffness = 0;
+  SurfaceContact contact(model, part.mesh, std::move(part.map), shape, own);
   contact.set_vertex_ids(std::move(part.vertex_of));
+  if (params.object_point_stiffness) {
+    const std::vector<double>& whole = *params.object_point_stiffness;
+    std::vector<double> limit(static_cast<std::size_t>(model.n_points), params.max_point_stiffness);
+    for (std::size_t j = 0; j < limit.size() && j < active.full_of.size(); ++j) {
+      const auto object = static_cast<std::size_t>(active.full_of[j]);
+      if (object < whole.size()) limit[j] = whole[object];
+    }
+    contact.limit_point_stiffness(limit, params.max_point_stiffness);
+  }
   return contact;
 }
 

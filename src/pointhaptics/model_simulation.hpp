@@ -78,7 +78,8 @@ struct ProbeAttachment {
 SurfaceContact probe_surface_contact(const ObjectSurface& surface, const SurfaceContactParams& params, const ToolShape& shape,
                                      const Model& model, const ActiveSet* active);
 /// The same with the part already made (restrict_surface(), on the worker that built the active set).
-SurfaceContact probe_surface_contact(ActiveSurface part, const SurfaceContactParams& params, const ToolShape& shape, const Model& model);
+SurfaceContact probe_surface_contact(ActiveSurface part, const SurfaceContactParams& params, const ToolShape& shape, const Model& model,
+                                     const ActiveSet& active);
 
 class ModelSimulation {
  public:

@@ -129,6 +129,12 @@ void Simulation::attach_probe(const ProbeParams& params, double coupling_stiffne
   // friction then measured 0.288 of the pressure for mu = 0.3 (0.286 with a hundredth, where new contacts
   // stuck for tens of steps; the full penalty made explicit steps chatter: 0.217)
   contact.tangential_share = 0.1;
+  if (surface && lod_) {
+    // every active set's part of the surface presses as the whole surface does on the object's points
+    const SurfaceContact whole(lod_->object_model(), surface->mesh, surface->map, probe_shape(params), contact);
+    contact.penalty = whole.per_area_penalty();
+    contact.object_point_stiffness = std::make_shared<const std::vector<double>>(whole.point_stiffness(lod_->object_model().n_points));
+  }
   std::optional<SurfaceContact> on_surface;
   if (surface)
     on_surface.emplace(probe_surface_contact(*surface, contact, probe_shape(params), sim.model(), lod_ ? &lod_->active_set() : nullptr));

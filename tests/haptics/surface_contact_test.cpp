@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 namespace pointhaptics {
@@ -112,6 +113,48 @@ TEST(SurfaceContact, ForcesAreTheEnergyGradientAndTheTangentTheirDerivative) {
       EXPECT_GT(load.contacts, 0);
     }
   }
+}
+
+// limit_point_stiffness (a level of detail's part of the surface pressing as the whole one does): every point
+// ends at most at max(its limit, the cap), no point softer than the uniform lowering to the cap left it, and a
+// vertex whose points are all within their limits keeps its penalty.
+TEST(SurfaceContact, PointStiffnessLimitsLowerOnlyTheVerticesOfPointsBeyondThem) {
+  const Block b = block();
+  const SurfaceMap map = build_surface_map(b.model, b.surface.V);
+  SurfaceContact contact(b.model, b.surface, map, tools()[0].shape, SurfaceContactParams{});
+  const std::vector<double> before = contact.point_stiffness(b.model.n_points);
+  const double stiffest = *std::max_element(before.begin(), before.end());
+  ASSERT_GT(stiffest, 0);
+  // every third point limited to a fifth of its stiffness, the others not at all
+  std::vector<double> limit(before.size());
+  for (std::size_t j = 0; j < limit.size(); ++j) limit[j] = j % 3 == 0 ? before[j] / 5 : 10 * stiffest;
+  const double cap = stiffest / 2, uniform = cap / stiffest;
+  contact.limit_point_stiffness(limit, cap);
+  const std::vector<double> after = contact.point_stiffness(b.model.n_points);
+  int lowered = 0, kept = 0;
+  for (std::size_t j = 0; j < after.size(); ++j) {
+    EXPECT_LE(after[j], std::max(limit[j], cap) * (1 + 1e-12)) << j;
+    EXPECT_GE(after[j], uniform * before[j] * (1 - 1e-12)) << j;
+    if (after[j] < before[j] * (1 - 1e-9)) ++lowered;
+  }
+  // a point none of whose vertices has a limited point keeps its stiffness
+  for (index_t j = 0; j < b.model.n_points; ++j) {
+    bool free = before[static_cast<std::size_t>(j)] > 0;
+    for (index_t v = 0; v < map.n_vertices() && free; ++v) {
+      bool carries_j = false, carries_limited = false;
+      for (index_t e = map.points.begin(v); e < map.points.end(v); ++e) {
+        carries_j = carries_j || (map.points.index[e] == j && map.weight[e] != 0);
+        carries_limited = carries_limited || (map.points.index[e] % 3 == 0 && map.weight[e] != 0);
+      }
+      free = !(carries_j && carries_limited);
+    }
+    if (!free) continue;
+    ++kept;
+    EXPECT_DOUBLE_EQ(after[static_cast<std::size_t>(j)], before[static_cast<std::size_t>(j)]) << j;
+  }
+  EXPECT_GT(lowered, 0);
+  EXPECT_GT(kept, 0);
+  EXPECT_LE(contact.max_point_stiffness(), *std::max_element(after.begin(), after.end()) * (1 + 1e-12));
 }
 
 TEST(SurfaceContact, CapsuleTorqueIsTheMomentOfItsForces) {

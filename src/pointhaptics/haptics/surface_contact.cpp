@@ -33,17 +33,43 @@ SurfaceContact::SurfaceContact(const Model& model, const TriangleMesh& mesh, Sur
   tangential_share_ = params.tangential_share;
   if (friction_ > 0) anchors_.assign(area.size(), Anchor{});
   tolerance_ = params.tolerance > 0 ? params.tolerance : 1e-4 * shape.radius;
+  per_area_penalty_ = per_area;
   // the explicit stable step's bound: a point's contact stiffness is at most sum_v k_v w_vj^2
-  std::vector<double> stiffness(static_cast<std::size_t>(model.n_points), 0.0);
-  for (index_t v = 0; v < m; ++v)
-    for (index_t e = map_.points.begin(v); e < map_.points.end(v); ++e)
-      stiffness[static_cast<std::size_t>(map_.points.index[e])] += penalty_[static_cast<std::size_t>(v)] * map_.weight[e] * map_.weight[e];
+  const std::vector<double> stiffness = point_stiffness(model.n_points);
   max_point_stiffness_ = stiffness.empty() ? 0.0 : *std::max_element(stiffness.begin(), stiffness.end());
   if (params.max_point_stiffness > 0 && max_point_stiffness_ > params.max_point_stiffness) {
     const double scale = params.max_point_stiffness / max_point_stiffness_;
     for (double& k : penalty_) k *= scale;
+    per_area_penalty_ *= scale;
     max_point_stiffness_ = params.max_point_stiffness;
   }
+}
+
+std::vector<double> SurfaceContact::point_stiffness(index_t n_points) const {
+  std::vector<double> stiffness(static_cast<std::size_t>(n_points), 0.0);
+  for (index_t v = 0; v < map_.n_vertices(); ++v)
+    for (index_t e = map_.points.begin(v); e < map_.points.end(v); ++e)
+      stiffness[static_cast<std::size_t>(map_.points.index[e])] += penalty_[static_cast<std::size_t>(v)] * map_.weight[e] * map_.weight[e];
+  return stiffness;
+}
+
+void SurfaceContact::limit_point_stiffness(std::span<const double> limit, double cap) {
+  const std::vector<double> stiffness = point_stiffness(static_cast<index_t>(limit.size()));
+  const double stiffest = stiffness.empty() ? 0.0 : *std::max_element(stiffness.begin(), stiffness.end());
+  // the uniform scale that brings the stiffest point to the cap: no vertex is lowered further, so no part of
+  // the surface is softer than a uniformly lowered penalty made it
+  const double uniform = stiffest > cap ? cap / stiffest : 1.0;
+  for (index_t v = 0; v < map_.n_vertices(); ++v) {
+    double scale = 1.0;
+    for (index_t e = map_.points.begin(v); e < map_.points.end(v); ++e) {
+      const auto j = static_cast<std::size_t>(map_.points.index[e]);
+      if (map_.weight[e] != 0 && stiffness[j] > limit[j]) scale = std::min(scale, limit[j] / stiffness[j]);
+    }
+    penalty_[static_cast<std::size_t>(v)] *= std::max(scale, uniform);
+  }
+  // each point now presses at most max(limit_j, uniform x its stiffness) <= max(limit_j, cap)
+  const std::vector<double> lowered = point_stiffness(static_cast<index_t>(limit.size()));
+  max_point_stiffness_ = lowered.empty() ? 0.0 : *std::max_element(lowered.begin(), lowered.end());
 }
 
 void SurfaceContact::evaluate(const Points& u) { carry_surface(map_, Y_, u, y_); }

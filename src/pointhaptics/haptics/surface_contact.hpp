@@ -25,7 +25,9 @@
 #include <pointhaptics/solvers/newton.hpp>
 
 #include <array>
+#include <memory>
 #include <optional>
+#include <span>
 #include <vector>
 
 namespace pointhaptics {
@@ -51,6 +53,11 @@ struct SurfaceContactParams {
   /// sticking for tens of steps while its force grew to the cone (friction 5% short of mu x pressure on a
   /// slide); a device's probe uses a tenth.
   double tangential_share = 0.01;
+  /// With levels of detail: each object point's contact stiffness with the whole surface (N/m,
+  /// SurfaceContact::point_stiffness()), and `penalty` the whole surface's. A part of the surface an active set
+  /// carries (probe_surface_contact()) then presses as the whole one does, lowered only at the vertices of a
+  /// point that would press stiffer than it does on the whole surface (limit_point_stiffness()).
+  std::shared_ptr<const std::vector<double>> object_point_stiffness;
 };
 
 /// What the object does to the tool.
@@ -122,6 +129,14 @@ class SurfaceContact final : public EnergyTerm {
   /// diagonal of its stiffness on the points (an estimate, not a strict bound: the largest eigenvalue is above
   /// it where a vertex is carried by several points).
   double max_point_stiffness() const { return max_point_stiffness_; }
+  /// N/m^3: the penalty per unit area the vertices took (params.penalty or its default, lowered to the cap).
+  double per_area_penalty() const { return per_area_penalty_; }
+  /// Each point's contact stiffness sum_v k_v w_vj^2 (N/m, per point of a model of n_points).
+  std::vector<double> point_stiffness(index_t n_points) const;
+  /// Lowers each vertex's penalty by the largest excess of its points' stiffness over `limit` (N/m per point
+  /// of the model), but never below the uniform scale that brings the stiffest point to `cap`: every point then
+  /// presses at most max(limit_j, cap), and no vertex softer than a uniform lowering would make it.
+  void limit_point_stiffness(std::span<const double> limit, double cap);
   /// The deformed vertices of the last evaluation.
   const Points& vertices() const { return y_; }
   /// Whether the segment from-to enters the surface as the last evaluation carried it: crosses a triangle
@@ -178,7 +193,7 @@ class SurfaceContact final : public EnergyTerm {
   std::vector<Active> active_;            // at the last linearise()
   std::vector<index_t> ids_;              // the object surface's vertex of each vertex (empty: the same)
   ToolLoad last_load_;
-  double tolerance_ = 0, max_point_stiffness_ = 0, friction_ = 0, tangential_share_ = 0.01;
+  double tolerance_ = 0, max_point_stiffness_ = 0, per_area_penalty_ = 0, friction_ = 0, tangential_share_ = 0.01;
   bool posed_ = false;
 };
 
