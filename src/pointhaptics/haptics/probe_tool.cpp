@@ -122,6 +122,7 @@ Vec3 ProbeTool::back_on_surface(const Vec3& p) const {
 void ProbeTool::place(const Model& model, const State& state, const Vec3& device, bool button, const Eigen::Quaterniond& orientation) {
   device_ = device;
   button_ = button;
+  step_start_ = state.time;
   orientation_ = (orientation * contact_.params().orientation).normalized();
   if (surface_) surface_->set_pose(ToolPose{surface_->pose().position, orientation_});
   contacts_before_ = last_.contacts;
@@ -185,7 +186,9 @@ void ProbeTool::after_step(const Model& model, const State& state, Workspace& ws
   // steps), so that over a few steps the surface comes to touch the probe and the force is the material's;
   // never pressing harder together than the coupling does (the probe's balance at the step's start)
   const double pressing = std::min(max_force_, k_ * (device_ - probe_).norm());
-  last_ = contact_model_of(surface_->advance_multipliers(multiplier_rate, pressing), state.time, probe_);
+  const double step = state.time - step_start_;
+  const double rate = step > 0 ? multiplier_rate * std::min(1.0, step / multiplier_rate_step) : multiplier_rate;
+  last_ = contact_model_of(surface_->advance_multipliers(rate, pressing), state.time, probe_);
   surface_->pressing_points(surface_touched_);
   held_K_ = last_.K;
   if (!contact_.params().object_stiffness) return;

@@ -117,6 +117,11 @@ class ProbeTool final : public DynamicForces {
   /// (tests/deep_compression_test.cpp), a half keeps it stable and on a slow press leaves 0.16% of the
   /// depth inside the surface and the force at 0.999 of the material's (tests/probe_surface_test.cpp).
   static constexpr double multiplier_rate = 0.5;
+  /// The step multiplier_rate is for, s: a shorter step takes a proportional share, so that the multipliers
+  /// build at the same rate per second whatever the step (an update is an integral action on the penetration:
+  /// at the same share per step, the 100k half-sphere's 0.1 ms steps built them ten times faster than 1 ms
+  /// steps, and its explicit run diverged at 0.47 s; at the share per millisecond at 2.2 s, docs/haptics.md).
+  static constexpr double multiplier_rate_step = 1e-3;
   /// How deep a surface vertex may be inside the probe when it is placed, over its radius. Without a bound, a
   /// hand pushing fast into a soft, coarse dome (scenes/half_sphere_lod.toml: E = 1e4 Pa, spacing 4 mm, a 6 mm
   /// probe) took the probe past the surface's vertices faster than the multipliers could build (their
@@ -134,6 +139,7 @@ class ProbeTool final : public DynamicForces {
   std::vector<std::array<double, 2>> cut_history_;  ///< per step of this cut: the edge's travel, m, and the new area, m^2
   double k_, max_force_;
   Vec3 device_ = Vec3::Constant(NAN);
+  double step_start_ = 0;  // the time at which the step being taken began (place())
   Vec3 probe_ = Vec3::Constant(NAN);
   bool button_ = false;
   int contacts_before_ = 0;
