@@ -10,6 +10,10 @@
 
 namespace pointhaptics {
 
+namespace {
+double largest(const std::vector<double>& x) { return x.empty() ? 0.0 : *std::max_element(x.begin(), x.end()); }
+}  // namespace
+
 SurfaceContact::SurfaceContact(const Model& model, const TriangleMesh& mesh, SurfaceMap map, const ToolShape& shape,
                                const SurfaceContactParams& params)
     : Y_(mesh.V), y_(mesh.V), triangles_(mesh.F), map_(std::move(map)), shape_(shape) {
@@ -35,8 +39,7 @@ SurfaceContact::SurfaceContact(const Model& model, const TriangleMesh& mesh, Sur
   tolerance_ = params.tolerance > 0 ? params.tolerance : 1e-4 * shape.radius;
   per_area_penalty_ = per_area;
   // the explicit stable step's bound: a point's contact stiffness is at most sum_v k_v w_vj^2
-  const std::vector<double> stiffness = point_stiffness(model.n_points);
-  max_point_stiffness_ = stiffness.empty() ? 0.0 : *std::max_element(stiffness.begin(), stiffness.end());
+  max_point_stiffness_ = largest(point_stiffness(model.n_points));
   if (params.max_point_stiffness > 0 && max_point_stiffness_ > params.max_point_stiffness) {
     const double scale = params.max_point_stiffness / max_point_stiffness_;
     for (double& k : penalty_) k *= scale;
@@ -55,10 +58,10 @@ std::vector<double> SurfaceContact::point_stiffness(index_t n_points) const {
 
 void SurfaceContact::limit_point_stiffness(std::span<const double> limit, double cap) {
   const std::vector<double> stiffness = point_stiffness(static_cast<index_t>(limit.size()));
-  const double stiffest = stiffness.empty() ? 0.0 : *std::max_element(stiffness.begin(), stiffness.end());
+  const double stiffest = largest(stiffness);
   // the uniform scale that brings the stiffest point to the cap: no vertex is lowered further, so no part of
-  // the surface is softer than a uniformly lowered penalty made it
-  const double uniform = stiffest > cap ? cap / stiffest : 1.0;
+  // the surface is softer than a uniformly lowered penalty made it (no cap: nothing is lowered)
+  const double uniform = cap > 0 && stiffest > cap ? cap / stiffest : 1.0;
   for (index_t v = 0; v < map_.n_vertices(); ++v) {
     double scale = 1.0;
     for (index_t e = map_.points.begin(v); e < map_.points.end(v); ++e) {
@@ -68,8 +71,7 @@ void SurfaceContact::limit_point_stiffness(std::span<const double> limit, double
     penalty_[static_cast<std::size_t>(v)] *= std::max(scale, uniform);
   }
   // each point now presses at most max(limit_j, uniform x its stiffness) <= max(limit_j, cap)
-  const std::vector<double> lowered = point_stiffness(static_cast<index_t>(limit.size()));
-  max_point_stiffness_ = lowered.empty() ? 0.0 : *std::max_element(lowered.begin(), lowered.end());
+  max_point_stiffness_ = largest(point_stiffness(static_cast<index_t>(limit.size())));
 }
 
 void SurfaceContact::evaluate(const Points& u) { carry_surface(map_, Y_, u, y_); }

@@ -135,7 +135,8 @@ class SurfaceContact final : public EnergyTerm {
   std::vector<double> point_stiffness(index_t n_points) const;
   /// Lowers each vertex's penalty by the largest excess of its points' stiffness over `limit` (N/m per point
   /// of the model), but never below the uniform scale that brings the stiffest point to `cap`: every point then
-  /// presses at most max(limit_j, cap), and no vertex softer than a uniform lowering would make it.
+  /// presses at most max(limit_j, cap), and no vertex softer than a uniform lowering would make it (cap <= 0:
+  /// no cap, and nothing is lowered).
   void limit_point_stiffness(std::span<const double> limit, double cap);
   /// The deformed vertices of the last evaluation.
   const Points& vertices() const { return y_; }
