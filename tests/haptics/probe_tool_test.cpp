@@ -2,7 +2,8 @@
 // the force at the device's maximum; the probe tool settles where the coupling spring balances the object's
 // contact forces, and its forces, springs and renumbering are those of its contact. On the surface the probe is
 // a god-object: its centre is not taken into the surface between vertices, and it is put back on the surface
-// when the surface flowed over it.
+// when the surface flowed over it; its multipliers build at the same rate per second whatever the step.
+#include <pointhaptics/core/workspace.hpp>
 #include <pointhaptics/haptics/coupling.hpp>
 #include <pointhaptics/haptics/probe_tool.hpp>
 
@@ -134,6 +135,29 @@ TEST(ProbeTool, OnTheSurfaceAProbeTheSurfaceFlowedOverIsPutBackOnIt) {
   s.tool.place(s.model, state, device, false);
   EXPECT_GE(s.tool.probe().y(), 0.02 + 2 * radius);
   EXPECT_TRUE(s.tool.probe().allFinite());
+}
+
+// The multipliers build at the same rate per second whatever the step: after a 0.1 ms step they press a tenth of
+// what they press after a 1 ms step from the same placement (an integral action whose share per step did not
+// follow the step built ten times as fast at 0.1 ms, and the 100k half-sphere's run diverged sooner).
+TEST(ProbeTool, OnTheSurfaceTheMultipliersBuildPerSecondNotPerStep) {
+  auto multipliers_after = [](double step) {
+    SurfaceProbe s(0.004, 0.005, 300);
+    State state = State::at_rest(s.model);
+    Workspace ws(s.model, 1);
+    const Vec3 device(0.02, 0.02 + 0.004 - 0.003, 0.02);  // pressed 3 mm into the top face
+    s.tool.place(s.model, state, device, false);
+    Points f = Points::Zero(3, s.model.n_points);
+    s.tool.add(s.model, state, f);
+    const Vec3 penalty = s.tool.contact_model().f0;  // the penalty's alone: no multiplier yet
+    state.time += step;
+    s.tool.after_step(s.model, state, ws);
+    EXPECT_GT(s.tool.contact_model().contacts, 0);
+    return Vec3(s.tool.contact_model().f0 - penalty);
+  };
+  const Vec3 per_ms = multipliers_after(1e-3), per_tenth = multipliers_after(1e-4);
+  ASSERT_GT(per_ms.norm(), 0.0);
+  EXPECT_LT((per_tenth - 0.1 * per_ms).norm(), 1e-9 * per_ms.norm());
 }
 
 }  // namespace
