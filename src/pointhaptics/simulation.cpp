@@ -131,7 +131,7 @@ void Simulation::attach_probe(const ProbeParams& params, double coupling_stiffne
   contact.tangential_share = 0.1;
   if (surface && lod_) {
     // every active set's part of the surface presses as the whole surface does on the object's points (after a
-    // cut, as the unsplit one did: the split adds vertices only along the cut, so this is near there only)
+    // cut, as the unsplit one did: the split adds vertices only along the cut, the one place this is approximate)
     const SurfaceContact whole(lod_->object_model(), surface->mesh, surface->map, probe_shape(params), contact);
     contact.penalty = whole.per_area_penalty();
     contact.object_point_stiffness = std::make_shared<const std::vector<double>>(whole.point_stiffness(lod_->object_model().n_points));
