@@ -1,5 +1,6 @@
 // Tests for mechanics/surface_map: the surface is carried exactly by affine and rigid displacement fields,
-// each vertex's weights are a partition of unity, forces go to the points with the same virtual work as a
+// each vertex's weights are a partition of unity (without its negative weights too, which still carries
+// translations and pushes every point of a vertex the way the vertex is pushed), forces go to the points with the same virtual work as a
 // finite-difference check of a surface potential confirms, every kernel works (the viscosity kernel's
 // singular centre included), and a vertex with no points around it is a named error.
 #include <pointhaptics/core/error.hpp>
@@ -9,6 +10,8 @@
 #include "support/test_models.hpp"
 
 #include <gtest/gtest.h>
+
+#include <algorithm>
 
 namespace pointhaptics {
 namespace {
@@ -67,6 +70,38 @@ TEST(SurfaceMap, CarriesAffineAndRigidFieldsExactly) {
         worst = std::max(worst, (y.col(v) - (centre + R * (c.surface.V.col(v) - centre) + b)).norm());
       EXPECT_LT(worst, 1e-12) << c.name << " rigid";
     }
+  }
+}
+
+TEST(SurfaceMap, WithoutNegativeWeightsIsANonNegativePartitionOfUnityThatCarriesTranslations) {
+  for (const Case& c : cases()) {
+    const Model model = model_of(c.cloud);
+    const SurfaceMap linear = build_surface_map(model, c.surface.V);
+    double most_negative = 0;
+    for (const double w : linear.weight) most_negative = std::min(most_negative, w);
+    // the surface lies beyond the outer points: the first-order map extrapolates to it with negative weights
+    EXPECT_LT(most_negative, -0.01) << c.name;
+    const SurfaceMap map = without_negative_weights(linear);
+    ASSERT_EQ(map.points.index, linear.points.index) << c.name;
+    for (index_t v = 0; v < map.n_vertices(); ++v) {
+      double sum = 0;
+      for (index_t e = map.points.begin(v); e < map.points.end(v); ++e) {
+        EXPECT_GE(map.weight[e], 0.0) << c.name << " vertex " << v;
+        sum += map.weight[e];
+      }
+      EXPECT_NEAR(sum, 1, 1e-12) << c.name << " vertex " << v;
+    }
+    const Vec3 b(0.001, -0.002, 0.0005);
+    Points translation(3, model.n_points), y;
+    translation.colwise() = b;
+    carry_surface(map, c.surface.V, translation, y);
+    EXPECT_LT((y - (c.surface.V.colwise() + b)).cwiseAbs().maxCoeff(), 1e-15) << c.name;
+    // a force on a vertex pushes each of its points the same way (the first-order map pulled some back)
+    Points on_vertex = Points::Zero(3, map.n_vertices()), on_points = Points::Zero(3, model.n_points);
+    on_vertex.col(0) = Vec3(0, -1, 0);
+    spread_surface_forces(map, on_vertex, on_points);
+    EXPECT_LE(on_points.row(1).maxCoeff(), 0.0) << c.name;
+    EXPECT_NEAR(on_points.row(1).sum(), -1.0, 1e-12) << c.name;
   }
 }
 

@@ -9,6 +9,16 @@
 /// reach any tolerance with a penalty of the object's own stiffness. Forces on the vertices reach the points
 /// by W^T (virtual work), and the tool feels their opposite.
 ///
+/// W is the surface's map without its negative weights (without_negative_weights()). The surface lies half a
+/// spacing beyond the outer points, so the first-order map extrapolates to it: a vertex moves by about 1.4 of
+/// its outer points' displacement less 0.4 of the next layer's (the weights' negative part sums to -0.35 on
+/// average at the 100k half-sphere's pole, -0.5 at worst). A force pushing a vertex out of the tool then pulls
+/// that inner layer into it: with the multipliers pressing as hard as the material, the probe squeezed the
+/// layers under it until neighbourhoods were crushed (det F down to 0.04), and
+/// scenes/half_sphere_100k_lod.toml diverged at 2.2 s of its deterministic run. Non-negative weights push
+/// every point the same way; that run is calm (docs/haptics.md). The price is the map's exactness under
+/// strain across the surface, which the contact experiment's forces do not show (to 0.02% at R/4).
+///
 /// Coulomb friction (friction > 0) is met the same way (Simo and Laursen's augmented Lagrangian): a pressing
 /// vertex sticks to an anchor on the tool (kept in the tool's frame, so it follows the tool), and adds
 ///   E_t = sum_v (|tau_v + k_v s_v|^2 - |tau_v|^2) / (2 k_v),  s_v = P_v (y_v - anchor_v),
@@ -146,6 +156,7 @@ class SurfaceContact final : public EnergyTerm {
   bool enters(const Vec3& from, const Vec3& to) const;
   /// Where p is seen from the surface as the last evaluation carried it (nearest_surface_within()).
   std::optional<SurfaceSide> side_of(const Vec3& p, double radius) const { return nearest_surface_within(p, y_, triangles_, radius); }
+  /// The contact's map: the surface's without its negative weights.
   const SurfaceMap& map() const { return map_; }
 
  private:

@@ -136,6 +136,16 @@ void carry_surface(const SurfaceMap& map, const Points& Y, const Points& u, Poin
   }
 }
 
+SurfaceMap without_negative_weights(SurfaceMap map) {
+  for (index_t v = 0; v < map.n_vertices(); ++v) {
+    double sum = 0;
+    for (index_t e = map.points.begin(v); e < map.points.end(v); ++e) sum += std::max(map.weight[e], 0.0);
+    // a carried vertex's weights sum to 1, so some are positive; an empty row stays empty
+    for (index_t e = map.points.begin(v); e < map.points.end(v); ++e) map.weight[e] = sum > 0 ? std::max(map.weight[e], 0.0) / sum : 0.0;
+  }
+  return map;
+}
+
 void spread_surface_forces(const SurfaceMap& map, const Points& f_vertices, Points& f_points) {
   for (index_t v = 0; v < map.n_vertices(); ++v)
     for (index_t e = map.points.begin(v); e < map.points.end(v); ++e) f_points.col(map.points.index[e]) += map.weight[e] * f_vertices.col(v);

@@ -31,6 +31,14 @@ struct SurfaceMap {
 using VertexSees = std::function<bool(index_t vertex, index_t point)>;
 SurfaceMap build_surface_map(const Model& model, const Points& Y, std::vector<char>* uncarried = nullptr, const VertexSees& sees = {});
 
+/// The map with each vertex's negative weights left out and the rest scaled to sum to 1 (a vertex without
+/// points keeps its empty row): a partition of unity of non-negative weights, so a force on a vertex pushes
+/// every point that carries it the same way. It carries translations exactly; under an affine displacement
+/// u = A X a vertex moves by A X_v (X_v: its points' weighted centre, inside the object by about half a
+/// spacing) instead of A Y_v, so a rotation slides it along the surface (first order) and a stretch across the
+/// surface moves it by the strain times that depth. (The contact's map: SurfaceContact says why.)
+SurfaceMap without_negative_weights(SurfaceMap map);
+
 /// W f: a field of the points (k x n, e.g. k = 1 von Mises stress, 9 a stress tensor) at the vertices (k x m),
 /// into `out` (resized once).
 void interpolate_at_surface(const SurfaceMap& map, const Eigen::Ref<const Eigen::MatrixXd>& field, Eigen::MatrixXd& out);
