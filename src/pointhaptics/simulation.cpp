@@ -125,6 +125,7 @@ void Simulation::attach_probe(const ProbeParams& params, double coupling_stiffne
   // once a step (ProbeTool::after_step), keep it on the surface
   contact.max_point_stiffness = sim.model().material.young * sim.model().spacing;
   contact.friction = params.friction;
+  contact.non_negative_weights = params.non_negative_surface_map;
   // friction's penalty a tenth of the normal one (SurfaceContactParams::tangential_share): sliding, the
   // friction then measured 0.288 of the pressure for mu = 0.3 (0.286 with a hundredth, where new contacts
   // stuck for tens of steps; the full penalty made explicit steps chatter: 0.217)

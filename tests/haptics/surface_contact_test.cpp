@@ -1,7 +1,7 @@
 // Tests for haptics/surface_contact: the contact energy's forces are its gradient and its tangent the
 // forces' derivative (finite differences, sphere and capsule, with and without multipliers); the load on the
-// tool balances what the points get, and a pressing tool pushes every point that carries the surface away
-// from it (the contact's map has no negative weights); a capsule's off-centre contact has the torque of its forces; a tool
+// tool balances what the points get, and with the map without negative weights a pressing tool pushes every
+// point that carries the surface away from it (the exact map pulls some into it); a capsule's off-centre contact has the torque of its forces; a tool
 // held at a position in a static solve leaves no vertex inside it beyond the tolerance and pushes the
 // object with the force the supports resist; with Coulomb friction the forces stay the energy's gradient, a
 // small move of the pressed tool sticks (a tangential force inside the cone) and a longer one slides with mu
@@ -183,12 +183,14 @@ TEST(SurfaceContact, CapsuleTorqueIsTheMomentOfItsForces) {
 }
 
 TEST(SurfaceContact, APressingToolPushesEveryPointThatCarriesTheSurfaceAwayFromIt) {
-  // the first-order map would pull the layer under the outer points up into the tool (its negative weights):
-  // the contact's map has none, so every point's contact force points down, away from a tool pressing the top
+  // the exact map pulls the layer under the outer points up into the tool (its negative weights); without
+  // them (non_negative_weights) every point's contact force points down, away from a tool pressing the top
   // (a ball: its surface lies beyond the outer points everywhere, where a lattice's box has points on its faces)
   const double ball = 0.02, radius = 0.01, depth = 0.002;
   const Block b{build_model(sample_sphere(Vec3::Zero(), ball, spacing), MaterialParams{}, KernelParams{}), sphere_surface(Vec3::Zero(), ball, spacing / 2)};
-  SurfaceContact contact(b.model, b.surface, build_surface_map(b.model, b.surface.V), ToolShape{ToolKind::SPHERE, radius, 0});
+  SurfaceContactParams params;
+  params.non_negative_weights = true;
+  SurfaceContact contact(b.model, b.surface, build_surface_map(b.model, b.surface.V), ToolShape{ToolKind::SPHERE, radius, 0}, params);
   contact.set_pose(ToolPose{Vec3(0, ball + radius - depth, 0), Eigen::Quaterniond::Identity()});
   Points f = Points::Zero(3, b.model.n_points);
   const Points u = Points::Zero(3, b.model.n_points);
@@ -197,6 +199,12 @@ TEST(SurfaceContact, APressingToolPushesEveryPointThatCarriesTheSurfaceAwayFromI
   EXPECT_LE(f.row(1).maxCoeff(), 0.0);
   EXPECT_NEAR(-f.row(1).sum(), contact.last_load().force.y(), 1e-12 * contact.last_load().force.y());
   for (index_t e = 0; e < static_cast<index_t>(contact.map().weight.size()); ++e) EXPECT_GE(contact.map().weight[static_cast<std::size_t>(e)], 0.0);
+  // the exact map (the default) pulls some points up, into the tool
+  SurfaceContact exact(b.model, b.surface, build_surface_map(b.model, b.surface.V), ToolShape{ToolKind::SPHERE, radius, 0});
+  exact.set_pose(contact.pose());
+  f.setZero();
+  exact.add_forces(b.model, u, f);
+  EXPECT_GT(f.row(1).maxCoeff(), 0.0);
 }
 
 TEST(SurfaceContact, StaticIndentationMeetsTheConstraintAndBalancesTheSupports) {

@@ -425,6 +425,16 @@ TEST(SceneToml, TheLocalModelsStiffnessIsChosen) {
             std::string::npos);
 }
 
+TEST(SceneToml, TheContactsSurfaceMapIsChosen) {
+  const std::string probe = "\n[probe]\nkeyframes = [[0.0, 0.0, 0.0, 0.0]]\n";
+  EXPECT_FALSE(parse_scene(std::string(full_scene) + probe, "t.toml", ".").probe.non_negative_surface_map);
+  EXPECT_TRUE(parse_scene(std::string(full_scene) + probe + "surface_map = \"non_negative\"\n", "t.toml", ".").probe.non_negative_surface_map);
+  EXPECT_NE(error_of("keyframes = [[0.0, 0.0, 0.0, 0.0]]", "keyframes = [[0.0, 0.0, 0.0, 0.0]]\nsurface_map = \"positive\"",
+                     std::string(full_scene) + probe)
+                .find("probe.surface_map: unknown value \"positive\""),
+            std::string::npos);
+}
+
 TEST(SceneToml, AHeldToolPressesAlongItsDirection) {
   std::string text = std::string(full_scene) + held_tool_section;
   EXPECT_EQ(parse_scene(text, "t.toml", ".").probe.direction, Vec3(0, -1, 0));  // the default

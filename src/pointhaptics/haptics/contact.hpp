@@ -32,6 +32,8 @@ struct ProbeParams {
   /// against 0.97 ms) and took it out of real time, for a local model that strays 1.5 mN from the next
   /// update where the contact's own strays 2.6 mN (docs/haptics.md).
   bool object_stiffness = false;
+  /// On the surface: the contact's map without its negative weights (SurfaceContactParams::non_negative_weights).
+  bool non_negative_surface_map = false;
   /// CUT: the work of cutting per unit of new cut area, J/m^2 (N/m): the hand feels it as a force against the
   /// edge's motion, this times the new area over the distance moved (0: the blade cuts freely)
   double cut_resistance = 0;

@@ -16,7 +16,7 @@ double largest(const std::vector<double>& x) { return x.empty() ? 0.0 : *std::ma
 
 SurfaceContact::SurfaceContact(const Model& model, const TriangleMesh& mesh, SurfaceMap map, const ToolShape& shape,
                                const SurfaceContactParams& params)
-    : Y_(mesh.V), y_(mesh.V), triangles_(mesh.F), map_(without_negative_weights(std::move(map))), shape_(shape) {
+    : Y_(mesh.V), y_(mesh.V), triangles_(mesh.F), map_(params.non_negative_weights ? without_negative_weights(std::move(map)) : std::move(map)), shape_(shape) {
   if (!(shape.radius > 0) || !std::isfinite(shape.radius)) throw Error("tool: radius must be positive (m)");
   if (!(shape.length >= 0) || !std::isfinite(shape.length)) throw Error("tool: length must be >= 0 (m)");
   if (map_.n_vertices() != Y_.cols()) throw Error("tool: the surface map is for another surface");

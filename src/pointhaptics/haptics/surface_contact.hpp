@@ -9,24 +9,6 @@
 /// reach any tolerance with a penalty of the object's own stiffness. Forces on the vertices reach the points
 /// by W^T (virtual work), and the tool feels their opposite.
 ///
-/// W is the surface's map without its negative weights (without_negative_weights()). The surface lies half a
-/// spacing beyond the outer points, so the first-order map extrapolates to it: a vertex moves by about 1.4 of
-/// its outer points' displacement less 0.4 of the next layer's (the weights' negative part sums to -0.35 on
-/// average at the 100k half-sphere's pole, -0.5 at worst). A force pushing a vertex out of the tool then pulls
-/// that inner layer into it: with the multipliers pressing as hard as the material, the probe squeezed the
-/// layers under it until neighbourhoods were crushed (det F down to 0.04), and
-/// scenes/half_sphere_100k_lod.toml diverged at 2.2 s of its deterministic run. Non-negative weights push
-/// every point the same way; that run is calm (docs/haptics.md). The price is the map's exactness under
-/// strain across the surface, which the contact experiment's forces do not show (to 0.02% at R/4).
-///
-/// Coulomb friction (friction > 0) is met the same way (Simo and Laursen's augmented Lagrangian): a pressing
-/// vertex sticks to an anchor on the tool (kept in the tool's frame, so it follows the tool), and adds
-///   E_t = sum_v (|tau_v + k_v s_v|^2 - |tau_v|^2) / (2 k_v),  s_v = P_v (y_v - anchor_v),
-/// with P_v the projection off the normal frozen at the last update, while the trial force t = tau_v + k_v s_v
-/// lies in the cone |t| <= friction x lambda_v (stick), and linear in |t| beyond it (slip: the force stays on
-/// the cone, so a slide is one minimisation). Between minimisations tau_v takes the trial force (put on the
-/// cone, the anchor then moving to the vertex); the solve is done when no sticking vertex strays from its
-/// anchor, and no sliding one's force changes, by more than the tolerance's worth of penalty.
 #include <pointhaptics/core/model.hpp>
 #include <pointhaptics/geometry/mesh_distance.hpp>
 #include <pointhaptics/geometry/triangle_mesh.hpp>
@@ -68,6 +50,15 @@ struct SurfaceContactParams {
   /// carries (probe_surface_contact()) then presses as the whole one does, lowered only at the vertices of a
   /// point that would press stiffer than it does on the whole surface (limit_point_stiffness()).
   std::shared_ptr<const std::vector<double>> object_point_stiffness;
+  /// The contact's map without its negative weights (without_negative_weights()) instead of the surface's
+  /// exact one. The surface lies half a spacing beyond the outer points, so the exact map extrapolates to it:
+  /// a vertex moves by about 1.4 of its outer points' displacement less 0.4 of the next layer's (the negative
+  /// weights sum to -0.35 on average at the 100k half-sphere's pole), and a force pushing a vertex out of the
+  /// tool pulls that layer into it. With the multipliers pressing as hard as the material, a probe 3.6
+  /// spacings wide squeezed the layers under it until they were crushed (scenes/half_sphere_100k_lod.toml
+  /// diverged at 2.2 s of its deterministic run; with this map it is calm). Not the default: on the coarse
+  /// soft dome (a probe 1.5 spacings wide) its real-time soak diverged in 2 of 3 runs (docs/haptics.md).
+  bool non_negative_weights = false;
 };
 
 /// What the object does to the tool.
@@ -156,7 +147,7 @@ class SurfaceContact final : public EnergyTerm {
   bool enters(const Vec3& from, const Vec3& to) const;
   /// Where p is seen from the surface as the last evaluation carried it (nearest_surface_within()).
   std::optional<SurfaceSide> side_of(const Vec3& p, double radius) const { return nearest_surface_within(p, y_, triangles_, radius); }
-  /// The contact's map: the surface's without its negative weights.
+  /// The contact's map: the surface's, or without its negative weights (SurfaceContactParams::non_negative_weights).
   const SurfaceMap& map() const { return map_; }
 
  private:

@@ -141,6 +141,7 @@ struct ProbeSpec {
   double length = 0;                       ///< capsule: its axis segment, m, along the tool's local z
   double friction = 0;                     ///< Coulomb's coefficient on the surface
   bool object_stiffness = false;           ///< local_stiffness = "object" (else "contact"): ProbeParams::object_stiffness
+  bool non_negative_surface_map = false;   ///< surface_map = "non_negative" (else "exact"): ProbeParams::non_negative_surface_map
   int line = 0;
   bool held() const { return present && position.allFinite(); }
 };

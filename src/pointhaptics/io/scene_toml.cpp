@@ -555,6 +555,7 @@ void read_probe(TableReader& r, ProbeSpec& p, const Context& ctx) {
   if (p.cut && !p.capsule) r.fail_table("shape", "a blade (mode = \"cut\") is a capsule whose axis is its edge: give shape = \"capsule\" and length");
   p.friction = r.number("friction", p.friction, [](double m) { return m >= 0 && m <= 10; }, "must be in [0, 10]");
   p.object_stiffness = r.choice("local_stiffness", "contact", {"contact", "object"}) == "object";
+  p.non_negative_surface_map = r.choice("surface_map", "exact", {"exact", "non_negative"}) == "non_negative";
   if (r.find("position")) {
     p.position = r.vec3("position", p.position);
     if (r.find("trajectory") || r.find("keyframes"))
