@@ -415,24 +415,25 @@ TEST(SceneToml, BadHeldToolIsANamedError) {
             std::string::npos);
 }
 
-TEST(SceneToml, TheLocalModelsStiffnessIsChosen) {
+// A [probe] key with two values: off by default, on when the other value is given, and an unknown value named.
+template <class Flag>
+void expect_probe_choice(const std::string& key, const std::string& value, Flag flag) {
   const std::string probe = "\n[probe]\nkeyframes = [[0.0, 0.0, 0.0, 0.0]]\n";
-  EXPECT_FALSE(parse_scene(std::string(full_scene) + probe, "t.toml", ".").probe.object_stiffness);
-  EXPECT_TRUE(parse_scene(std::string(full_scene) + probe + "local_stiffness = \"object\"\n", "t.toml", ".").probe.object_stiffness);
-  EXPECT_NE(error_of("keyframes = [[0.0, 0.0, 0.0, 0.0]]", "keyframes = [[0.0, 0.0, 0.0, 0.0]]\nlocal_stiffness = \"soft\"",
+  EXPECT_FALSE(flag(parse_scene(std::string(full_scene) + probe, "t.toml", ".").probe)) << key;
+  EXPECT_TRUE(flag(parse_scene(std::string(full_scene) + probe + key + " = \"" + value + "\"\n", "t.toml", ".").probe)) << key;
+  EXPECT_NE(error_of("keyframes = [[0.0, 0.0, 0.0, 0.0]]", "keyframes = [[0.0, 0.0, 0.0, 0.0]]\n" + key + " = \"soft\"",
                      std::string(full_scene) + probe)
-                .find("probe.local_stiffness: unknown value \"soft\""),
-            std::string::npos);
+                .find("probe." + key + ": unknown value \"soft\""),
+            std::string::npos)
+      << key;
+}
+
+TEST(SceneToml, TheLocalModelsStiffnessIsChosen) {
+  expect_probe_choice("local_stiffness", "object", [](const ProbeSpec& p) { return p.object_stiffness; });
 }
 
 TEST(SceneToml, TheContactsSurfaceMapIsChosen) {
-  const std::string probe = "\n[probe]\nkeyframes = [[0.0, 0.0, 0.0, 0.0]]\n";
-  EXPECT_FALSE(parse_scene(std::string(full_scene) + probe, "t.toml", ".").probe.non_negative_surface_map);
-  EXPECT_TRUE(parse_scene(std::string(full_scene) + probe + "surface_map = \"non_negative\"\n", "t.toml", ".").probe.non_negative_surface_map);
-  EXPECT_NE(error_of("keyframes = [[0.0, 0.0, 0.0, 0.0]]", "keyframes = [[0.0, 0.0, 0.0, 0.0]]\nsurface_map = \"positive\"",
-                     std::string(full_scene) + probe)
-                .find("probe.surface_map: unknown value \"positive\""),
-            std::string::npos);
+  expect_probe_choice("surface_map", "non_negative", [](const ProbeSpec& p) { return p.non_negative_surface_map; });
 }
 
 TEST(SceneToml, AHeldToolPressesAlongItsDirection) {
