@@ -9,6 +9,14 @@
 /// reach any tolerance with a penalty of the object's own stiffness. Forces on the vertices reach the points
 /// by W^T (virtual work), and the tool feels their opposite.
 ///
+/// Coulomb friction (friction > 0) is met the same way (Simo and Laursen's augmented Lagrangian): a pressing
+/// vertex sticks to an anchor on the tool (kept in the tool's frame, so it follows the tool), and adds
+///   E_t = sum_v (|tau_v + k_v s_v|^2 - |tau_v|^2) / (2 k_v),  s_v = P_v (y_v - anchor_v),
+/// with P_v the projection off the normal frozen at the last update, while the trial force t = tau_v + k_v s_v
+/// lies in the cone |t| <= friction x lambda_v (stick), and linear in |t| beyond it (slip: the force stays on
+/// the cone, so a slide is one minimisation). Between minimisations tau_v takes the trial force (put on the
+/// cone, the anchor then moving to the vertex); the solve is done when no sticking vertex strays from its
+/// anchor, and no sliding one's force changes, by more than the tolerance's worth of penalty.
 #include <pointhaptics/core/model.hpp>
 #include <pointhaptics/geometry/mesh_distance.hpp>
 #include <pointhaptics/geometry/triangle_mesh.hpp>
