@@ -1,11 +1,11 @@
-// Tests for haptics/surface_contact: the contact energy's forces are its gradient and its tangent the
-// forces' derivative (finite differences, sphere and capsule, with and without multipliers); the load on the
-// tool balances what the points get, and with the map without negative weights a pressing tool pushes every
-// point that carries the surface away from it (the exact map pulls some into it); a capsule's off-centre contact has the torque of its forces; a tool
-// held at a position in a static solve leaves no vertex inside it beyond the tolerance and pushes the
-// object with the force the supports resist; with Coulomb friction the forces stay the energy's gradient, a
-// small move of the pressed tool sticks (a tangential force inside the cone) and a longer one slides with mu
-// times the normal force.
+// Tests for haptics/surface_contact: the contact energy's forces are its gradient and its tangent the forces'
+// derivative (finite differences, sphere and capsule, with and without multipliers); the load on the tool
+// balances what the points get, and with the map without negative weights a pressing tool pushes every point
+// that carries the surface away from it (the exact map pulls some into it); a capsule's off-centre contact
+// has the torque of its forces; a tool held at a position in a static solve leaves no vertex inside it beyond
+// the tolerance and pushes the object with the force the supports resist; with Coulomb friction the forces
+// stay the energy's gradient, a small move of the pressed tool sticks (a tangential force inside the cone)
+// and a longer one slides with mu times the normal force.
 #include <pointhaptics/geometry/sampling.hpp>
 #include <pointhaptics/geometry/shape_surfaces.hpp>
 #include <pointhaptics/haptics/surface_contact.hpp>

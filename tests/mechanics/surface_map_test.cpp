@@ -1,8 +1,8 @@
 // Tests for mechanics/surface_map: the surface is carried exactly by affine and rigid displacement fields,
 // each vertex's weights are a partition of unity (without its negative weights too, which still carries
-// translations and pushes every point of a vertex the way the vertex is pushed), forces go to the points with the same virtual work as a
-// finite-difference check of a surface potential confirms, every kernel works (the viscosity kernel's
-// singular centre included), and a vertex with no points around it is a named error.
+// translations and pushes every point of a vertex the way the vertex is pushed), forces go to the points with
+// the same virtual work as a finite-difference check of a surface potential confirms, every kernel works (the
+// viscosity kernel's singular centre included), and a vertex with no points around it is a named error.
 #include <pointhaptics/core/error.hpp>
 #include <pointhaptics/geometry/shape_surfaces.hpp>
 #include <pointhaptics/mechanics/surface_map.hpp>
