@@ -118,8 +118,11 @@ double strain_stiffening(const Model& model, Workspace& ws) {
     ws.for_each_chunk([&](int chunk) {
       double m = 1;
       const index_t end = std::min(ws.chunk_end(chunk), model.stencil_end());
-      for (index_t i = ws.chunk_begin(chunk); i < end; ++i) {
-        m = std::max(m, energy.stiffening(i, ws.gradient(i)));
+      // four points at a time (the check runs over every point of every step)
+      for (index_t i = ws.chunk_begin(chunk); i < end; i += lane_count) {
+        const int count = static_cast<int>(std::min<index_t>(lane_count, end - i));
+        const Lanes s = energy.stiffening(i, count, four_gradients(ws.gradients.data(), i, count));
+        for (int k = 0; k < count; ++k) m = std::max(m, s[k]);
       }
       chunk_max[chunk] = m;
     });

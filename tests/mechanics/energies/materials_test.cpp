@@ -182,6 +182,35 @@ TYPED_TEST(Hyperelastic, StiffeningIsOneAtRestAndCoversTheTangent) {
   }
 }
 
+TYPED_TEST(Hyperelastic, FourPointStiffeningIsTheOnePointOne) {
+  // the explicit step's check takes four points at a time (a vectorised form for neo-Hookean, point by
+  // point for the others): every lane must equal the one-point form, including lanes past the floor of J
+  // (the one-point form's extension), inverted or not finite ones, and lanes past `count` must be rest
+  PointEnergy<TypeParam> energy;
+  energy.material = make<TypeParam>();
+  std::mt19937 rng(11);
+  std::vector<Mat3> gradients = sample_gradients(rng);
+  gradients.push_back(Mat3::Constant(std::numeric_limits<double>::quiet_NaN()));
+  gradients.push_back(-0.99 * Mat3::Identity());  // J = 1e-6, below the floor
+  ASSERT_GT(gradients.size(), 20u);
+  for (std::size_t first = 0; first < gradients.size(); first += lane_count) {
+    const int count = static_cast<int>(std::min<std::size_t>(lane_count, gradients.size() - first));
+    Matrix3<Lanes> G{};
+    for (int k = 0; k < count; ++k)
+      for (int e = 0; e < 9; ++e) G.m[e][k] = gradients[first + k].data()[e];
+    const Lanes s = energy.stiffening(0, count, G);
+    for (int k = 0; k < count; ++k) {
+      const double expected = energy.stiffening(0, gradients[first + k]);
+      if (std::isnan(expected)) {
+        EXPECT_TRUE(std::isnan(s[k]));
+        continue;
+      }
+      ASSERT_NEAR(s[k], expected, 1e-12 * expected) << "G =\n" << gradients[first + k];
+    }
+    for (int k = count; k < lane_count; ++k) EXPECT_NEAR(s[k], 1.0, 1e-12);
+  }
+}
+
 TEST(NeoHookean, IsCalculixNeoHookeForPositiveJ) {
   // W = C10 (J^-2/3 I1 - 3) + (J - 1)^2 / D1, C10 = mu / 2, D1 = 2 / K
   const NeoHookean m = make<NeoHookean>(2e4, 0.45);

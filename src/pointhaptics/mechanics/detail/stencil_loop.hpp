@@ -143,12 +143,7 @@ void stencil_loop(const Model& model, const PaddedPoints& u, const PaddedGradien
   if constexpr (FourPointStressMap<StressMap>) {
     for (index_t i = first; i < last; i += lane_count) {
       const int count = static_cast<int>(std::min<index_t>(lane_count, last - i));
-      Matrix3<Lanes> G{};  // lanes past `count` stay zero: a rest state, never read back
-      for (int p = 0; p < count; ++p) {
-        const double* g = Gall + 12 * static_cast<std::ptrdiff_t>(i + p);
-        for (int c = 0; c < 3; ++c)
-          for (int r = 0; r < 3; ++r) G.m[r + 3 * c][p] = g[4 * c + r];
-      }
+      const Matrix3<Lanes> G = four_gradients(Gall, i, count);  // lanes past `count`: never read back
       const Matrix3<Lanes> A = stress_map(i, count, G);
       for (int p = 0; p < count; ++p)
         stencil_of(i + p, Lane4{A.m[0][p], A.m[1][p], A.m[2][p], 0.0}, Lane4{A.m[3][p], A.m[4][p], A.m[5][p], 0.0},

@@ -76,13 +76,22 @@ struct PowerOfJ {
 
   PowerOfJ(double J, double p) {
     const double j = std::max(J, j_floor);
-    const double g = std::pow(j, -p), g1 = -p * g / j, g2 = p * (p + 1) * g / (j * j);
+    const double g = power(j, p), g1 = -p * g / j, g2 = p * (p + 1) * g / (j * j);
     if (J >= j_floor) {
       value = g, first = g1, second = g2;
     } else {
       const double s = J - j_floor;
       value = g + g1 * s + 0.5 * g2 * s * s, first = g1 + g2 * s, second = g2;
     }
+  }
+  /// j^-p: the deviatoric invariants' powers (2/3, 4/3) through one cube root, which costs a third of a
+  /// std::pow (the explicit step's stiffening check runs it at every point of every step).
+  static double power(double j, double p) {
+    if (p == 2.0 / 3.0 || p == 4.0 / 3.0) {
+      const double r = 1 / std::cbrt(j), r2 = r * r;
+      return p == 2.0 / 3.0 ? r2 : r2 * r2;
+    }
+    return std::pow(j, -p);
   }
 };
 
@@ -126,11 +135,14 @@ inline void stretch_bounds(const Mat3& F, double& s1, double& s3) {
 
 /// The explicit stable step's stiffening of a hyperelastic model with a volume term K (J - 1)^2 / 2: one plus
 /// the growth of the bound of |dP / dF| over its rest value (`shear_growth`: the deviatoric terms'; the bulk
-/// terms' |cof F|^2 + 2 |J - 1| |F| here), over the tangent's rest norm max(3 K, 2 mu).
-inline double hyperelastic_stiffening(const Mat3& F, double jm1, double shear_growth, double bulk, double mu) {
-  const double c = cofactor(F).squaredNorm();
-  const double bulk_growth = bulk * (c + 2 * std::abs(jm1) * F.norm() - 3);
-  return std::max(1.0, 1 + (shear_growth + bulk_growth) / std::max(3 * bulk, 2 * mu));
+/// terms' |cof F|^2 + 2 |J - 1| |F| here, from `cof_squared` = |cof F|^2 and `f` = |F|), over the tangent's
+/// rest norm max(3 K, 2 mu). For one point or four (lanes.hpp).
+template <class T>
+PH_ALWAYS_INLINE inline T hyperelastic_stiffening(const T& cof_squared, const T& f, const T& jm1, const T& shear_growth,
+                                                  double bulk, double mu) {
+  const T bulk_growth = bulk * (cof_squared + 2 * absolute(jm1) * f - 3);
+  const T one = T{} + 1;
+  return larger(T(one + (shear_growth + bulk_growth) / std::max(3 * bulk, 2 * mu)), one);
 }
 
 }  // namespace pointhaptics

@@ -185,6 +185,34 @@ PH_ALWAYS_INLINE inline Lanes max_abs(const Matrix3<Lanes>& a) {
   return r;
 }
 
+/// sqrt, |x| and max for one point or lane by lane (the lanes' sqrt is one vector instruction).
+PH_ALWAYS_INLINE inline double square_root(double x) { return std::sqrt(x); }
+PH_ALWAYS_INLINE inline Lanes square_root(const Lanes& x) {
+  Lanes r;
+  for (int k = 0; k < lane_count; ++k) r[k] = __builtin_sqrt(x[k]);
+  return r;
+}
+template <class T>
+PH_ALWAYS_INLINE inline T absolute(const T& x) {
+  return where(x < 0, T(-x), x);
+}
+template <class T>
+PH_ALWAYS_INLINE inline T larger(const T& a, const T& b) {
+  return where(a < b, b, a);
+}
+
+/// The four points i .. i + count - 1 (count <= 4) of gradients stored by columns with a pad (12 doubles a
+/// point, Workspace::gradients); lanes past `count` stay zero, a rest state.
+PH_ALWAYS_INLINE inline Matrix3<Lanes> four_gradients(const double* padded_gradients, std::ptrdiff_t i, int count) {
+  Matrix3<Lanes> G{};
+  for (int p = 0; p < count; ++p) {
+    const double* g = padded_gradients + 12 * (i + p);
+    for (int c = 0; c < 3; ++c)
+      for (int r = 0; r < 3; ++r) G.m[r + 3 * c][p] = g[4 * c + r];
+  }
+  return G;
+}
+
 /// J^-1/3 for J > 0.
 PH_ALWAYS_INLINE inline double inverse_cube_root(double J) { return 1 / std::cbrt(J); }
 /// J^-1/3 in each lane (J > 0), to a few ulps, without a division or a call: a quartic in J - 1 (relative

@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <array>
+#include <concepts>
 #include <type_traits>
 #include <variant>
 
@@ -109,6 +110,24 @@ void complete_lanes(const Energy& energy, index_t i, int count, const Matrix3<La
   }
 }
 
+/// A material with a four-point stiffening(G, general) (lanes.hpp), as NeoHookean.
+template <class Material>
+concept FourPointStiffening = requires(const Material& m, const Matrix3<Lanes>& G, LaneMask& general) {
+  { m.stiffening(G, general) } -> std::same_as<Lanes>;
+};
+
+/// energy.stiffening(i + k, G_k) in the lanes k < count where `general` is set; the others keep `s`.
+template <class Energy>
+Lanes complete_stiffening(const Energy& energy, index_t i, int count, const Matrix3<Lanes>& G, const LaneMask& general, Lanes s) {
+  for (int k = 0; k < count; ++k) {
+    if (!general[k]) continue;
+    Mat3 Gk;
+    for (int e = 0; e < 9; ++e) Gk.data()[e] = G.m[e][k];
+    s[k] = energy.stiffening(i + k, Gk);
+  }
+  return s;
+}
+
 /// A stencil's energy per unit volume when every point has the same material: the material's, plus the
 /// added terms. Every function takes the point i (ignored by the material here; see MixedEnergy).
 template <class Material>
@@ -150,6 +169,14 @@ struct PointEnergy : AddedTerms {
   }
   /// How much stiffer than at rest the material is at G (the explicit stable step).
   double stiffening(index_t, const Mat3& G) const { return material.stiffening(G); }
+  /// The same for the points i .. i + count - 1 (count <= 4) at once; lanes past `count` are 1.
+  Lanes stiffening(index_t i, int count, const Matrix3<Lanes>& G) const {
+    LaneMask general = LaneMask{} - 1;  // every lane
+    Lanes s = Lanes{} + 1;
+    if constexpr (FourPointStiffening<Material>) s = material.stiffening(G, general);
+    if (any_lane(general)) [[unlikely]] s = complete_stiffening(*this, i, count, G, general, s);
+    return s;
+  }
 };
 
 /// The most materials one object can mix (the object's own and its regions'; model_builder.hpp's limit).
@@ -206,6 +233,10 @@ struct MixedEnergy : AddedTerms {
   }
   double stiffening(index_t i, const Mat3& G) const {
     return visit(i, [&](const auto& m) { return m.stiffening(G); });
+  }
+  /// Point by point (the explicit step's check; mixed objects are rare enough not to pay for lanes here).
+  Lanes stiffening(index_t i, int count, const Matrix3<Lanes>& G) const {
+    return complete_stiffening(*this, i, count, G, LaneMask{} - 1, Lanes{} + 1);
   }
 };
 

@@ -81,11 +81,11 @@ struct MooneyRivlin : HessianTangent<MooneyRivlin> {
     const Mat3 F = Mat3::Identity() + G;
     const double jm1 = volume_change(G);
     const PowerOfJ g1(1 + jm1, 2.0 / 3.0), g2(1 + jm1, 4.0 / 3.0);
-    // the rest values are constants: computed once
-    static const double first_rest = NeoHookean::shear_bound(Mat3::Identity(), PowerOfJ(1, 2.0 / 3.0));
-    static const double second_rest = second_bound(Mat3::Identity(), PowerOfJ(1, 4.0 / 3.0));
-    const double growth = c10 * (NeoHookean::shear_bound(F, g1) - first_rest) + c01 * (second_bound(F, g2) - second_rest);
-    return hyperelastic_stiffening(F, jm1, growth, bulk, mu());
+    static const double second_rest = second_bound(Mat3::Identity(), PowerOfJ(1, 4.0 / 3.0));  // a constant: once
+    const double i1 = F.squaredNorm(), f = std::sqrt(i1), c = cofactor(F).norm();
+    const double first = NeoHookean::shear_bound(i1, f, c, g1.value, std::abs(g1.first), std::abs(g1.second));
+    const double growth = c10 * (first - NeoHookean::rest_shear_bound) + c01 * (second_bound(F, g2) - second_rest);
+    return hyperelastic_stiffening(c * c, f, jm1, growth, bulk, mu());
   }
   /// The C01 (I2bar - 3) terms of |dP| / |dF|, over C01.
   static double second_bound(const Mat3& F, const PowerOfJ& g) {

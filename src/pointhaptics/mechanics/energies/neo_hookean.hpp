@@ -69,17 +69,35 @@ struct NeoHookean : HessianTangent<NeoHookean> {
   /// norms (|F|^2 = I1, |cof F|, |d cof| <= 2 |F| |dF|); the bound's growth over its rest value, over the
   /// tangent's rest norm 3 K (the volumetric mode; 2 mu for negative Poisson's ratios).
   double stiffening(const Mat3& G) const {
-    const Mat3 F = Mat3::Identity() + G;
     const double jm1 = volume_change(G);
     const PowerOfJ g(1 + jm1, 2.0 / 3.0);
-    static const double rest = shear_bound(Mat3::Identity(), PowerOfJ(1, 2.0 / 3.0));  // a constant: once
-    return hyperelastic_stiffening(F, jm1, c10() * (shear_bound(F, g) - rest), bulk, mu);
+    return stiffening_at(to_matrix3(G), jm1, g.value, std::abs(g.first), std::abs(g.second));
   }
-  /// The C10 (I1bar - 3) terms of |dP| / |dF|, over C10.
-  static double shear_bound(const Mat3& F, const PowerOfJ& g) {
-    const double i1 = F.squaredNorm(), f = std::sqrt(i1), c = cofactor(F).norm();
-    return 2 * g.value + std::abs(g.second) * i1 * c * c + std::abs(g.first) * (2 * f * c + 2 * i1 * f + 2 * c * f);
+  /// The same for four points (lanes.hpp), the explicit step's check over every point of every step. The
+  /// lanes whose J is below PowerOfJ's floor (or not finite) are marked in `general`, for the form above.
+  Lanes stiffening(const Matrix3<Lanes>& G, LaneMask& general) const {
+    const Lanes jm1 = volume_change(G), J = 1 + jm1;
+    general = !(J >= PowerOfJ::j_floor);
+    const Lanes j = where(general, Lanes{} + 1, J);
+    const Lanes y = inverse_cube_root(j), g = y * y;  // J^-2/3 and its derivatives' magnitudes
+    return stiffening_at(G, jm1, g, (2.0 / 3.0) * g / j, (10.0 / 9.0) * g / (j * j));
   }
+  /// The stiffening at G from g = J^-2/3, |g'| and |g''|.
+  template <class T>
+  PH_ALWAYS_INLINE T stiffening_at(const Matrix3<T>& G, const T& jm1, const T& g, const T& g1, const T& g2) const {
+    const Matrix3<T> F = plus_identity(G, 1.0), cof = cofactor(F);
+    const T i1 = inner(F, F), f = square_root(i1), c2 = inner(cof, cof);
+    const T shear_growth = c10() * (shear_bound(i1, f, square_root(c2), g, g1, g2) - rest_shear_bound);
+    return hyperelastic_stiffening(c2, f, jm1, shear_growth, bulk, mu);
+  }
+  /// The C10 (I1bar - 3) terms of |dP| / |dF|, over C10, from I1 = |F|^2, f = |F|, c = |cof F| and g = J^-2/3,
+  /// |g'|, |g''|.
+  template <class T>
+  PH_ALWAYS_INLINE static T shear_bound(const T& i1, const T& f, const T& c, const T& g, const T& g1, const T& g2) {
+    return 2 * g + g2 * i1 * c * c + g1 * (2 * f * c + 2 * i1 * f + 2 * c * f);
+  }
+  /// shear_bound() at rest (F = I: I1 = 3, |F| = |cof F| = sqrt 3, g = 1, |g'| = 2/3, |g''| = 10/9): 20 + 4 sqrt 3.
+  static constexpr double rest_shear_bound = 20 + 4 * 1.7320508075688772;
 };
 
 }  // namespace pointhaptics
