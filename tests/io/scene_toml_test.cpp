@@ -157,8 +157,11 @@ TEST(SceneToml, ThePreconditionerIsChosen) {
   const Scene scene = parse_scene(text);
   EXPECT_EQ(scene.solver.preconditioner, Preconditioner::CHOLESKY);
   EXPECT_EQ(scene.solver.refactor_iterations, 4);
+  text = full_scene;
+  text.replace(text.find("dt = 2e-3"), 9, "dt = 2e-3\npreconditioner = \"two_level\"");
+  EXPECT_EQ(parse_scene(text).solver.preconditioner, Preconditioner::TWO_LEVEL);
   EXPECT_NE(error_of("dt = 2e-3", "dt = 2e-3\npreconditioner = \"ilu\"")
-                .find("solver.preconditioner: unknown value \"ilu\" (expected block_jacobi | cholesky)"),
+                .find("solver.preconditioner: unknown value \"ilu\" (expected block_jacobi | cholesky | two_level)"),
             std::string::npos);
   EXPECT_NE(error_of("dt = 2e-3", "dt = 2e-3\nrefactor_iterations = 0").find("solver.refactor_iterations"), std::string::npos);
 }

@@ -1,9 +1,11 @@
 // Tests for solvers/sparse_cholesky and Newton's Cholesky preconditioner: the factor solves the assembled
 // tangent over the free points, refuses a matrix that is not positive definite, and as a preconditioner it
-// gives the block-Jacobi solution with far fewer CG iterations, lagging across implicit steps.
+// gives the block-Jacobi solution with far fewer CG iterations, lagging across implicit steps. The same for the
+// two-level preconditioner (solvers/coarse_correction.hpp), whose coarse level is such a factor.
 #include <pointhaptics/mechanics/tangent.hpp>
 #include <pointhaptics/scene_builder.hpp>
 #include <pointhaptics/io/scene_toml.hpp>
+#include <pointhaptics/solvers/coarse_correction.hpp>
 #include <pointhaptics/solvers/implicit_solver.hpp>
 #include <pointhaptics/solvers/sparse_cholesky.hpp>
 #include <pointhaptics/solvers/static_solver.hpp>
@@ -107,13 +109,11 @@ TEST(SparseCholesky, RefusesAMatrixThatIsNotPositiveDefinite) {
   EXPECT_TRUE(chol.factorise(K));
 }
 
-TEST(CholeskyPreconditioner, GivesTheBlockJacobiEquilibriumInFarFewerIterations) {
-  const Model model = cantilever(1e5);
+// the static equilibrium with block-Jacobi (k = 0) and with `other` (k = 1): their stats and displacements
+void solve_both(const Model& model, Preconditioner other, StaticStats (&stats)[2], Points (&u)[2]) {
   NewtonSettings settings;
-  StaticStats stats[2];
-  Points u[2];
   for (int k = 0; k < 2; ++k) {
-    settings.preconditioner = k == 0 ? Preconditioner::BLOCK_JACOBI : Preconditioner::CHOLESKY;
+    settings.preconditioner = k == 0 ? Preconditioner::BLOCK_JACOBI : other;
     State state = State::at_rest(model);
     Workspace ws(model, 2);
     NewtonSolver newton(model);
@@ -121,21 +121,30 @@ TEST(CholeskyPreconditioner, GivesTheBlockJacobiEquilibriumInFarFewerIterations)
     ASSERT_TRUE(stats[k].converged) << stats[k].failure;
     u[k] = state.u;
   }
+}
+
+TEST(CholeskyPreconditioner, GivesTheBlockJacobiEquilibriumInFarFewerIterations) {
+  const Model model = cantilever(1e5);
+  StaticStats stats[2];
+  Points u[2];
+  solve_both(model, Preconditioner::CHOLESKY, stats, u);
   EXPECT_EQ(stats[0].factorisations, 0);
   EXPECT_GE(stats[1].factorisations, 1);
   EXPECT_LT((u[1] - u[0]).norm(), 1e-6 * u[0].norm());
   EXPECT_LT(3 * stats[1].cg_iterations, stats[0].cg_iterations);
 }
 
-TEST(CholeskyPreconditioner, LagsAcrossStiffImplicitSteps) {
-  // E = 1e8 Pa at 1 kHz: about 75x the explicit stable step, where block-Jacobi CG needs ~20 iterations a step
+// 50 implicit steps of 1 ms of the cantilever at E = 1e8 Pa (about 75x the explicit stable step, where
+// block-Jacobi CG needs ~20 iterations a step) with block-Jacobi (k = 0) and `other` (k = 1): the CG
+// iterations, the factorisations of `other` and the displacements
+void step_both(Preconditioner other, long long (&cg)[2], long long& factorisations, Points (&u)[2]) {
   const Model model = cantilever(1e8);
-  Points u[2];
-  long long cg[2] = {0, 0}, factorisations = 0;
+  factorisations = 0;
   for (int k = 0; k < 2; ++k) {
+    cg[k] = 0;
     NewtonSettings settings;
     settings.tolerance = 1e-6;
-    settings.preconditioner = k == 0 ? Preconditioner::BLOCK_JACOBI : Preconditioner::CHOLESKY;
+    settings.preconditioner = k == 0 ? Preconditioner::BLOCK_JACOBI : other;
     ImplicitSolver solver(model, 1e-3, settings);
     State state = State::at_rest(model);
     Workspace ws(model, 2);
@@ -143,15 +152,61 @@ TEST(CholeskyPreconditioner, LagsAcrossStiffImplicitSteps) {
       const StepReport report = solver.step(model, state, ws, nullptr);
       ASSERT_EQ(report.status, StepStatus::CONVERGED) << report.failure;
       cg[k] += report.cg_iterations;
-      if (k == 1) {
-        factorisations += report.factorisations;
+      if (k == 1) factorisations += report.factorisations;
+      if (k == 1 && other == Preconditioner::CHOLESKY) {
         EXPECT_GT(report.factor_bytes, 0);
       }
     }
     u[k] = state.u;
   }
+}
+
+TEST(CholeskyPreconditioner, LagsAcrossStiffImplicitSteps) {
+  Points u[2];
+  long long cg[2], factorisations;
+  step_both(Preconditioner::CHOLESKY, cg, factorisations, u);
   EXPECT_LE(factorisations, 3) << "the factor is reused across steps";
   EXPECT_LT(4 * cg[1], cg[0]);
+  EXPECT_LT((u[1] - u[0]).norm(), 1e-4 * u[0].norm());
+}
+
+TEST(CoarseCorrection, KeepsAboutTheTargetNumberOfPointsSpreadOverTheObject) {
+  const Model model = cantilever(1e5, 0.005);  // 31 x 7 x 7 points
+  const std::vector<index_t> coarse = CoarseCorrection::coarse_points(model);
+  const double ratio = CoarseCorrection::coarsening(model);
+  EXPECT_GE(ratio, 2.0);
+  EXPECT_GT(coarse.size(), CoarseCorrection::target_coarse_points / 4);
+  EXPECT_LT(coarse.size(), 4 * CoarseCorrection::target_coarse_points);
+  EXPECT_TRUE(std::is_sorted(coarse.begin(), coarse.end()));
+  EXPECT_EQ(std::adjacent_find(coarse.begin(), coarse.end()), coarse.end());
+  // every fine point has a coarse one within a coarse cell's diagonal, and the clamped face has coarse points
+  double farthest = 0;
+  for (index_t i = 0; i < model.n_points; ++i) {
+    double nearest = 1e300;
+    for (index_t c : coarse) nearest = std::min(nearest, (model.X.col(i) - model.X.col(c)).norm());
+    farthest = std::max(farthest, nearest);
+  }
+  EXPECT_LE(farthest, std::sqrt(3.0) * ratio * model.spacing);
+  EXPECT_TRUE(std::any_of(coarse.begin(), coarse.end(), [&](index_t c) { return model.fixed[c] != 0; }));
+}
+
+TEST(TwoLevelPreconditioner, GivesTheBlockJacobiEquilibriumInFarFewerIterations) {
+  // CG's slow modes on the cantilever are its bending: block-Jacobi needs ~350 iterations at 5 mm, the
+  // coarse level about 85 (and their number hardly grows under refinement, docs/performance.md)
+  const Model model = cantilever(1e5, 0.005);
+  StaticStats stats[2];
+  Points u[2];
+  solve_both(model, Preconditioner::TWO_LEVEL, stats, u);
+  EXPECT_EQ(stats[1].factorisations, 0) << "the coarse factor is not the fine tangent's";
+  EXPECT_LT((u[1] - u[0]).norm(), 1e-6 * u[0].norm());
+  EXPECT_LT(3 * stats[1].cg_iterations, stats[0].cg_iterations);
+}
+
+TEST(TwoLevelPreconditioner, CutsTheIterationsOfStiffImplicitSteps) {
+  Points u[2];
+  long long cg[2], factorisations;
+  step_both(Preconditioner::TWO_LEVEL, cg, factorisations, u);
+  EXPECT_LT(3 * cg[1], cg[0]);
   EXPECT_LT((u[1] - u[0]).norm(), 1e-4 * u[0].norm());
 }
 

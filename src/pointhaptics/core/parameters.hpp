@@ -122,6 +122,8 @@ enum class Preconditioner {
   BLOCK_JACOBI,  ///< the tangent's inverted 3x3 diagonal blocks: cheap, many iterations on stiff problems
   CHOLESKY,      ///< a sparse Cholesky factor of the assembled tangent, reused across iterations and steps
                  ///< while CG converges in few iterations (lagged), refactorised when it no longer does
+  TWO_LEVEL,     ///< block-Jacobi plus a coarse model's factorised correction (every other point, twice the
+                 ///< spacing): the smooth, global modes in a few iterations; lags like block-Jacobi
 };
 
 /// [solver]: which solver advances the object, and how far.
@@ -163,8 +165,8 @@ struct EnumNames<LodScheme> {
 };
 template <>
 struct EnumNames<Preconditioner> {
-  static constexpr std::array<std::pair<Preconditioner, std::string_view>, 2> table{
-      {{Preconditioner::BLOCK_JACOBI, "block_jacobi"}, {Preconditioner::CHOLESKY, "cholesky"}}};
+  static constexpr std::array<std::pair<Preconditioner, std::string_view>, 3> table{
+      {{Preconditioner::BLOCK_JACOBI, "block_jacobi"}, {Preconditioner::CHOLESKY, "cholesky"}, {Preconditioner::TWO_LEVEL, "two_level"}}};
 };
 template <>
 struct EnumNames<SolverKind> {

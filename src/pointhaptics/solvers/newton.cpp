@@ -98,7 +98,10 @@ void NewtonSolver::note_cg_rate(long long iterations, double eta) {
     refresh_blocks_ = true;
 }
 
-void NewtonSolver::build_preconditioner(const Model& model, const NewtonProblem& problem, Workspace& ws) {
+void NewtonSolver::build_preconditioner(const Model& model, const NewtonProblem& problem, const Points& u, Workspace& ws) {
+  // the two-level preconditioner's coarse level lags with the blocks (rebuilt with them)
+  two_level_ = kind_ == Preconditioner::TWO_LEVEL && (coarse_.built_for(model) || coarse_.build(model)) &&
+               coarse_.factorise(model, u, problem.inertia);
   blocks_model_ = &model;
   blocks_inertia_ = problem.inertia;
   blocks_springs_ = problem.springs != nullptr;
@@ -141,10 +144,12 @@ bool NewtonSolver::factorise(const Model& model, const NewtonProblem& problem, W
 }
 
 void NewtonSolver::precondition(const Points& r, Points& z, Workspace& ws) {
-  if (use_cholesky_)
+  if (use_cholesky_) {
     cholesky_.solve(r, z);
-  else
-    precondition_blocks(ws.solver_scratch().blocks, r, z);
+    return;
+  }
+  precondition_blocks(ws.solver_scratch().blocks, r, z);
+  if (two_level_) coarse_.add_correction(*blocks_model_, r, z);
 }
 
 void NewtonSolver::apply_tangent(const Model& model, const NewtonProblem& problem, const Points& p, Workspace& ws, Points& q) const {
@@ -160,7 +165,7 @@ void NewtonSolver::linearise(const Model& model, const NewtonProblem& problem, c
   if (problem.term) problem.term->linearise(model, u, TangentMode::PROJECTED);
   if (!material) return;
   tangent_.linearise(model, u, TangentMode::PROJECTED, &ws);
-  build_preconditioner(model, problem, ws);
+  build_preconditioner(model, problem, u, ws);
   preconditioner_mode_ = TangentMode::PROJECTED;
 }
 
@@ -210,6 +215,8 @@ bool NewtonSolver::conjugate_gradients(const Model& model, const NewtonProblem& 
 NewtonStats NewtonSolver::solve(const Model& model, const NewtonProblem& problem, Points& u, Workspace& ws,
                                 const NewtonSettings& settings) {
   NewtonStats stats;
+  if (settings.preconditioner != kind_) refresh_blocks_ = true;  // another preconditioner: build it
+  kind_ = settings.preconditioner;
   SolverScratch& s = ws.solver_scratch();
   Points &r = s.r, &dx = s.dx, &trial = s.trial;
   double rel = residual(model, problem, u, ws, r);
@@ -245,7 +252,7 @@ NewtonStats NewtonSolver::solve(const Model& model, const NewtonProblem& problem
       // the block-Jacobi preconditioner is rebuilt when the tangent's mode changes, for another model or problem,
       // and when CG has slowed with it; in between it lags across iterations and steps (it changes slowly, and
       // costs a few tangent products: a quarter of an implicit step on the 10k-point beam when rebuilt every step)
-      if (mode != preconditioner_mode_ || blocks_stale(model, problem, ws)) build_preconditioner(model, problem, ws);
+      if (mode != preconditioner_mode_ || blocks_stale(model, problem, ws)) build_preconditioner(model, problem, u, ws);
       preconditioner_mode_ = mode;
       // the Cholesky factor lags across iterations and solves while CG converges fast with it
       // (an exact tangent found indefinite once is not factorised again: only a projected one, which is not)

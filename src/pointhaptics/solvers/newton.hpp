@@ -6,6 +6,7 @@
 #include <vector>
 #include <pointhaptics/mechanics/tangent.hpp>
 #include <pointhaptics/mechanics/viscoelasticity.hpp>
+#include <pointhaptics/solvers/coarse_correction.hpp>
 #include <pointhaptics/solvers/sparse_cholesky.hpp>
 
 namespace pointhaptics {
@@ -99,7 +100,7 @@ class NewtonSolver {
                 const ViscousStep& step) const;
   /// r = -grad Pi at u, zero at held points; returns the relative residual
   double residual(const Model& model, const NewtonProblem& problem, const Points& u, Workspace& ws, Points& r) const;
-  void build_preconditioner(const Model& model, const NewtonProblem& problem, Workspace& ws);
+  void build_preconditioner(const Model& model, const NewtonProblem& problem, const Points& u, Workspace& ws);
   /// Assemble the problem's tangent (as last linearised) and factorise it; false when it is not positive
   /// definite (CG then uses the block-Jacobi preconditioner).
   bool factorise(const Model& model, const NewtonProblem& problem, Workspace& ws);
@@ -133,6 +134,11 @@ class NewtonSolver {
   bool use_cholesky_ = false;
   bool refactorise_ = true;
   bool exact_indefinite_ = false;  ///< a factorisation of the exact tangent failed: factorise projected ones only
+  // TWO_LEVEL: block-Jacobi plus a coarse model's correction (coarse_correction.hpp), built and factorised
+  // with the blocks; `kind_` is the last solve's preconditioner
+  Preconditioner kind_ = Preconditioner::BLOCK_JACOBI;
+  CoarseCorrection coarse_;
+  bool two_level_ = false;
 
 };
 
