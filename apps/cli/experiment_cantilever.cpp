@@ -9,10 +9,12 @@
 #include <fmt/format.h>
 #include <fmt/os.h>
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
 #include <optional>
 #include <thread>
 
@@ -38,15 +40,38 @@ struct Deflection {
 Deflection deflection_of(const Points& X, const Points& u) {
   Deflection d;
   int n = 0;
+  bool centre_found = false;
+  double dy = 1e300, dz = 1e300;  // the tip face's nearest node rows to the centre, when it has no node there
   for (Eigen::Index k = 0; k < X.cols(); ++k) {
     const Vec3 p = X.col(k);
     if (std::abs(p.x() - L) > 1e-9) continue;
     d.mean -= u(1, k);
     ++n;
-    if ((p - Vec3(L, H / 2, W / 2)).norm() < 1e-9) d.centre = -u(1, k);
+    if ((p - Vec3(L, H / 2, W / 2)).norm() < 1e-9) d.centre = -u(1, k), centre_found = true;
     if ((p - Vec3(L, H, W)).norm() < 1e-9) d.corner = -u(1, k);
+    if (std::abs(p.y() - H / 2) > 1e-9) dy = std::min(dy, std::abs(p.y() - H / 2));
+    if (std::abs(p.z() - W / 2) > 1e-9) dz = std::min(dz, std::abs(p.z() - W / 2));
   }
   d.mean /= std::max(n, 1);
+  if (!centre_found) {
+    // a mesh with an odd number of elements across (16x3x3) has no node at the face centre, the centre of
+    // one element's face: the 20-node brick's face interpolates it there as -1/4 of each of the face's
+    // corners and 1/2 of each of its mid-edge nodes
+    const std::array<std::pair<Vec3, double>, 8> face{{{{L, H / 2 - dy, W / 2 - dz}, -0.25}, {{L, H / 2 + dy, W / 2 - dz}, -0.25},
+                                                       {{L, H / 2 - dy, W / 2 + dz}, -0.25}, {{L, H / 2 + dy, W / 2 + dz}, -0.25},
+                                                       {{L, H / 2 - dy, W / 2}, 0.5},       {{L, H / 2 + dy, W / 2}, 0.5},
+                                                       {{L, H / 2, W / 2 - dz}, 0.5},       {{L, H / 2, W / 2 + dz}, 0.5}}};
+    int found = 0;
+    double centre = 0;
+    for (const auto& [q, weight] : face)
+      for (Eigen::Index k = 0; k < X.cols(); ++k)
+        if ((X.col(k) - q).norm() < 1e-9) {
+          centre -= weight * u(1, k);
+          ++found;
+          break;
+        }
+    d.centre = found == 8 ? centre : std::numeric_limits<double>::quiet_NaN();
+  }
   return d;
 }
 

@@ -79,6 +79,9 @@ void print_summary(ph::Simulation& sim, const ph::RunSummary& s, double setup_s)
   if (s.preconditioner == "cholesky")
     fmt::print("preconditioner  cholesky: {} factorisation{} of the tangent, factor {:.1f} MB\n", s.factorisations,
                s.factorisations == 1 ? "" : "s", s.factor_bytes / 1e6);
+  if (s.preconditioner == "two_level")
+    fmt::print("preconditioner  two_level: a coarse level of {} points, its factor {:.2f} MB{}\n", s.coarse_points,
+               s.factor_bytes / 1e6, s.coarse_points == 0 ? " (none: the object is too small; block-Jacobi alone)" : "");
   fmt::print("displacement    max {:.4g} m at point {} ({:.4g}, {:.4g}, {:.4g})\n", max_u, worst, m.X(0, worst), m.X(1, worst),
              m.X(2, worst));
   // the out-of-balance force: |f_int + f_ext| over the free points relative to the load; in dynamics it is

@@ -234,6 +234,7 @@ void ModelSimulation::record(const StepReport& report, double seconds) {
   d.cg_iterations += report.cg_iterations;
   d.factorisations += report.factorisations;
   d.factor_bytes = std::max(d.factor_bytes, report.factor_bytes);
+  d.coarse_points = std::max(d.coarse_points, static_cast<long long>(report.coarse_points));
   if (solver_.kind != SolverKind::EXPLICIT) d.residual = report.residual;
   if (report.status == StepStatus::AT_BUDGET) ++d.budget_steps;
   d.status = report.status;

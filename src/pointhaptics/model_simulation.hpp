@@ -39,7 +39,8 @@ struct StepDiagnostics {
   long long iterations = 0;     ///< Newton iterations (explicit: sub-steps)
   long long cg_iterations = 0;
   long long factorisations = 0; ///< preconditioner = "cholesky": numeric factorisations of the tangent
-  double factor_bytes = 0;      ///< ... and the largest factor's size, bytes
+  double factor_bytes = 0;      ///< ... and the largest factor's size, bytes (two_level: the coarse factor's)
+  long long coarse_points = 0;  ///< preconditioner = "two_level": the coarse level's points (the largest)
   long long budget_steps = 0;   ///< implicit steps the iteration budget ended above the tolerance
   double residual = 0;          ///< the last Newton residual
   long long inverted_steps = 0; ///< steps that ended with inverted neighbourhoods (det F <= 0)

@@ -275,6 +275,7 @@ RunSummary Simulation::summary() {
   if (sim.solver().kind != SolverKind::EXPLICIT) s.preconditioner = std::string(enum_name(sim.solver().preconditioner));
   s.factorisations = d.factorisations;
   s.factor_bytes = d.factor_bytes;
+  s.coarse_points = d.coarse_points;
   s.budget_steps = d.budget_steps;
   s.stable_dt = sim.stable_dt();
   // a viscoelastic material's stress at the state: its history's, not the last step's in ws

@@ -46,6 +46,10 @@ std::string result_json(const Model& model, const State& state, const RunSummary
     doc["solver"]["factorisations"] = s.factorisations;
     doc["solver"]["factor_bytes"] = s.factor_bytes;
   }
+  if (s.preconditioner == "two_level") {
+    doc["solver"]["coarse_points"] = s.coarse_points;
+    doc["solver"]["factor_bytes"] = s.factor_bytes;
+  }
   doc["energy"] = {{"strain", s.strain_energy}, {"kinetic", s.kinetic_energy}};
   doc["timing"] = {{"wall_s", s.wall_s},
                    {"step_ms_mean", s.step_ms_mean},

@@ -74,9 +74,10 @@ struct RunSummary {
   double stable_dt = 0;         ///< explicit: the stable sub-step, s
   long long substeps = 0;       ///< explicit: sub-steps taken in all; static: load increments
   long long cg_iterations = 0;  ///< static, implicit: conjugate-gradient iterations in all
-  std::string preconditioner;   ///< static, implicit: "block_jacobi" or "cholesky"
+  std::string preconditioner;   ///< static, implicit: "block_jacobi", "cholesky" or "two_level"
   long long factorisations = 0; ///< cholesky: numeric factorisations of the tangent
-  double factor_bytes = 0;      ///< cholesky: the largest factor's size, bytes
+  double factor_bytes = 0;      ///< cholesky: the largest factor's size, bytes; two_level: the coarse factor's
+  long long coarse_points = 0;  ///< two_level: the coarse level's points
   long long budget_steps = 0;   ///< implicit with an iteration budget: steps it ended above the tolerance
   std::string failure;          ///< static: why it did not converge (empty when it did)
   bool interrupted = false;     ///< the run was stopped (SIGINT, SIGTERM) before its end: the state reached

@@ -2,6 +2,8 @@
 
 #include <pointhaptics/mechanics/viscoelasticity.hpp>
 
+#include <algorithm>
+
 #include <fmt/format.h>
 
 namespace pointhaptics {
@@ -48,6 +50,8 @@ StepReport ImplicitSolver::step(const Model& model, State& state, Workspace& ws,
   report.cg_iterations = stats.cg_iterations;
   report.factorisations = stats.factorisations;
   report.factor_bytes = newton_.cholesky_stats().factor_bytes;
+  report.coarse_points = newton_.coarse_points();
+  if (report.coarse_points > 0) report.factor_bytes = std::max(report.factor_bytes, newton_.coarse_stats().factor_bytes);
   report.residual = stats.residual;
   if (!stats.converged) {
     report.status = StepStatus::FAILED;

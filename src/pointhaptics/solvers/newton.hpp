@@ -93,6 +93,9 @@ class NewtonSolver {
                        int max_iterations, Workspace& ws);
   /// The Cholesky factor's size and timings (zero unless the CHOLESKY preconditioner ran).
   const CholeskyStats& cholesky_stats() const { return cholesky_.stats(); }
+  /// TWO_LEVEL: the coarse level's points (0: none in use) and its factor's size and timings.
+  index_t coarse_points() const { return two_level_ ? coarse_.n_coarse() : 0; }
+  const CholeskyStats& coarse_stats() const { return coarse_.cholesky_stats(); }
 
  private:
   /// Pi(u); `step`: the material within a viscoelastic step (viscoelasticity.hpp)

@@ -48,7 +48,8 @@ struct StepReport {
   int iterations = 0;          ///< Newton iterations (explicit: the sub-steps)
   long long cg_iterations = 0; ///< CG iterations, summed
   int factorisations = 0;      ///< preconditioner = "cholesky": numeric factorisations of the tangent
-  double factor_bytes = 0;     ///< ... and the factor's size, bytes (0: none)
+  double factor_bytes = 0;     ///< ... and the factor's size, bytes (0: none; "two_level": the coarse factor's)
+  index_t coarse_points = 0;   ///< preconditioner = "two_level": the coarse level's points (0: none)
   double residual = 0;         ///< Newton's relative residual at the end (0 for explicit steps)
   std::string failure;         ///< why the step FAILED (empty otherwise; allocated only then)
 };

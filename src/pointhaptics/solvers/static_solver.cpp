@@ -85,6 +85,8 @@ StepReport StaticSolver::step(const Model& model, State& state, Workspace& ws, D
   report.cg_iterations = stats.cg_iterations;
   report.factorisations = stats.factorisations;
   report.factor_bytes = newton_.cholesky_stats().factor_bytes;
+  report.coarse_points = newton_.coarse_points();
+  if (report.coarse_points > 0) report.factor_bytes = std::max(report.factor_bytes, newton_.coarse_stats().factor_bytes);
   report.residual = stats.residual;
   report.failure = stats.failure;
   return report;
