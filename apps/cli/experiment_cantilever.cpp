@@ -126,10 +126,11 @@ PointRun solve_point_model(const Scene& scene, int threads) {
   const auto start = std::chrono::steady_clock::now();
   Simulation sim(build_scene_model(scene), scene.solver, threads);
   sim.run(0.0);
-  const RunSummary s = sim.summary();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const RunSummary s = sim.summary();  // (a report: not timed)
   if (!s.converged) throw Error(fmt::format("point model at spacing {} did not converge: {}", scene.object.spacing, s.failure));
   PointRun r;
-  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  r.seconds = seconds;
   r.points = sim.model().n_points;
   r.h = sim.model().h;
   r.iterations = s.iterations;

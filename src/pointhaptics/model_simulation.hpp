@@ -118,7 +118,9 @@ class ModelSimulation {
   void set_state(const State& state);
   StepInputs& inputs() { return inputs_; }
   const SolverSpec& solver() const { return solver_; }
-  double stable_dt() const { return stable_dt_; }
+  /// The explicit stable step (computed at construction for explicit steps, else when first asked; from the
+  /// simulation's own thread).
+  double stable_dt() const;
   int n_threads() const { return n_threads_; }
   Workspace& workspace() { return ws_; }
 
@@ -144,7 +146,7 @@ class ModelSimulation {
   State state_;
   Workspace ws_;
   int n_threads_ = 0;
-  double stable_dt_ = 0;
+  mutable double stable_dt_ = 0;  ///< 0: not computed yet (static and implicit kinds, until stable_dt())
   Points cut_positions_;                 ///< X + u at a cut (kept: no allocation per blade step)
   std::vector<BladeSweep> blade_strips_;  ///< a blade's strips this step
   CutSheets cut_sheets_;
