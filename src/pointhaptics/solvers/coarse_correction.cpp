@@ -4,9 +4,21 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <unordered_map>
 
 namespace pointhaptics {
+
+namespace {
+// the coarse cell of x: cells of `cell` m from `low`, shifted by an eighth of a cell so that lattice points on
+// a cell's low faces fall inside it despite sampling round-off; t is x in cells
+std::uint64_t cell_key(const Vec3& x, const Vec3& low, double cell, Vec3* t_out = nullptr) {
+  const Vec3 t = (x - low) / cell + Vec3::Constant(0.125);
+  if (t_out) *t_out = t;
+  return (static_cast<std::uint64_t>(std::floor(t.x())) << 42) | (static_cast<std::uint64_t>(std::floor(t.y())) << 21) |
+         static_cast<std::uint64_t>(std::floor(t.z()));
+}
+}  // namespace
 
 double CoarseCorrection::coarsening(const Model& fine) {
   return std::max(2.0, std::cbrt(static_cast<double>(fine.n_points) / target_coarse_points));
@@ -17,8 +29,7 @@ std::vector<index_t> CoarseCorrection::coarse_points(const Model& fine) {
   if (n == 0 || !(fine.spacing > 0)) return {};
   const Vec3 low = fine.X.rowwise().minCoeff();
   const double cell = coarsening(fine) * fine.spacing;
-  // a cell of [2m s, 2(m+1) s) from the low corner keeps the point nearest its corner: on a lattice, the
-  // point of even indices (a quarter spacing of slack for sampling round-off)
+  // each cell keeps the point nearest its low corner (on a lattice at a ratio of 2: the points of even indices)
   struct Kept {
     index_t point;
     double distance;
@@ -26,9 +37,8 @@ std::vector<index_t> CoarseCorrection::coarse_points(const Model& fine) {
   std::unordered_map<std::uint64_t, Kept> kept;
   kept.reserve(static_cast<std::size_t>(n / 4));
   for (index_t i = 0; i < n; ++i) {
-    const Vec3 t = (fine.X.col(i) - low) / cell + Vec3::Constant(0.125);
-    const std::uint64_t key = (static_cast<std::uint64_t>(std::floor(t.x())) << 42) |
-                              (static_cast<std::uint64_t>(std::floor(t.y())) << 21) | static_cast<std::uint64_t>(std::floor(t.z()));
+    Vec3 t;
+    const std::uint64_t key = cell_key(fine.X.col(i), low, cell, &t);
     const double distance = (t - t.array().floor().matrix()).squaredNorm();
     auto [it, fresh] = kept.try_emplace(key, Kept{i, distance});
     if (!fresh && (distance < it->second.distance || (distance == it->second.distance && i < it->second.point))) it->second = {i, distance};
@@ -51,7 +61,7 @@ bool CoarseCorrection::build(const Model& fine) {
   selected_ = coarse_points(fine);
   const index_t n = static_cast<index_t>(selected_.size());
   if (n < 8 || n >= fine.n_points) return false;
-  // the coarse cloud: each fine point's volume goes to the coarse point nearest it (the total is kept)
+  // the coarse cloud: each fine point's volume goes to its cell's coarse point (the total is kept)
   PointCloud cloud;
   cloud.X.resize(3, n);
   for (index_t c = 0; c < n; ++c) cloud.X.col(c) = fine.X.col(selected_[c]);
@@ -65,18 +75,13 @@ bool CoarseCorrection::build(const Model& fine) {
   KernelParams kernel = fine.kernel;
   kernel.support = coarsening(fine) * fine.h;
   try {
-    // nearest coarse point of each fine point: through a provisional coarse model's neighbour search would
-    // need the model first; the cells above give it directly (the coarse point of the fine point's cell)
+    // each fine point's volume to its cell's coarse point
     const Vec3 low = fine.X.rowwise().minCoeff();
+    const double cell = coarsening(fine) * fine.spacing;
     std::unordered_map<std::uint64_t, index_t> of_cell;
     of_cell.reserve(static_cast<std::size_t>(n));
-    auto key_of = [&](const Vec3& x) {
-      const Vec3 t = (x - low) / (coarsening(fine) * fine.spacing) + Vec3::Constant(0.125);
-      return (static_cast<std::uint64_t>(std::floor(t.x())) << 42) | (static_cast<std::uint64_t>(std::floor(t.y())) << 21) |
-             static_cast<std::uint64_t>(std::floor(t.z()));
-    };
-    for (index_t c = 0; c < n; ++c) of_cell[key_of(fine.X.col(selected_[c]))] = c;
-    for (index_t i = 0; i < fine.n_points; ++i) cloud.volume[of_cell.at(key_of(fine.X.col(i)))] += fine.volume[i];
+    for (index_t c = 0; c < n; ++c) of_cell[cell_key(fine.X.col(selected_[c]), low, cell)] = c;
+    for (index_t i = 0; i < fine.n_points; ++i) cloud.volume[of_cell.at(cell_key(fine.X.col(i), low, cell))] += fine.volume[i];
     if (fine.stiffness_scale.size()) {
       cloud.stiffness_scale.resize(n);
       for (index_t c = 0; c < n; ++c) cloud.stiffness_scale[c] = fine.stiffness_scale[selected_[c]];
