@@ -61,12 +61,14 @@ namespace pointhaptics {
 namespace {
 
 // "implicit" or "implicit_viscoelastic" (the same beam with a Prony series: its history is updated each step),
-// "implicit_cholesky" (its Cholesky preconditioner: the factor made in the first step is reused)
+// "implicit_cholesky" (its Cholesky preconditioner: the factor made in the first step is reused),
+// "implicit_two_level" (the coarse level made in the first step is reused)
 Simulation beam(const std::string& kind) {
-  const bool viscous = kind.ends_with("_viscoelastic"), cholesky = kind.ends_with("_cholesky");
-  std::string text = test::cantilever_scene(viscous || cholesky ? kind.substr(0, kind.find('_')) : kind, "2e-3");
+  const bool viscous = kind.ends_with("_viscoelastic");
+  const std::string preconditioner = kind.ends_with("_cholesky") ? "cholesky" : kind.ends_with("_two_level") ? "two_level" : "";
+  std::string text = test::cantilever_scene(kind.substr(0, kind.find('_')), "2e-3");
   if (viscous) text.replace(text.find("damping"), 0, "prony = [[0.3, 0.05], [0.2, 1.0]]\n");
-  if (cholesky) text.replace(text.find("[solver]") + 9, 0, "preconditioner = \"cholesky\"\n");
+  if (!preconditioner.empty()) text.replace(text.find("[solver]") + 9, 0, "preconditioner = \"" + preconditioner + "\"\n");
   const Scene scene = parse_scene(text);
   return Simulation(build_scene_model(scene), scene.solver, 1);
 }
@@ -85,6 +87,9 @@ TEST_P(StepTest, KeepsTheStateBuffersAndAllocatesNothing) {
   if (GetParam().ends_with("_cholesky")) {
     EXPECT_EQ(sim.summary().factorisations, 1);
   }
+  if (GetParam().ends_with("_two_level")) {
+    EXPECT_GT(sim.summary().coarse_points, 8) << "the coarse level is in use";
+  }
   EXPECT_EQ(sim.state().u.data(), u) << "the displacement buffer was replaced: a NumPy view of it would go stale";
   EXPECT_EQ(sim.state().velocity.data(), v);
   if (PH_COUNTS_ALLOCATIONS) {
@@ -99,7 +104,8 @@ TEST_P(StepTest, KeepsTheStateBuffersAndAllocatesNothing) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Solvers, StepTest, ::testing::Values("explicit", "implicit", "static", "explicit_viscoelastic",
-                                                               "implicit_viscoelastic", "static_viscoelastic", "implicit_cholesky"),
+                                                               "implicit_viscoelastic", "static_viscoelastic", "implicit_cholesky",
+                                                               "implicit_two_level"),
                          [](const auto& info) { return info.param; });
 
 }  // namespace
