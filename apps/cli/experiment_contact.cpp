@@ -58,7 +58,7 @@ struct Setup {
   double top = 0;  // the top face's height, m
 };
 
-Setup setup(int per_radius, MaterialModel model, int refine, int threads, double friction = 0) {
+Setup setup(int per_radius, MaterialModel model, int refine, int threads, bool non_negative_map, double friction = 0) {
   Setup s;
   s.scene = block_scene(R / per_radius, model, refine);
   s.sim = std::make_unique<Simulation>(build_scene_model(s.scene), s.scene.solver, threads);
@@ -66,6 +66,7 @@ Setup setup(int per_radius, MaterialModel model, int refine, int threads, double
   s.top = s.surface.mesh.V.row(1).maxCoeff();
   SurfaceContactParams contact;
   contact.friction = friction;
+  contact.non_negative_weights = non_negative_map;
   s.sim->hold_tool(ToolShape{ToolKind::SPHERE, R, 0}, ToolPose{Vec3(0, s.top + 2 * R, 0), Eigen::Quaterniond::Identity()},
                    s.surface.mesh, s.surface.map, contact);
   return s;
@@ -164,7 +165,7 @@ int run_contact_experiment(const ContactOptions& options) {
   std::string table, sliding_table, offsets, goal;
   for (const auto& [n, refine] : samplings) {
     const std::string label = refine > 0 ? fmt::format("R/{} (R/{} near the contact)", n, refine) : fmt::format("R/{}", n);
-    Setup s = setup(n, *model, refine, options.threads);
+    Setup s = setup(n, *model, refine, options.threads, options.surface_map == "non_negative");
     double worst = 0;  // the largest |force / CalculiX - 1| from 0.1 R to 0.3 R
     Simulation& sim = *s.sim;
     HeldTool& tool = *sim.held_tool();
@@ -242,7 +243,7 @@ int run_contact_experiment(const ContactOptions& options) {
   for (const auto& [sampling, steps] : friction_runs) {
     const auto [n, refine] = sampling;
     const std::string label = refine > 0 ? fmt::format("R/{} (R/{} near the contact)", n, refine) : fmt::format("R/{}", n);
-    Setup s = setup(n, *model, refine, options.threads, options.friction);
+    Setup s = setup(n, *model, refine, options.threads, options.surface_map == "non_negative", options.friction);
     Simulation& sim = *s.sim;
     HeldTool& tool = *sim.held_tool();
     const double spacing = R / n, height = s.top + R - 0.1 * R;
@@ -293,7 +294,7 @@ int run_contact_experiment(const ContactOptions& options) {
            "Block {} x {} x {} mm (E = {:.0e} Pa, nu = {}, {}, bottom held), a rigid frictionless sphere of "
            "radius R = {} mm pressed into the middle of its top face through the object's surface (its exact boundary at "
            "half the spacing, carried by the points), solved statically at each depth (the contact by an augmented "
-           "Lagrangian: no surface vertex more than 1e-4 R inside the sphere).\n\n"
+           "Lagrangian: no surface vertex more than 1e-4 R inside the sphere; the contact's surface map: {}).\n\n"
            "## The reference: CalculiX\n\n"
            "An axisymmetric model (CAX8, geometrically nonlinear, the same material) of a cylinder of the block's half "
            "width and height, bottom held, and a rigid sphere (a layer of elements 10^4 times stiffer, moved by its inner "
@@ -323,7 +324,8 @@ int run_contact_experiment(const ContactOptions& options) {
            "as the steps shorten:\n\n"
            "| sampling | steps per spacing (step) | mu | nudged: friction / pressure | sliding: friction / pressure | sliding: drag / normal | solve per step (s) |\n"
            "|---|---|---|---|---|---|---|\n{}\n",
-           1e3 * width, 1e3 * height, 1e3 * width, young, poisson, options.material, 1e3 * R, depth_header, depth_rule, fem_table,
+           1e3 * width, 1e3 * height, 1e3 * width, young, poisson, options.material, 1e3 * R, options.surface_map, depth_header,
+           depth_rule, fem_table,
            table, goal, offsets, sliding_table, friction_table);
   md.close();
   if (run_plot_script("plot_contact.py", out.string(), options.plot_script) != 0) return 1;

@@ -15,6 +15,9 @@ struct ContactOptions {
   /// the block's material: neo-Hookean by default (St. Venant-Kirchhoff collapses under the sphere past
   /// about 0.2 R in CalculiX and in the point model alike)
   std::string material = "neo_hookean";
+  /// the contact's surface map: "exact" or "non_negative" (its negative weights left out; a scene's
+  /// `[probe] surface_map`)
+  std::string surface_map = "exact";
   /// CalculiX's element sizes at the contact, R / n: the last one is the reference, the others show its
   /// convergence (quick: 10 only)
   std::vector<int> fem_per_radius{10, 20, 40};

@@ -399,6 +399,8 @@ int main(int argc, char** argv) {
   contact_cmd->add_option("--threads", contact.threads, "Threads (0: all)")->check(CLI::NonNegativeNumber);
   contact_cmd->add_option("--refine", contact.refine,
                           "The first spacing once more with points at R / n near the contact ([[refine]]; default 8, 0: none)")->check(CLI::Range(0, 64));
+  contact_cmd->add_option("--surface-map", contact.surface_map, "The contact's surface map: exact (default) | non_negative ([probe] surface_map)")
+      ->check(CLI::IsMember({"exact", "non_negative"}));
   contact_cmd->add_option("--friction", contact.friction, "Coulomb's coefficient of the friction run (default 0.3)")
       ->check(CLI::Range(0.01, 2.0));
   contact_cmd->add_option("--drag-steps", contact.drag_steps,

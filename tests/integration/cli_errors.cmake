@@ -43,3 +43,7 @@ execute_process(COMMAND ${EXE} run ${WORK}/does-not-exist.toml RESULT_VARIABLE r
 if(rc EQUAL 0 OR NOT err MATCHES "does-not-exist.toml")
   message(FATAL_ERROR "missing scene file: ${err}")
 endif()
+execute_process(COMMAND ${EXE} experiment contact --out ${WORK}/contact --surface-map nearest RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET TIMEOUT 60)
+if(rc EQUAL 0 OR NOT err MATCHES "surface-map")
+  message(FATAL_ERROR "an unknown contact surface map: ${err}")
+endif()
