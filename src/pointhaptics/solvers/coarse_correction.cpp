@@ -10,14 +10,20 @@
 namespace pointhaptics {
 
 namespace {
-// the coarse cell of x: cells of `cell` m from `low`, shifted by an eighth of a cell so that lattice points on
-// a cell's low faces fall inside it despite sampling round-off; t is x in cells
-std::uint64_t cell_key(const Vec3& x, const Vec3& low, double cell, Vec3* t_out = nullptr) {
-  const Vec3 t = (x - low) / cell + Vec3::Constant(0.125);
-  if (t_out) *t_out = t;
-  return (static_cast<std::uint64_t>(std::floor(t.x())) << 42) | (static_cast<std::uint64_t>(std::floor(t.y())) << 21) |
-         static_cast<std::uint64_t>(std::floor(t.z()));
-}
+// The coarse cells of a fine model: coarsening() spacings wide from its low corner.
+struct Cells {
+  Vec3 low;
+  double size;
+  explicit Cells(const Model& fine) : low(fine.X.rowwise().minCoeff()), size(CoarseCorrection::coarsening(fine) * fine.spacing) {}
+  // the cell of x, shifted by an eighth of a cell so that lattice points on a cell's low faces fall inside it
+  // despite sampling round-off; t is x in cells
+  std::uint64_t key(const Vec3& x, Vec3* t_out = nullptr) const {
+    const Vec3 t = (x - low) / size + Vec3::Constant(0.125);
+    if (t_out) *t_out = t;
+    return (static_cast<std::uint64_t>(std::floor(t.x())) << 42) | (static_cast<std::uint64_t>(std::floor(t.y())) << 21) |
+           static_cast<std::uint64_t>(std::floor(t.z()));
+  }
+};
 }  // namespace
 
 double CoarseCorrection::coarsening(const Model& fine) {
@@ -27,8 +33,7 @@ double CoarseCorrection::coarsening(const Model& fine) {
 std::vector<index_t> CoarseCorrection::coarse_points(const Model& fine) {
   const index_t n = fine.n_points;
   if (n == 0 || !(fine.spacing > 0)) return {};
-  const Vec3 low = fine.X.rowwise().minCoeff();
-  const double cell = coarsening(fine) * fine.spacing;
+  const Cells cells(fine);
   // each cell keeps the point nearest its low corner (on a lattice at a ratio of 2: the points of even indices)
   struct Kept {
     index_t point;
@@ -38,7 +43,7 @@ std::vector<index_t> CoarseCorrection::coarse_points(const Model& fine) {
   kept.reserve(static_cast<std::size_t>(n / 4));
   for (index_t i = 0; i < n; ++i) {
     Vec3 t;
-    const std::uint64_t key = cell_key(fine.X.col(i), low, cell, &t);
+    const std::uint64_t key = cells.key(fine.X.col(i), &t);
     const double distance = (t - t.array().floor().matrix()).squaredNorm();
     auto [it, fresh] = kept.try_emplace(key, Kept{i, distance});
     if (!fresh && (distance < it->second.distance || (distance == it->second.distance && i < it->second.point))) it->second = {i, distance};
@@ -62,26 +67,25 @@ bool CoarseCorrection::build(const Model& fine) {
   const index_t n = static_cast<index_t>(selected_.size());
   if (n < 8 || n >= fine.n_points) return false;
   // the coarse cloud: each fine point's volume goes to its cell's coarse point (the total is kept)
+  const double ratio = coarsening(fine);
   PointCloud cloud;
   cloud.X.resize(3, n);
   for (index_t c = 0; c < n; ++c) cloud.X.col(c) = fine.X.col(selected_[c]);
-  cloud.spacing = coarsening(fine) * fine.spacing;
+  cloud.spacing = ratio * fine.spacing;
   cloud.surface.assign(static_cast<std::size_t>(n), 0);
   cloud.volume = Eigen::VectorXd::Zero(n);
   if (fine.support.size()) {
     cloud.support.resize(n);
-    for (index_t c = 0; c < n; ++c) cloud.support[c] = coarsening(fine) * fine.support[selected_[c]];
+    for (index_t c = 0; c < n; ++c) cloud.support[c] = ratio * fine.support[selected_[c]];
   }
   KernelParams kernel = fine.kernel;
-  kernel.support = coarsening(fine) * fine.h;
+  kernel.support = ratio * fine.h;
   try {
-    // each fine point's volume to its cell's coarse point
-    const Vec3 low = fine.X.rowwise().minCoeff();
-    const double cell = coarsening(fine) * fine.spacing;
+    const Cells cells(fine);
     std::unordered_map<std::uint64_t, index_t> of_cell;
     of_cell.reserve(static_cast<std::size_t>(n));
-    for (index_t c = 0; c < n; ++c) of_cell[cell_key(fine.X.col(selected_[c]), low, cell)] = c;
-    for (index_t i = 0; i < fine.n_points; ++i) cloud.volume[of_cell.at(cell_key(fine.X.col(i), low, cell))] += fine.volume[i];
+    for (index_t c = 0; c < n; ++c) of_cell[cells.key(fine.X.col(selected_[c]))] = c;
+    for (index_t i = 0; i < fine.n_points; ++i) cloud.volume[of_cell.at(cells.key(fine.X.col(i)))] += fine.volume[i];
     if (fine.stiffness_scale.size()) {
       cloud.stiffness_scale.resize(n);
       for (index_t c = 0; c < n; ++c) cloud.stiffness_scale[c] = fine.stiffness_scale[selected_[c]];
