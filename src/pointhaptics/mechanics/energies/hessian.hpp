@@ -84,8 +84,9 @@ struct PowerOfJ {
       value = g + g1 * s + 0.5 * g2 * s * s, first = g1 + g2 * s, second = g2;
     }
   }
-  /// j^-p: the deviatoric invariants' powers (2/3, 4/3) through one cube root, which costs a third of a
-  /// std::pow (the explicit step's stiffening check runs it at every point of every step).
+  /// j^-p: the deviatoric invariants' powers (2/3, 4/3, the only ones the materials pass) through one cube
+  /// root instead of a std::pow, for the one-point forms (the Hessian's linearisation, lanes below the
+  /// floor); the force loop and the stiffening check use lanes.hpp's inverse_cube_root.
   static double power(double j, double p) {
     if (p == 2.0 / 3.0 || p == 4.0 / 3.0) {
       const double r = 1 / std::cbrt(j), r2 = r * r;
