@@ -146,9 +146,22 @@ SurfaceMap without_negative_weights(SurfaceMap map) {
   return map;
 }
 
+// The carry's transpose, padded the same way: it runs at every CG iteration of the two-level preconditioner
+// (P^T r), where the three-scalar loop was a fifth of the preconditioner's cost
 void spread_surface_forces(const SurfaceMap& map, const Points& f_vertices, Points& f_points) {
-  for (index_t v = 0; v < map.n_vertices(); ++v)
-    for (index_t e = map.points.begin(v); e < map.points.end(v); ++e) f_points.col(map.points.index[e]) += map.weight[e] * f_vertices.col(v);
+  thread_local std::vector<Lanes> padded;  // grown once per thread, reused: no allocation per spread
+  padded.assign(static_cast<std::size_t>(f_points.cols()), Lanes{});
+  const index_t* point = map.points.index.data();
+  const double* weight = map.weight.data();
+  Lanes* force = padded.data();
+  for (index_t v = 0; v < map.n_vertices(); ++v) {
+    const Lanes f{f_vertices(0, v), f_vertices(1, v), f_vertices(2, v), 0.0};
+    for (index_t e = map.points.begin(v); e < map.points.end(v); ++e) force[point[e]] += weight[e] * f;
+  }
+  for (index_t j = 0; j < f_points.cols(); ++j) {
+    const Lanes& sum = padded[static_cast<std::size_t>(j)];
+    f_points.col(j) += Vec3(sum[0], sum[1], sum[2]);
+  }
 }
 
 }  // namespace pointhaptics
