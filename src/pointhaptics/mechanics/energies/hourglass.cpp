@@ -54,9 +54,15 @@ double hourglass_coefficient(const Model& model, index_t i, index_t e, double we
 void build_hourglass(Model& model, const std::vector<double>& weight_sum) {
   const Csr& nbr = model.neighbours;
   const index_t n = model.n_points;
+  // k_ji = k_ij to the bit (the formula is symmetric term by term), so each pair is computed once, from its
+  // lower end, and copied to its reverse: no two iterations write one slot
   tbb::parallel_for(index_t{0}, n, [&](index_t i) {
-    for (index_t e = nbr.begin(i); e < nbr.end(i); ++e)
-      model.hg_coef[e] = hourglass_coefficient(model, i, e, weight_sum[i], weight_sum[nbr.index[e]]);
+    for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
+      const index_t j = nbr.index[e];
+      if (j < i) continue;
+      model.hg_coef[e] = hourglass_coefficient(model, i, e, weight_sum[i], weight_sum[j]);
+      model.hg_coef[model.reverse_pair[e]] = model.hg_coef[e];
+    }
   });
   model.hg_diagonal = Eigen::VectorXd::Zero(n);
   if (!(model.material.hourglass > 0)) return;
@@ -71,7 +77,9 @@ void build_hourglass(Model& model, const std::vector<double>& weight_sum) {
     diagonal = Eigen::VectorXd::Zero(n);
     PairWeights pair{std::vector<double>(n, 0.0), {}};
     for (index_t i = b * n / blocks; i < (b + 1) * n / blocks; ++i)
-      for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) add_pair_diagonal(model, i, e, 1.0, pair, diagonal.data());
+      // r_ji = -r_ij and k_ji = k_ij, so a pair's reverse adds the same squares: each pair once, twice over
+      for (index_t e = nbr.begin(i); e < nbr.end(i); ++e)
+        if (nbr.index[e] > i) add_pair_diagonal(model, i, e, 2.0, pair, diagonal.data());
   });
   for (const Eigen::VectorXd& diagonal : diagonals) model.hg_diagonal += diagonal;
 }
