@@ -31,6 +31,7 @@ SceneSession open_scene(Scene scene, const SessionOptions& options) {
     SurfaceContactParams contact;
     contact.friction = scene.probe.friction;
     contact.non_negative_weights = scene.probe.non_negative_surface_map;
+    contact.sample_spacing = scene.probe.sample_spacing;
     s.simulation->hold_tool(shape, ToolPose{scene.probe.position, Eigen::Quaterniond(q[0], q[1], q[2], q[3])}, surface.mesh, surface.map,
                             contact);
   } else if (scene.probe.present) {
@@ -85,6 +86,7 @@ InteractiveOptions scene_interactive_options(const Scene& scene, const Model& mo
   o.probe.stiffness = scene.probe.stiffness;
   o.probe.object_stiffness = scene.probe.object_stiffness;
   o.probe.non_negative_surface_map = scene.probe.non_negative_surface_map;
+  o.probe.sample_spacing = scene.probe.sample_spacing;
   o.probe.friction = scene.probe.friction;
   o.probe.length = scene.probe.capsule ? scene.probe.length : 0.0;
   const auto& q = scene.probe.orientation;

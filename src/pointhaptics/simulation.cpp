@@ -126,6 +126,7 @@ void Simulation::attach_probe(const ProbeParams& params, double coupling_stiffne
   contact.max_point_stiffness = sim.model().material.young * sim.model().spacing;
   contact.friction = params.friction;
   contact.non_negative_weights = params.non_negative_surface_map;
+  contact.sample_spacing = params.sample_spacing;
   // friction's penalty a tenth of the normal one (SurfaceContactParams::tangential_share): sliding, the
   // friction then measured 0.288 of the pressure for mu = 0.3 (0.286 with a hundredth, where new contacts
   // stuck for tens of steps; the full penalty made explicit steps chatter: 0.217)
@@ -133,7 +134,11 @@ void Simulation::attach_probe(const ProbeParams& params, double coupling_stiffne
   if (surface && lod_) {
     // every active set's part of the surface presses as the whole surface does on the object's points (after a
     // cut, as the unsplit one did: the split adds vertices only along the cut, the one place this is approximate)
-    const SurfaceContact whole(lod_->object_model(), surface->mesh, surface->map, probe_shape(params), contact);
+    // (without samples: only its penalty and its points' stiffness are wanted, and a thin tool would sample the
+    // whole object's surface; the parts' samples press no stiffer on a point than their vertices would)
+    SurfaceContactParams whole_params = contact;
+    whole_params.sample_spacing = -1;
+    const SurfaceContact whole(lod_->object_model(), surface->mesh, surface->map, probe_shape(params), whole_params);
     contact.penalty = whole.per_area_penalty();
     contact.object_point_stiffness = std::make_shared<const std::vector<double>>(whole.point_stiffness(lod_->object_model().n_points));
   }

@@ -91,13 +91,15 @@ struct SurfaceProbe {
   ProbeParams params;
   ProbeTool tool;
   /// the contact's penalty capped as a simulation caps it (E x spacing per point)
-  SurfaceProbe(double radius, double edge, double k)
+  /// (sample_spacing: SurfaceContactParams's; negative, the surface's vertices only)
+  SurfaceProbe(double radius, double edge, double k, double sample_spacing = 0)
       : model(build_model(sample_box(Vec3::Zero(), Vec3(0.04, 0.02, 0.04), 0.005), MaterialParams{}, KernelParams{})),
         mesh(box_surface(Vec3::Zero(), Vec3(0.04, 0.02, 0.04), edge)), params(with_radius(radius)),
         tool(model, params, k, 10.0,
-             SurfaceContact(model, mesh, build_surface_map(model, mesh.V), probe_shape(params), capped(model))) {}
-  static SurfaceContactParams capped(const Model& model) {
+             SurfaceContact(model, mesh, build_surface_map(model, mesh.V), probe_shape(params), capped(model, sample_spacing))) {}
+  static SurfaceContactParams capped(const Model& model, double sample_spacing) {
     SurfaceContactParams p;
+    p.sample_spacing = sample_spacing;
     p.max_point_stiffness = model.material.young * model.spacing;
     return p;
   }
@@ -109,9 +111,10 @@ struct SurfaceProbe {
 };
 
 // A face of two triangles 4 cm across and a probe of 3 mm: pushed down through the face's middle, no vertex
-// comes inside the probe, and only the test of its centre's path keeps it from going through.
+// comes inside the probe, and only the test of its centre's path keeps it from going through (the contact
+// without its samples on the triangles, which would otherwise catch it first).
 TEST(ProbeTool, OnTheSurfaceAPushIsNotTakenThroughAFaceBetweenItsVertices) {
-  SurfaceProbe s(0.003, 0.04, 300);
+  SurfaceProbe s(0.003, 0.04, 300, -1);
   const State state = State::at_rest(s.model);
   const Vec3 above(0.012, 0.02 + 0.004, 0.021), deep(0.012, 0.002, 0.021);
   s.tool.place(s.model, state, above, false);

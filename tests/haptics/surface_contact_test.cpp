@@ -116,6 +116,73 @@ TEST(SurfaceContact, ForcesAreTheEnergyGradientAndTheTangentTheirDerivative) {
   }
 }
 
+// A tool narrower than the surface's triangles (a 1 mm sphere over 2.5 mm edges, 3.5 mm diagonals: a sphere
+// fits through a triangle whose circumradius exceeds its radius): centred over a diagonal's midpoint, 1.77 mm
+// from the nearest vertices, it touches none of them. The contact's samples on the triangles (two splits, to
+// edges of at most its radius) carry the surface there, and the forces stay the energy's gradient.
+TEST(SurfaceContact, ASphereNarrowerThanTheTrianglesPressesOnTheirSamples) {
+  const Block b = block();
+  const SurfaceMap map = build_surface_map(b.model, b.surface.V);
+  const ToolShape thin{ToolKind::SPHERE, 0.001, 0};
+  const ToolPose pressed{Vec3(0.02 + 0.00125, 0.02 + 0.001 - 0.0002, 0.02 + 0.00125), Eigen::Quaterniond::Identity()};
+  const Points u = random_field(b.model.n_points, 1e-6, 3);
+  SurfaceContactParams vertices_only;
+  vertices_only.sample_spacing = -1;
+  SurfaceContact without(b.model, b.surface, map, thin, vertices_only);
+  without.set_pose(pressed);
+  EXPECT_EQ(without.sample_levels(), 0);
+  EXPECT_EQ(without.load(b.model, u).contacts, 0);  // it sinks 0.2 mm into the face unfelt
+  SurfaceContact contact(b.model, b.surface, map, thin);
+  contact.set_pose(pressed);
+  EXPECT_EQ(contact.sample_levels(), 2);
+  EXPECT_EQ(contact.surface_vertices(), b.surface.V.cols());
+  const ToolLoad load = contact.load(b.model, u);
+  EXPECT_GT(load.contacts, 0);
+  EXPECT_NEAR(load.penetration, 0.0002, 2e-5);  // the sample under it is on the face
+  EXPECT_GT(load.force.y(), 0);
+  ASSERT_FALSE(contact.update_multipliers(b.model, u));
+  Points f = Points::Zero(3, b.model.n_points);
+  contact.add_forces(b.model, u, f);
+  EXPECT_LT((contact.last_load().force + f.rowwise().sum()).norm(), 1e-9 * contact.last_load().force.norm());
+  expect_forces_are_the_gradient_and_the_tangent_their_derivative(contact, b.model, u, f);
+}
+
+// Held in a static solve, the thin sphere pushes the face down by its depth and no sample ends inside it
+// beyond the tolerance; the same sphere over the vertices only is not held at all.
+TEST(SurfaceContact, StaticIndentationByASphereNarrowerThanTheTrianglesMeetsTheConstraint) {
+  for (const bool samples : {true, false}) {
+    SCOPED_TRACE(samples ? "with samples" : "vertices only");
+    Block b = block(true);
+    const TriangleMesh surface = b.surface;
+    SolverSpec spec;
+    spec.kind = SolverKind::STATIC;
+    Simulation sim(std::move(b.model), spec, 2);
+    const double radius = 0.001, depth = 0.0002;
+    SurfaceContactParams params;
+    if (!samples) params.sample_spacing = -1;
+    sim.hold_tool(ToolShape{ToolKind::SPHERE, radius, 0},
+                  ToolPose{Vec3(0.02 + 0.00125, 0.02 + radius - depth, 0.02 + 0.00125), Eigen::Quaterniond::Identity()}, surface,
+                  build_surface_map(sim.model(), surface.V), params);
+    ASSERT_EQ(sim.step().status, StepStatus::CONVERGED);
+    const RunSummary s = sim.summary();
+    ASSERT_TRUE(s.tool.present);
+    if (!samples) {
+      EXPECT_EQ(s.tool.force.norm(), 0.0);
+      continue;
+    }
+    EXPECT_GT(s.tool.force.y(), 0);
+    EXPECT_NEAR(s.reactions[0].y(), s.tool.force.y(), 1e-4 * s.tool.force.y());
+    EXPECT_LT(s.tool.penetration, 0.01 * depth);
+    // the sample under the sphere went down by the depth: the face follows the tool between its vertices
+    const SurfaceContact& contact = sim.held_tool()->contact();
+    double under = NAN;
+    for (index_t v = contact.surface_vertices(); v < contact.vertices().cols(); ++v)
+      if (std::hypot(contact.vertices()(0, v) - 0.02125, contact.vertices()(2, v) - 0.02125) < 1e-5 && contact.vertices()(1, v) > 0.01)
+        under = contact.vertices()(1, v);
+    EXPECT_NEAR(under, 0.02 - depth, 0.01 * depth);
+  }
+}
+
 // limit_point_stiffness (a level of detail's part of the surface pressing as the whole one does): every point
 // ends at most at max(its limit, the cap), no point softer than the uniform lowering to the cap left it, and a
 // vertex whose points are all within their limits keeps its penalty.

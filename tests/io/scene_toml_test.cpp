@@ -439,6 +439,16 @@ TEST(SceneToml, TheContactsSurfaceMapIsChosen) {
   expect_probe_choice("surface_map", "non_negative", [](const ProbeSpec& p) { return p.non_negative_surface_map; });
 }
 
+// The contact's samples along the surface's edges: the tool's radius by default (0), a spacing given in m,
+// and one that is not positive named.
+TEST(SceneToml, TheContactsSampleSpacingIsGiven) {
+  const std::string text = std::string(full_scene) + held_tool_section;
+  EXPECT_EQ(parse_scene(text, "t.toml", ".").probe.sample_spacing, 0.0);
+  EXPECT_EQ(parse_scene(text + "sample_spacing = 0.002\n", "t.toml", ".").probe.sample_spacing, 0.002);
+  const std::string error = error_of("friction = 0.3", "friction = 0.3\nsample_spacing = 0.0", text);
+  EXPECT_NE(error.find("probe.sample_spacing: 0 is out of range: must be > 0"), std::string::npos) << error;
+}
+
 TEST(SceneToml, AHeldToolPressesAlongItsDirection) {
   std::string text = std::string(full_scene) + held_tool_section;
   EXPECT_EQ(parse_scene(text, "t.toml", ".").probe.direction, Vec3(0, -1, 0));  // the default

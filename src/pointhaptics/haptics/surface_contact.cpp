@@ -7,23 +7,51 @@
 
 #include <algorithm>
 #include <cmath>
+#include <unordered_map>
 
 namespace pointhaptics {
 
 namespace {
 double largest(const std::vector<double>& x) { return x.empty() ? 0.0 : *std::max_element(x.begin(), x.end()); }
+
+/// The map the contact carries its vertices by: the surface's, checked against it first (the samples index it)
+SurfaceMap contact_map(const TriangleMesh& mesh, SurfaceMap map, const SurfaceContactParams& params) {
+  if (map.n_vertices() != mesh.V.cols()) throw Error("tool: the surface map is for another surface");
+  return params.non_negative_weights ? without_negative_weights(std::move(map)) : map;
+}
+
+std::vector<std::uint64_t> identity_ids(index_t n) {
+  std::vector<std::uint64_t> ids(static_cast<std::size_t>(n));
+  for (index_t v = 0; v < n; ++v) ids[static_cast<std::size_t>(v)] = static_cast<std::uint64_t>(v);
+  return ids;
+}
 }  // namespace
 
 SurfaceContact::SurfaceContact(const Model& model, const TriangleMesh& mesh, SurfaceMap map, const ToolShape& shape,
                                const SurfaceContactParams& params)
-    : Y_(mesh.V), y_(mesh.V), triangles_(mesh.F), map_(params.non_negative_weights ? without_negative_weights(std::move(map)) : std::move(map)), shape_(shape) {
+    : SurfaceContact(model, mesh,
+                     contact_samples(mesh, contact_map(mesh, std::move(map), params),
+                                     params.sample_spacing != 0 ? params.sample_spacing : shape.radius),
+                     shape, params) {}
+
+SurfaceContact::SurfaceContact(const Model& model, const TriangleMesh& surface, ContactSamples samples, const ToolShape& shape,
+                               const SurfaceContactParams& params)
+    : Y_(std::move(samples.mesh.V)),
+      y_(Y_),
+      triangles_(surface.F),
+      parents_(std::move(samples.parents)),
+      keys_(contact_sample_keys(identity_ids(static_cast<index_t>(surface.V.cols())), parents_)),
+      n_surface_(static_cast<index_t>(surface.V.cols())),
+      sample_levels_(samples.levels),
+      map_(std::move(samples.map)),
+      shape_(shape) {
   if (!(shape.radius > 0) || !std::isfinite(shape.radius)) throw Error("tool: radius must be positive (m)");
   if (!(shape.length >= 0) || !std::isfinite(shape.length)) throw Error("tool: length must be >= 0 (m)");
-  if (map_.n_vertices() != Y_.cols()) throw Error("tool: the surface map is for another surface");
   const index_t m = static_cast<index_t>(Y_.cols());
-  // a vertex stands for a third of its triangles' area: the penalty is a pressure per unit penetration
+  // a vertex stands for a third of its triangles' area (the split ones, samples included): the penalty is a
+  // pressure per unit penetration
   std::vector<double> area(static_cast<std::size_t>(m), 0.0);
-  for (const auto& t : mesh.F) {
+  for (const auto& t : samples.mesh.F) {
     const double a = 0.5 * (Y_.col(t[1]) - Y_.col(t[0])).cross(Y_.col(t[2]) - Y_.col(t[0])).norm();
     for (const index_t v : t) area[static_cast<std::size_t>(v)] += a / 3.0;
   }
@@ -74,7 +102,18 @@ void SurfaceContact::limit_point_stiffness(std::span<const double> limit, double
   max_point_stiffness_ = largest(point_stiffness(static_cast<index_t>(limit.size())));
 }
 
-void SurfaceContact::evaluate(const Points& u) { carry_surface(map_, Y_, u, y_); }
+void SurfaceContact::evaluate(const Points& u) {
+  // the surface's vertices by the map, then each sample as the mean of its ends (its row is their rows' mean:
+  // the same position, for two additions instead of its row's weights)
+  carry_surface(map_, Y_, u, y_, n_surface_);
+  for (std::size_t k = 0; k < parents_.size(); ++k)
+    y_.col(n_surface_ + static_cast<index_t>(k)) = 0.5 * (y_.col(parents_[k][0]) + y_.col(parents_[k][1]));
+}
+
+void SurfaceContact::set_vertex_ids(const std::vector<index_t>& ids) {
+  if (static_cast<index_t>(ids.size()) != n_surface_) throw Error("tool: one id per vertex of the surface");
+  keys_ = contact_sample_keys(std::vector<std::uint64_t>(ids.begin(), ids.end()), parents_);
+}
 
 double SurfaceContact::energy(const Model&, const Points& u) {
   evaluate(u);
@@ -324,16 +363,14 @@ ToolLoad SurfaceContact::advance_multipliers(double rate, double max_force) {
 }
 
 void SurfaceContact::take_multipliers(const SurfaceContact& other) {
-  const auto id = [](const SurfaceContact& c, index_t v) { return c.ids_.empty() ? v : c.ids_[static_cast<std::size_t>(v)]; };
-  index_t n = 0;
-  for (index_t v = 0; v < other.y_.cols(); ++v) n = std::max(n, id(other, v) + 1);
-  std::vector<index_t> of_id(static_cast<std::size_t>(n), -1);  // object vertex -> the other's vertex
-  for (index_t v = 0; v < other.y_.cols(); ++v) of_id[static_cast<std::size_t>(id(other, v))] = v;
-  for (index_t v = 0; v < y_.cols(); ++v) {
-    const index_t object = id(*this, v);
-    const index_t o = object < n ? of_id[static_cast<std::size_t>(object)] : -1;
-    lambda_[static_cast<std::size_t>(v)] = o < 0 ? 0.0 : other.lambda_[static_cast<std::size_t>(o)];
-    if (!anchors_.empty()) anchors_[static_cast<std::size_t>(v)] = o < 0 || other.anchors_.empty() ? Anchor{} : other.anchors_[static_cast<std::size_t>(o)];
+  std::unordered_map<std::uint64_t, index_t> of_key;  // a vertex's or sample's key -> the other's vertex
+  of_key.reserve(other.keys_.size());
+  for (std::size_t v = 0; v < other.keys_.size(); ++v) of_key.emplace(other.keys_[v], static_cast<index_t>(v));
+  for (std::size_t v = 0; v < keys_.size(); ++v) {
+    const auto found = of_key.find(keys_[v]);
+    const index_t o = found == of_key.end() ? -1 : found->second;
+    lambda_[v] = o < 0 ? 0.0 : other.lambda_[static_cast<std::size_t>(o)];
+    if (!anchors_.empty()) anchors_[v] = o < 0 || other.anchors_.empty() ? Anchor{} : other.anchors_[static_cast<std::size_t>(o)];
   }
 }
 

@@ -20,6 +20,7 @@
 #include <pointhaptics/core/model.hpp>
 #include <pointhaptics/geometry/mesh_distance.hpp>
 #include <pointhaptics/geometry/triangle_mesh.hpp>
+#include <pointhaptics/haptics/contact_samples.hpp>
 #include <pointhaptics/haptics/tool_shape.hpp>
 #include <pointhaptics/mechanics/surface_map.hpp>
 #include <pointhaptics/solvers/newton.hpp>
@@ -67,6 +68,12 @@ struct SurfaceContactParams {
   /// diverged at 2.2 s of its deterministic run; with this map it is calm). Not the default: on the coarse
   /// soft dome (a probe 1.5 spacings wide) its real-time soak diverged in 2 of 3 runs (docs/haptics.md).
   bool non_negative_weights = false;
+  /// Largest distance between the contact's samples along the surface's edges, m (0: the tool's radius).
+  /// Longer edges get samples at their midpoints (haptics/contact_samples.hpp), so that the tool cannot pass
+  /// between the surface's vertices: a sphere fits through a triangle whose circumradius (edge / sqrt 3 when
+  /// equilateral) exceeds its radius, so edges of one radius leave a margin for the surface's stretching and
+  /// let the tool in by at most 0.18 of its radius before a sample touches. Negative: the vertices only.
+  double sample_spacing = 0;
 };
 
 /// What the object does to the tool.
@@ -74,7 +81,7 @@ struct ToolLoad {
   Vec3 force = Vec3::Zero();   ///< N, on the tool, scene axes
   Vec3 friction = Vec3::Zero();  ///< N: the part of `force` friction makes (the rest is the normal pressure's)
   Vec3 torque = Vec3::Zero();  ///< N m, about the tool's position
-  int contacts = 0;            ///< vertices pressing on it
+  int contacts = 0;            ///< vertices (and samples, SurfaceContactParams::sample_spacing) pressing on it
   double penetration = 0;      ///< deepest vertex inside the tool, m (0: none)
   /// d force / d tool position with the object held still, N/m: -sum_v k_v n_v n_v^T over the pressing
   /// vertices (negative semi-definite; the tool's curvature term, which would make it indefinite, left out)
@@ -120,9 +127,9 @@ class SurfaceContact final : public EnergyTerm {
   const ToolLoad& last_load() const { return last_load_; }
   /// The point that carries most of each vertex pressing on the tool at the last evaluation (out is cleared).
   void pressing_points(std::vector<index_t>& out) const;
-  /// The object surface's vertex each of this contact's vertices is (a part of the surface, with levels of
-  /// detail; empty: the whole surface, in its order).
-  void set_vertex_ids(std::vector<index_t> ids) { ids_ = std::move(ids); }
+  /// The object surface's vertex each of the surface's vertices given to the constructor is (a part of the
+  /// surface, with levels of detail; by default the whole surface, in its order): the samples' keys follow.
+  void set_vertex_ids(const std::vector<index_t>& ids);
   /// The multipliers and anchors of `other` (the same tool on another part of the same object surface, or
   /// the same part over other points) for the vertices both have: a new active set keeps the proxy's force.
   void take_multipliers(const SurfaceContact& other);
@@ -147,8 +154,12 @@ class SurfaceContact final : public EnergyTerm {
   /// presses at most max(limit_j, cap), and no vertex softer than a uniform lowering would make it (cap <= 0:
   /// no cap, and nothing is lowered).
   void limit_point_stiffness(std::span<const double> limit, double cap);
-  /// The deformed vertices of the last evaluation.
+  /// The deformed vertices of the last evaluation: the surface's, then the samples.
   const Points& vertices() const { return y_; }
+  /// How many of them are the surface's own vertices (the rest are samples on its triangles).
+  index_t surface_vertices() const { return n_surface_; }
+  /// How many times the surface's triangles were split for the samples (0: none).
+  int sample_levels() const { return sample_levels_; }
   /// Whether the segment from-to enters the surface as the last evaluation carried it: crosses a triangle
   /// from its outer side to its inner one. The tool's core may not (the god-object's rule): a tool that has
   /// pushed a coarse surface's vertices aside can hold none inside it, and so pass through unseen.
@@ -194,15 +205,21 @@ class SurfaceContact final : public EnergyTerm {
   template <class Pressing>
   ToolLoad for_each_pressing(const Pressing& pressing) const;
 
-  Points Y_, y_;
+  SurfaceContact(const Model& model, const TriangleMesh& surface, ContactSamples samples, const ToolShape& shape,
+                 const SurfaceContactParams& params);
+
+  Points Y_, y_;                                   // the surface's vertices, then the samples
   std::vector<std::array<index_t, 3>> triangles_;  // the surface's, counter-clockwise seen from outside
+  std::vector<std::array<index_t, 2>> parents_;    // each sample's two ends (ContactSamples::parents)
+  std::vector<std::uint64_t> keys_;                // each vertex's and sample's name on the whole surface
+  index_t n_surface_ = 0;
+  int sample_levels_ = 0;
   SurfaceMap map_;
   ToolShape shape_;
   ToolPose pose_, previous_pose_;
   std::vector<double> penalty_, lambda_;  // per vertex
   std::vector<Anchor> anchors_;           // per vertex, with friction
   std::vector<Active> active_;            // at the last linearise()
-  std::vector<index_t> ids_;              // the object surface's vertex of each vertex (empty: the same)
   ToolLoad last_load_;
   double tolerance_ = 0, max_point_stiffness_ = 0, per_area_penalty_ = 0, friction_ = 0, tangential_share_ = 0.01;
   bool posed_ = false;

@@ -556,6 +556,7 @@ void read_probe(TableReader& r, ProbeSpec& p, const Context& ctx) {
   p.friction = r.number("friction", p.friction, [](double m) { return m >= 0 && m <= 10; }, "must be in [0, 10]");
   p.object_stiffness = r.choice("local_stiffness", "contact", {"contact", "object"}) == "object";
   p.non_negative_surface_map = r.choice("surface_map", "exact", {"exact", "non_negative"}) == "non_negative";
+  p.sample_spacing = r.number("sample_spacing", p.sample_spacing, positive, "must be > 0 (m: the contact's samples along the surface's edges)");
   if (r.find("position")) {
     p.position = r.vec3("position", p.position);
     if (r.find("trajectory") || r.find("keyframes"))

@@ -43,8 +43,9 @@ SurfaceMap without_negative_weights(SurfaceMap map);
 /// into `out` (resized once).
 void interpolate_at_surface(const SurfaceMap& map, const Eigen::Ref<const Eigen::MatrixXd>& field, Eigen::MatrixXd& out);
 
-/// y = Y + W u (3 x m), into `y` (resized once; no allocation after).
-void carry_surface(const SurfaceMap& map, const Points& Y, const Points& u, Points& y);
+/// y = Y + W u (3 x m), into `y` (resized once; no allocation after). With `rows` >= 0 only the first `rows`
+/// vertices are carried (y still has them all).
+void carry_surface(const SurfaceMap& map, const Points& Y, const Points& u, Points& y, index_t rows = -1);
 
 /// f_points += W^T f_vertices: forces on the vertices onto the points, with the same virtual work
 /// (f_vertices . W du = (W^T f_vertices) . du).
