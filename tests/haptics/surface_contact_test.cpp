@@ -116,6 +116,24 @@ TEST(SurfaceContact, ForcesAreTheEnergyGradientAndTheTangentTheirDerivative) {
   }
 }
 
+// The block held at its bottom in a static solve, a sphere of `radius` held `depth` into its top face above
+// (x, z).
+struct Press {
+  Simulation sim;
+  TriangleMesh surface;
+};
+
+Press pressed_block(double radius, double depth, double x, double z, const SurfaceContactParams& params = {}) {
+  Block b = block(true);
+  TriangleMesh surface = b.surface;
+  SolverSpec spec;
+  spec.kind = SolverKind::STATIC;
+  Simulation sim(std::move(b.model), spec, 2);
+  sim.hold_tool(ToolShape{ToolKind::SPHERE, radius, 0}, ToolPose{Vec3(x, 0.02 + radius - depth, z), Eigen::Quaterniond::Identity()},
+                surface, build_surface_map(sim.model(), surface.V), params);
+  return {std::move(sim), std::move(surface)};
+}
+
 // A tool narrower than the surface's triangles (a 1 mm sphere over 2.5 mm edges, 3.5 mm diagonals: a sphere
 // fits through a triangle whose circumradius exceeds its radius): centred over a diagonal's midpoint, 1.77 mm
 // from the nearest vertices, it touches none of them. The contact's samples on the triangles (two splits, to
@@ -152,17 +170,11 @@ TEST(SurfaceContact, ASphereNarrowerThanTheTrianglesPressesOnTheirSamples) {
 TEST(SurfaceContact, StaticIndentationByASphereNarrowerThanTheTrianglesMeetsTheConstraint) {
   for (const bool samples : {true, false}) {
     SCOPED_TRACE(samples ? "with samples" : "vertices only");
-    Block b = block(true);
-    const TriangleMesh surface = b.surface;
-    SolverSpec spec;
-    spec.kind = SolverKind::STATIC;
-    Simulation sim(std::move(b.model), spec, 2);
     const double radius = 0.001, depth = 0.0002;
     SurfaceContactParams params;
     if (!samples) params.sample_spacing = -1;
-    sim.hold_tool(ToolShape{ToolKind::SPHERE, radius, 0},
-                  ToolPose{Vec3(0.02 + 0.00125, 0.02 + radius - depth, 0.02 + 0.00125), Eigen::Quaterniond::Identity()}, surface,
-                  build_surface_map(sim.model(), surface.V), params);
+    Press press = pressed_block(radius, depth, 0.02 + 0.00125, 0.02 + 0.00125, params);
+    Simulation& sim = press.sim;
     ASSERT_EQ(sim.step().status, StepStatus::CONVERGED);
     const RunSummary s = sim.summary();
     ASSERT_TRUE(s.tool.present);
@@ -275,14 +287,10 @@ TEST(SurfaceContact, APressingToolPushesEveryPointThatCarriesTheSurfaceAwayFromI
 }
 
 TEST(SurfaceContact, StaticIndentationMeetsTheConstraintAndBalancesTheSupports) {
-  Block b = block(true);
-  const TriangleMesh surface = b.surface;
-  SolverSpec spec;
-  spec.kind = SolverKind::STATIC;
-  Simulation sim(std::move(b.model), spec, 2);
   const double radius = 0.01, depth = 0.001;
-  sim.hold_tool(ToolShape{ToolKind::SPHERE, radius, 0}, ToolPose{Vec3(0.02, 0.02 + radius - depth, 0.02), Eigen::Quaterniond::Identity()},
-                surface, build_surface_map(sim.model(), surface.V));
+  Press press = pressed_block(radius, depth, 0.02, 0.02);
+  Simulation& sim = press.sim;
+  const TriangleMesh& surface = press.surface;
   ASSERT_EQ(sim.step().status, StepStatus::CONVERGED);
   const RunSummary s = sim.summary();
   ASSERT_TRUE(s.tool.present);
