@@ -156,7 +156,7 @@ void lifted_blade_stops_at_the_cut_face(bool levels_of_detail) {
   const double face = 0.03375 + 0.001;
   if (levels_of_detail) {
     // held on the piece's side, not through it: its end (2.6 cm from its centre) on the face z = 3 cm, pushed
-    // back out along z (1.56 N; nothing before the samples)
+    // back out along z (1.34 N; nothing before the samples)
     EXPECT_GE(probe.z(), 0.03 + 0.025) << probe.transpose();
     EXPECT_GT(probe.x(), 0.045) << probe.transpose();
     EXPECT_GT(force.z(), 0.5) << force.transpose();

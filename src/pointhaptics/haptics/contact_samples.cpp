@@ -1,33 +1,36 @@
 #include <pointhaptics/haptics/contact_samples.hpp>
 
 #include <algorithm>
-#include <map>
+#include <unordered_map>
 #include <utility>
 
 namespace pointhaptics {
 
 namespace {
 
-/// The mean of rows a and b of `map`, merged by point (points in increasing order).
-void append_mean_row(SurfaceMap& map, index_t a, index_t b, std::vector<std::pair<index_t, double>>& scratch) {
-  scratch.clear();
-  for (const index_t v : {a, b})
-    for (index_t e = map.points.begin(v); e < map.points.end(v); ++e) scratch.emplace_back(map.points.index[e], 0.5 * map.weight[e]);
-  std::sort(scratch.begin(), scratch.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
-  for (std::size_t k = 0; k < scratch.size(); ++k) {
-    if (k > 0 && scratch[k].first == scratch[k - 1].first) {
-      map.weight.back() += scratch[k].second;
-      continue;
+/// The midpoint of a and b, each a combination of the surface's vertices: the mean of the two combinations.
+/// Both lie in one of the surface's triangles, so the mean has at most three vertices.
+ContactSample midpoint_of(const ContactSample& a, const ContactSample& b) {
+  ContactSample out{{0, 0, 0}, {0, 0, 0}};
+  int used = 0;
+  for (const ContactSample* s : {&a, &b})
+    for (int k = 0; k < 3; ++k) {
+      if (s->weight[k] == 0) continue;
+      int slot = 0;
+      while (slot < used && out.vertex[slot] != s->vertex[k]) ++slot;
+      if (slot == used) {
+        if (used == 3) continue;  // (cannot happen: one triangle's vertices)
+        out.vertex[used++] = s->vertex[k];
+      }
+      out.weight[slot] += 0.5 * s->weight[k];
     }
-    map.points.index.push_back(scratch[k].first);
-    map.weight.push_back(scratch[k].second);
-  }
-  map.points.offset.push_back(static_cast<index_t>(map.points.index.size()));
+  for (int k = used; k < 3; ++k) out.vertex[k] = out.vertex[0];
+  return out;
 }
 
-double longest_edge(const Points& V, const std::array<index_t, 3>& t) {
+double longest_edge(const std::vector<Vec3>& V, const std::array<index_t, 3>& t) {
   double longest = 0;
-  for (int k = 0; k < 3; ++k) longest = std::max(longest, (V.col(t[(k + 1) % 3]) - V.col(t[k])).norm());
+  for (int k = 0; k < 3; ++k) longest = std::max(longest, (V[t[(k + 1) % 3]] - V[t[k]]).norm());
   return longest;
 }
 
@@ -41,34 +44,44 @@ std::uint64_t mix(std::uint64_t x) {
 
 }  // namespace
 
-ContactSamples contact_samples(const TriangleMesh& mesh, const SurfaceMap& map, double max_edge) {
-  ContactSamples out{mesh, map, {}, 0};
-  if (!(max_edge > 0)) return out;
-  std::vector<std::pair<index_t, double>> scratch;
-  std::vector<Vec3> added;  // the samples' reference positions, appended to V at the end of each level
+ContactSamples contact_samples(const TriangleMesh& mesh, double max_edge) {
+  ContactSamples out;
+  out.triangles = mesh.F;
+  const auto n = static_cast<index_t>(mesh.V.cols());
+  // every point so far, the surface's vertices first: its position and its combination of the vertices
+  std::vector<Vec3> position(static_cast<std::size_t>(n));
+  std::vector<ContactSample> combination(static_cast<std::size_t>(n));
+  for (index_t v = 0; v < n; ++v) {
+    position[static_cast<std::size_t>(v)] = mesh.V.col(v);
+    combination[static_cast<std::size_t>(v)] = ContactSample{{v, v, v}, {1, 0, 0}};
+  }
   // an edge's (low, high) ends -> its sample, over all levels: a triangle split after its neighbour finds the
   // sample that neighbour put on their edge
-  std::map<std::pair<index_t, index_t>, index_t> midpoint;
-  for (int level = 0; level < max_contact_sample_levels; ++level) {
-    const index_t before = static_cast<index_t>(out.mesh.V.cols());
+  std::unordered_map<std::uint64_t, index_t> midpoint;
+  for (int level = 0; max_edge > 0 && level < max_contact_sample_levels; ++level) {
+    // this level's splits, counted first: a level that would pass the bound is not made
+    std::size_t long_triangles = 0;
+    for (const auto& t : out.triangles) long_triangles += longest_edge(position, t) > max_edge;
+    const auto points = static_cast<index_t>(position.size());
+    if (long_triangles == 0 || points + static_cast<index_t>(3 * long_triangles) > max_contact_vertices) break;
+    midpoint.reserve(midpoint.size() + 3 * long_triangles);
+    position.reserve(position.size() + 3 * long_triangles);
+    combination.reserve(combination.size() + 3 * long_triangles);
     auto sample = [&](index_t a, index_t b) {
-      const auto key = std::minmax(a, b);
-      const auto [it, fresh] = midpoint.try_emplace({key.first, key.second}, before + static_cast<index_t>(added.size()));
+      const auto [low, high] = std::minmax(a, b);
+      const std::uint64_t edge = static_cast<std::uint64_t>(low) << 32 | static_cast<std::uint32_t>(high);
+      const auto [it, fresh] = midpoint.try_emplace(edge, static_cast<index_t>(position.size()));
       if (fresh) {
-        added.push_back(0.5 * (out.mesh.V.col(a) + out.mesh.V.col(b)));
-        out.parents.push_back({key.first, key.second});
-        append_mean_row(out.map, key.first, key.second, scratch);
+        position.push_back(0.5 * (position[static_cast<std::size_t>(a)] + position[static_cast<std::size_t>(b)]));
+        combination.push_back(midpoint_of(combination[static_cast<std::size_t>(a)], combination[static_cast<std::size_t>(b)]));
+        out.parents.push_back({low, high});
       }
       return it->second;
     };
-    // this level's splits, counted first: a level that would pass the bound is not made
-    std::size_t long_triangles = 0;
-    for (const auto& t : out.mesh.F) long_triangles += longest_edge(out.mesh.V, t) > max_edge;
-    if (long_triangles == 0 || before + static_cast<index_t>(3 * long_triangles) > max_contact_vertices) break;
     std::vector<std::array<index_t, 3>> split;
-    split.reserve(out.mesh.F.size() + 3 * long_triangles);
-    for (const auto& t : out.mesh.F) {
-      if (longest_edge(out.mesh.V, t) <= max_edge) {
+    split.reserve(out.triangles.size() + 3 * long_triangles);
+    for (const auto& t : out.triangles) {
+      if (longest_edge(position, t) <= max_edge) {
         split.push_back(t);
         continue;
       }
@@ -79,13 +92,13 @@ ContactSamples contact_samples(const TriangleMesh& mesh, const SurfaceMap& map, 
       split.push_back({ca, bc, t[2]});
       split.push_back({ab, bc, ca});
     }
-    if (added.empty()) break;
-    out.mesh.V.conservativeResize(3, before + static_cast<index_t>(added.size()));
-    for (std::size_t k = 0; k < added.size(); ++k) out.mesh.V.col(before + static_cast<index_t>(k)) = added[k];
-    added.clear();
-    out.mesh.F = std::move(split);
+    out.triangles = std::move(split);
     out.levels = level + 1;
   }
+  const auto samples = static_cast<index_t>(position.size()) - n;
+  out.Y.resize(3, samples);
+  out.samples.assign(combination.begin() + n, combination.end());
+  for (index_t k = 0; k < samples; ++k) out.Y.col(k) = position[static_cast<std::size_t>(n + k)];
   return out;
 }
 

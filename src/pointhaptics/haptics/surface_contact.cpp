@@ -29,29 +29,29 @@ std::vector<std::uint64_t> identity_ids(index_t n) {
 
 SurfaceContact::SurfaceContact(const Model& model, const TriangleMesh& mesh, SurfaceMap map, const ToolShape& shape,
                                const SurfaceContactParams& params)
-    : SurfaceContact(model, mesh,
-                     contact_samples(mesh, contact_map(mesh, std::move(map), params),
-                                     params.sample_spacing != 0 ? params.sample_spacing : shape.radius),
-                     shape, params) {}
+    : SurfaceContact(model, mesh, contact_map(mesh, std::move(map), params),
+                     contact_samples(mesh, params.sample_spacing != 0 ? params.sample_spacing : shape.radius), shape, params) {}
 
-SurfaceContact::SurfaceContact(const Model& model, const TriangleMesh& surface, ContactSamples samples, const ToolShape& shape,
-                               const SurfaceContactParams& params)
-    : Y_(std::move(samples.mesh.V)),
-      y_(Y_),
+SurfaceContact::SurfaceContact(const Model& model, const TriangleMesh& surface, SurfaceMap map, ContactSamples samples,
+                               const ToolShape& shape, const SurfaceContactParams& params)
+    : Y_(3, surface.V.cols() + samples.Y.cols()),
       triangles_(surface.F),
+      samples_(std::move(samples.samples)),
       parents_(std::move(samples.parents)),
       keys_(contact_sample_keys(identity_ids(static_cast<index_t>(surface.V.cols())), parents_)),
       n_surface_(static_cast<index_t>(surface.V.cols())),
       sample_levels_(samples.levels),
-      map_(std::move(samples.map)),
+      map_(std::move(map)),
       shape_(shape) {
+  Y_ << surface.V, samples.Y;
+  y_ = Y_;
   if (!(shape.radius > 0) || !std::isfinite(shape.radius)) throw Error("tool: radius must be positive (m)");
   if (!(shape.length >= 0) || !std::isfinite(shape.length)) throw Error("tool: length must be >= 0 (m)");
   const index_t m = static_cast<index_t>(Y_.cols());
   // a vertex stands for a third of its triangles' area (the split ones, samples included): the penalty is a
   // pressure per unit penetration
   std::vector<double> area(static_cast<std::size_t>(m), 0.0);
-  for (const auto& t : samples.mesh.F) {
+  for (const auto& t : samples.triangles) {
     const double a = 0.5 * (Y_.col(t[1]) - Y_.col(t[0])).cross(Y_.col(t[2]) - Y_.col(t[0])).norm();
     for (const index_t v : t) area[static_cast<std::size_t>(v)] += a / 3.0;
   }
@@ -76,11 +76,33 @@ SurfaceContact::SurfaceContact(const Model& model, const TriangleMesh& surface, 
   }
 }
 
+template <class Fn>
+void SurfaceContact::for_each_weight(index_t v, const Fn& fn) const {
+  const auto row = [&](index_t vertex, double scale) {
+    for (index_t e = map_.points.begin(vertex); e < map_.points.end(vertex); ++e) fn(map_.points.index[e], scale * map_.weight[e]);
+  };
+  if (v < n_surface_) return row(v, 1.0);
+  const ContactSample& sample = samples_[static_cast<std::size_t>(v - n_surface_)];
+  for (int k = 0; k < 3; ++k)
+    if (sample.weight[k] != 0) row(sample.vertex[k], sample.weight[k]);
+}
+
+template <class Fn>
+void SurfaceContact::for_each_squared_weight(index_t v, const Fn& fn) const {
+  const auto row = [&](index_t vertex, double scale) {
+    for (index_t e = map_.points.begin(vertex); e < map_.points.end(vertex); ++e)
+      fn(map_.points.index[e], scale * map_.weight[e] * map_.weight[e]);
+  };
+  if (v < n_surface_) return row(v, 1.0);
+  const ContactSample& sample = samples_[static_cast<std::size_t>(v - n_surface_)];
+  for (int k = 0; k < 3; ++k)
+    if (sample.weight[k] != 0) row(sample.vertex[k], sample.weight[k]);
+}
+
 std::vector<double> SurfaceContact::point_stiffness(index_t n_points) const {
   std::vector<double> stiffness(static_cast<std::size_t>(n_points), 0.0);
-  for (index_t v = 0; v < map_.n_vertices(); ++v)
-    for (index_t e = map_.points.begin(v); e < map_.points.end(v); ++e)
-      stiffness[static_cast<std::size_t>(map_.points.index[e])] += penalty_[static_cast<std::size_t>(v)] * map_.weight[e] * map_.weight[e];
+  for (index_t v = 0; v < static_cast<index_t>(Y_.cols()); ++v)
+    for_each_squared_weight(v, [&](index_t j, double w2) { stiffness[static_cast<std::size_t>(j)] += penalty_[static_cast<std::size_t>(v)] * w2; });
   return stiffness;
 }
 
@@ -90,12 +112,12 @@ void SurfaceContact::limit_point_stiffness(std::span<const double> limit, double
   // the uniform scale that brings the stiffest point to the cap: no vertex is lowered further, so no part of
   // the surface is softer than a uniformly lowered penalty made it (no cap: nothing is lowered)
   const double uniform = cap > 0 && stiffest > cap ? cap / stiffest : 1.0;
-  for (index_t v = 0; v < map_.n_vertices(); ++v) {
+  for (index_t v = 0; v < static_cast<index_t>(Y_.cols()); ++v) {
     double scale = 1.0;
-    for (index_t e = map_.points.begin(v); e < map_.points.end(v); ++e) {
-      const auto j = static_cast<std::size_t>(map_.points.index[e]);
-      if (map_.weight[e] != 0 && stiffness[j] > limit[j]) scale = std::min(scale, limit[j] / stiffness[j]);
-    }
+    for_each_weight(v, [&](index_t point, double w) {
+      const auto j = static_cast<std::size_t>(point);
+      if (w != 0 && stiffness[j] > limit[j]) scale = std::min(scale, limit[j] / stiffness[j]);
+    });
     penalty_[static_cast<std::size_t>(v)] *= std::max(scale, uniform);
   }
   // each point now presses at most max(limit_j, uniform x its stiffness) <= max(limit_j, cap)
@@ -103,11 +125,12 @@ void SurfaceContact::limit_point_stiffness(std::span<const double> limit, double
 }
 
 void SurfaceContact::evaluate(const Points& u) {
-  // the surface's vertices by the map, then each sample as the mean of its ends (its row is their rows' mean:
-  // the same position, for two additions instead of its row's weights)
-  carry_surface(map_, Y_, u, y_, n_surface_);
-  for (std::size_t k = 0; k < parents_.size(); ++k)
-    y_.col(n_surface_ + static_cast<index_t>(k)) = 0.5 * (y_.col(parents_[k][0]) + y_.col(parents_[k][1]));
+  // the surface's vertices by the map, then each sample as its combination of them
+  carry_surface_into(map_, Y_, u, y_.leftCols(n_surface_));
+  for (std::size_t k = 0; k < samples_.size(); ++k) {
+    const ContactSample& s = samples_[k];
+    y_.col(n_surface_ + static_cast<index_t>(k)) = s.weight[0] * y_.col(s.vertex[0]) + s.weight[1] * y_.col(s.vertex[1]) + s.weight[2] * y_.col(s.vertex[2]);
+  }
 }
 
 void SurfaceContact::set_vertex_ids(const std::vector<index_t>& ids) {
@@ -194,12 +217,12 @@ void SurfaceContact::add_forces(const Model&, const Points& u, Points& f) {
   evaluate(u);
   last_load_ = for_each_pressing([&](index_t v, const ToolDistance& d, double pressure) {
     const Vec3 force = pressure * d.normal;  // on the vertex, out of the tool
-    for (index_t e = map_.points.begin(v); e < map_.points.end(v); ++e) f.col(map_.points.index[e]) += map_.weight[e] * force;
+    for_each_weight(v, [&](index_t j, double w) { f.col(j) += w * force; });
   });
   for (index_t v = 0; v < static_cast<index_t>(anchors_.size()); ++v) {
     if (!anchors_[static_cast<std::size_t>(v)].held) continue;
     const Vec3 force = -friction_force(v);  // on the vertex, toward its anchor
-    for (index_t e = map_.points.begin(v); e < map_.points.end(v); ++e) f.col(map_.points.index[e]) += map_.weight[e] * force;
+    for_each_weight(v, [&](index_t j, double w) { f.col(j) += w * force; });
   }
 }
 
@@ -226,9 +249,9 @@ void SurfaceContact::linearise(const Model&, const Points& u, TangentMode mode) 
 void SurfaceContact::add_tangent_product(const Points& dx, Points& out) const {
   for (const Active& a : active_) {
     Vec3 dy = Vec3::Zero();
-    for (index_t e = map_.points.begin(a.vertex); e < map_.points.end(a.vertex); ++e) dy += map_.weight[e] * dx.col(map_.points.index[e]);
+    for_each_weight(a.vertex, [&](index_t j, double w) { dy += w * dx.col(j); });
     const Vec3 h = a.hessian * dy;
-    for (index_t e = map_.points.begin(a.vertex); e < map_.points.end(a.vertex); ++e) out.col(map_.points.index[e]) += map_.weight[e] * h;
+    for_each_weight(a.vertex, [&](index_t j, double w) { out.col(j) += w * h; });
   }
 }
 
@@ -237,7 +260,7 @@ Mat3 SurfaceContact::add_tool_load(const Vec3& e, Points& b) const {
   for (const Active& a : active_) {
     sum += a.preconditioner;
     const Vec3 h = a.preconditioner * e;
-    for (index_t k = map_.points.begin(a.vertex); k < map_.points.end(a.vertex); ++k) b.col(map_.points.index[k]) += map_.weight[k] * h;
+    for_each_weight(a.vertex, [&](index_t j, double w) { b.col(j) += w * h; });
   }
   return sum;
 }
@@ -246,7 +269,7 @@ Vec3 SurfaceContact::tool_response(const Points& x) const {
   Vec3 f = Vec3::Zero();
   for (const Active& a : active_) {
     Vec3 y = Vec3::Zero();
-    for (index_t k = map_.points.begin(a.vertex); k < map_.points.end(a.vertex); ++k) y += map_.weight[k] * x.col(map_.points.index[k]);
+    for_each_weight(a.vertex, [&](index_t j, double w) { y += w * x.col(j); });
     f += a.preconditioner * y;
   }
   return f;
@@ -254,9 +277,9 @@ Vec3 SurfaceContact::tool_response(const Points& x) const {
 
 void SurfaceContact::add_diagonal_blocks(Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks) const {
   // the positive parts only (the normal and the friction's stiffness): the preconditioner wants positive blocks
+  // (at a sample a bound of its squared weights: for_each_squared_weight)
   for (const Active& a : active_)
-    for (index_t e = map_.points.begin(a.vertex); e < map_.points.end(a.vertex); ++e)
-      Eigen::Map<Mat3>(blocks.col(map_.points.index[e]).data()) += map_.weight[e] * map_.weight[e] * a.preconditioner;
+    for_each_squared_weight(a.vertex, [&](index_t j, double w2) { Eigen::Map<Mat3>(blocks.col(j).data()) += w2 * a.preconditioner; });
 }
 
 bool SurfaceContact::update_multipliers(const Model& model, const Points& u) {
@@ -330,10 +353,12 @@ bool SurfaceContact::enters(const Vec3& from, const Vec3& to) const {
 void SurfaceContact::pressing_points(std::vector<index_t>& out) const {
   out.clear();
   for_each_pressing([&](index_t v, const ToolDistance&, double) {
-    index_t best = map_.points.begin(v);
-    for (index_t e = best; e < map_.points.end(v); ++e)
-      if (map_.weight[e] > map_.weight[best]) best = e;
-    if (best < map_.points.end(v)) out.push_back(map_.points.index[best]);
+    index_t best = -1;
+    double most = 0;
+    for_each_weight(v, [&](index_t j, double w) {
+      if (best < 0 || w > most) best = j, most = w;
+    });
+    if (best >= 0) out.push_back(best);
   });
 }
 

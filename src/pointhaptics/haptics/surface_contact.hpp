@@ -166,7 +166,8 @@ class SurfaceContact final : public EnergyTerm {
   bool enters(const Vec3& from, const Vec3& to) const;
   /// Where p is seen from the surface as the last evaluation carried it (nearest_surface_within()).
   std::optional<SurfaceSide> side_of(const Vec3& p, double radius) const { return nearest_surface_within(p, y_, triangles_, radius); }
-  /// The contact's map: the surface's, or without its negative weights (SurfaceContactParams::non_negative_weights).
+  /// The contact's map of the surface's vertices: the surface's, or without its negative weights
+  /// (SurfaceContactParams::non_negative_weights). The samples are carried through it by their vertices.
   const SurfaceMap& map() const { return map_; }
 
  private:
@@ -205,11 +206,21 @@ class SurfaceContact final : public EnergyTerm {
   template <class Pressing>
   ToolLoad for_each_pressing(const Pressing& pressing) const;
 
-  SurfaceContact(const Model& model, const TriangleMesh& surface, ContactSamples samples, const ToolShape& shape,
+  SurfaceContact(const Model& model, const TriangleMesh& surface, SurfaceMap map, ContactSamples samples, const ToolShape& shape,
                  const SurfaceContactParams& params);
+  /// fn(point, weight) for every point that carries vertex or sample v: a sample's vertices' rows times its
+  /// weights (a point can come more than once).
+  template <class Fn>
+  void for_each_weight(index_t v, const Fn& fn) const;
+  /// fn(point, bound of weight^2): a vertex's own squares; a sample's, sum_k b_k w_kj^2, which is at least
+  /// (sum_k b_k w_kj)^2 (the b_k are >= 0 and sum to 1): the stiffness caps and the preconditioner's blocks
+  /// are then upper bounds at the samples, and no merged row is made.
+  template <class Fn>
+  void for_each_squared_weight(index_t v, const Fn& fn) const;
 
   Points Y_, y_;                                   // the surface's vertices, then the samples
   std::vector<std::array<index_t, 3>> triangles_;  // the surface's, counter-clockwise seen from outside
+  std::vector<ContactSample> samples_;             // each a combination of the surface's vertices
   std::vector<std::array<index_t, 2>> parents_;    // each sample's two ends (ContactSamples::parents)
   std::vector<std::uint64_t> keys_;                // each vertex's and sample's name on the whole surface
   index_t n_surface_ = 0;

@@ -115,9 +115,13 @@ void interpolate_at_surface(const SurfaceMap& map, const Eigen::Ref<const Eigen:
 // four doubles per point, so that a weight's term is one load and one multiply-add of a SIMD register, and
 // each vertex keeps four partial sums, so that its multiply-adds do not wait on one another. Measured on the
 // bench box (10.6k vertices, 20 weights each): 0.6 of the three-scalar loop's time.
-void carry_surface(const SurfaceMap& map, const Points& Y, const Points& u, Points& y, index_t rows) {
+void carry_surface(const SurfaceMap& map, const Points& Y, const Points& u, Points& y) {
   y.resize(3, map.n_vertices());
-  const index_t n_vertices = rows >= 0 ? std::min(rows, map.n_vertices()) : map.n_vertices();
+  carry_surface_into(map, Y, u, y);
+}
+
+void carry_surface_into(const SurfaceMap& map, const Points& Y, const Points& u, Eigen::Ref<Points> y) {
+  const index_t n_vertices = map.n_vertices();
   thread_local std::vector<Lanes> padded;  // grown once per thread, reused: no allocation per carry
   padded.resize(static_cast<std::size_t>(u.cols()));
   for (index_t j = 0; j < u.cols(); ++j) padded[static_cast<std::size_t>(j)] = Lanes{u(0, j), u(1, j), u(2, j), 0.0};

@@ -43,9 +43,11 @@ SurfaceMap without_negative_weights(SurfaceMap map);
 /// into `out` (resized once).
 void interpolate_at_surface(const SurfaceMap& map, const Eigen::Ref<const Eigen::MatrixXd>& field, Eigen::MatrixXd& out);
 
-/// y = Y + W u (3 x m), into `y` (resized once; no allocation after). With `rows` >= 0 only the first `rows`
-/// vertices are carried (y still has them all).
-void carry_surface(const SurfaceMap& map, const Points& Y, const Points& u, Points& y, index_t rows = -1);
+/// y = Y + W u (3 x m), into `y` (resized once; no allocation after).
+void carry_surface(const SurfaceMap& map, const Points& Y, const Points& u, Points& y);
+/// The same into the first m columns of `y` (which has at least m; Y too): a contact's vertices before its
+/// samples (haptics/contact_samples.hpp).
+void carry_surface_into(const SurfaceMap& map, const Points& Y, const Points& u, Eigen::Ref<Points> y);
 
 /// f_points += W^T f_vertices: forces on the vertices onto the points, with the same virtual work
 /// (f_vertices . W du = (W^T f_vertices) . du).
