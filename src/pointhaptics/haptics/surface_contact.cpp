@@ -30,7 +30,8 @@ std::vector<std::uint64_t> identity_ids(index_t n) {
 SurfaceContact::SurfaceContact(const Model& model, const TriangleMesh& mesh, SurfaceMap map, const ToolShape& shape,
                                const SurfaceContactParams& params)
     : SurfaceContact(model, mesh, contact_map(mesh, std::move(map), params),
-                     contact_samples(mesh, params.sample_spacing != 0 ? params.sample_spacing : shape.radius), shape, params) {}
+                     contact_samples(mesh, params.sample_spacing != 0 ? params.sample_spacing : default_sample_spacing * shape.radius),
+                     shape, params) {}
 
 SurfaceContact::SurfaceContact(const Model& model, const TriangleMesh& surface, SurfaceMap map, ContactSamples samples,
                                const ToolShape& shape, const SurfaceContactParams& params)

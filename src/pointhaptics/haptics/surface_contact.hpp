@@ -68,13 +68,20 @@ struct SurfaceContactParams {
   /// diverged at 2.2 s of its deterministic run; with this map it is calm). Not the default: on the coarse
   /// soft dome (a probe 1.5 spacings wide) its real-time soak diverged in 2 of 3 runs (docs/haptics.md).
   bool non_negative_weights = false;
-  /// Largest distance between the contact's samples along the surface's edges, m (0: the tool's radius).
-  /// Longer edges get samples at their midpoints (haptics/contact_samples.hpp), so that the tool cannot pass
-  /// between the surface's vertices: a sphere fits through a triangle whose circumradius (edge / sqrt 3 when
-  /// equilateral) exceeds its radius, so edges of one radius leave a margin for the surface's stretching and
-  /// let the tool in by at most 0.18 of its radius before a sample touches. Negative: the vertices only.
+  /// Largest distance between the contact's samples along the surface's edges, m (0: default_sample_spacing
+  /// times the tool's radius). Longer edges get samples at their midpoints (haptics/contact_samples.hpp), so
+  /// that the tool cannot pass between the surface's vertices. Negative: the vertices only.
   double sample_spacing = 0;
 };
+
+/// A sphere fits through a triangle whose circumradius exceeds its radius, touching none of its vertices. At
+/// edges of at most 1.2 radii a triangle's circumradius is at most 0.6 radius (half its longest edge when
+/// right-angled, 0.69 radius when equilateral), so the tool dips at most 0.2-0.28 of its radius below a face
+/// before a sample touches it, and the lattice's right triangles under a tool wider than their diagonal get
+/// none: samples under such a tool (scenes/beam_probe.toml, 10.6 mm diagonals under a 10 mm probe, split once
+/// at a spacing of one radius) let its rolling probe through the beam at 1.3 s, where without them it rolls on
+/// top.
+inline constexpr double default_sample_spacing = 1.2;
 
 /// What the object does to the tool.
 struct ToolLoad {
