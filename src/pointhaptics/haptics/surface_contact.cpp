@@ -44,7 +44,8 @@ SurfaceContact::SurfaceContact(const Model& model, const TriangleMesh& surface, 
       sample_levels_(samples.levels),
       map_(std::move(map)),
       shape_(shape) {
-  Y_ << surface.V, samples.Y;
+  Y_.leftCols(n_surface_) = surface.V;
+  Y_.rightCols(samples.Y.cols()) = samples.Y;
   y_ = Y_;
   if (!(shape.radius > 0) || !std::isfinite(shape.radius)) throw Error("tool: radius must be positive (m)");
   if (!(shape.length >= 0) || !std::isfinite(shape.length)) throw Error("tool: length must be >= 0 (m)");
@@ -78,26 +79,26 @@ SurfaceContact::SurfaceContact(const Model& model, const TriangleMesh& surface, 
 }
 
 template <class Fn>
-void SurfaceContact::for_each_weight(index_t v, const Fn& fn) const {
-  const auto row = [&](index_t vertex, double scale) {
-    for (index_t e = map_.points.begin(vertex); e < map_.points.end(vertex); ++e) fn(map_.points.index[e], scale * map_.weight[e]);
-  };
-  if (v < n_surface_) return row(v, 1.0);
+void SurfaceContact::for_each_surface_vertex(index_t v, const Fn& fn) const {
+  if (v < n_surface_) return fn(v, 1.0);
   const ContactSample& sample = samples_[static_cast<std::size_t>(v - n_surface_)];
   for (int k = 0; k < 3; ++k)
-    if (sample.weight[k] != 0) row(sample.vertex[k], sample.weight[k]);
+    if (sample.weight[k] != 0) fn(sample.vertex[k], sample.weight[k]);
+}
+
+template <class Fn>
+void SurfaceContact::for_each_weight(index_t v, const Fn& fn) const {
+  for_each_surface_vertex(v, [&](index_t vertex, double b) {
+    for (index_t e = map_.points.begin(vertex); e < map_.points.end(vertex); ++e) fn(map_.points.index[e], b * map_.weight[e]);
+  });
 }
 
 template <class Fn>
 void SurfaceContact::for_each_squared_weight(index_t v, const Fn& fn) const {
-  const auto row = [&](index_t vertex, double scale) {
+  for_each_surface_vertex(v, [&](index_t vertex, double b) {
     for (index_t e = map_.points.begin(vertex); e < map_.points.end(vertex); ++e)
-      fn(map_.points.index[e], scale * map_.weight[e] * map_.weight[e]);
-  };
-  if (v < n_surface_) return row(v, 1.0);
-  const ContactSample& sample = samples_[static_cast<std::size_t>(v - n_surface_)];
-  for (int k = 0; k < 3; ++k)
-    if (sample.weight[k] != 0) row(sample.vertex[k], sample.weight[k]);
+      fn(map_.points.index[e], b * map_.weight[e] * map_.weight[e]);
+  });
 }
 
 std::vector<double> SurfaceContact::point_stiffness(index_t n_points) const {

@@ -215,6 +215,10 @@ class SurfaceContact final : public EnergyTerm {
 
   SurfaceContact(const Model& model, const TriangleMesh& surface, SurfaceMap map, ContactSamples samples, const ToolShape& shape,
                  const SurfaceContactParams& params);
+  /// fn(vertex, b) for the surface's vertices that make vertex or sample v: v itself with b = 1, or the
+  /// sample's vertices with their weights.
+  template <class Fn>
+  void for_each_surface_vertex(index_t v, const Fn& fn) const;
   /// fn(point, weight) for every point that carries vertex or sample v: a sample's vertices' rows times its
   /// weights (a point can come more than once).
   template <class Fn>
