@@ -35,7 +35,7 @@ struct ProbeParams {
   /// On the surface: the contact's map without its negative weights (SurfaceContactParams::non_negative_weights).
   bool non_negative_surface_map = false;
   /// On the surface: the contact's samples along the surface's edges at most this far apart, m
-  /// (SurfaceContactParams::sample_spacing; 0: the tool's radius).
+  /// (SurfaceContactParams::sample_spacing; 0: default_sample_spacing, 1.2, times the tool's radius).
   double sample_spacing = 0;
   /// CUT: the work of cutting per unit of new cut area, J/m^2 (N/m): the hand feels it as a force against the
   /// edge's motion, this times the new area over the distance moved (0: the blade cuts freely)

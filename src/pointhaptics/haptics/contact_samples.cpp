@@ -59,9 +59,10 @@ ContactSamples contact_samples(const TriangleMesh& mesh, double max_edge) {
   // sample that neighbour put on their edge
   std::unordered_map<std::uint64_t, index_t> midpoint;
   for (int level = 0; max_edge > 0 && level < max_contact_sample_levels; ++level) {
-    // this level's splits, counted first: a level that would pass the bound is not made
+    // this level's splits, found first: a level that would pass the bound is not made
+    std::vector<char> splits(out.triangles.size());
     std::size_t long_triangles = 0;
-    for (const auto& t : out.triangles) long_triangles += longest_edge(position, t) > max_edge;
+    for (std::size_t k = 0; k < out.triangles.size(); ++k) long_triangles += splits[k] = longest_edge(position, out.triangles[k]) > max_edge;
     const auto points = static_cast<index_t>(position.size());
     if (long_triangles == 0 || points + static_cast<index_t>(3 * long_triangles) > max_contact_vertices) break;
     midpoint.reserve(midpoint.size() + 3 * long_triangles);
@@ -80,8 +81,9 @@ ContactSamples contact_samples(const TriangleMesh& mesh, double max_edge) {
     };
     std::vector<std::array<index_t, 3>> split;
     split.reserve(out.triangles.size() + 3 * long_triangles);
-    for (const auto& t : out.triangles) {
-      if (longest_edge(position, t) <= max_edge) {
+    for (std::size_t k = 0; k < out.triangles.size(); ++k) {
+      const auto& t = out.triangles[k];
+      if (!splits[k]) {
         split.push_back(t);
         continue;
       }

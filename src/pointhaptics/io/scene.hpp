@@ -142,7 +142,7 @@ struct ProbeSpec {
   double friction = 0;                     ///< Coulomb's coefficient on the surface
   bool object_stiffness = false;           ///< local_stiffness = "object" (else "contact"): ProbeParams::object_stiffness
   bool non_negative_surface_map = false;   ///< surface_map = "non_negative" (else "exact"): ProbeParams::non_negative_surface_map
-  double sample_spacing = 0;               ///< m (0: the tool's radius): ProbeParams::sample_spacing
+  double sample_spacing = 0;               ///< m (0: 1.2 x the tool's radius): ProbeParams::sample_spacing
   int line = 0;
   bool held() const { return present && position.allFinite(); }
 };
