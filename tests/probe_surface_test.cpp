@@ -329,6 +329,9 @@ DomeRun press_and_slide_on_the_soft_dome(bool levels_of_detail) {
   Simulation& sim = *session.simulation;
   InteractiveOptions o = session.interactive;
   o.real_time = false;
+  // the contact's own behaviour, as docs/haptics.md measured it: the passivity controller's damping of the
+  // hand (it acts on about half the ticks of this slide) moves this chaotic run's counts
+  o.rules.passivity_control = false;
   DomeRun run;
   EXPECT_TRUE(o.surface);
   run.radius = o.probe.radius;

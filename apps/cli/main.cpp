@@ -252,6 +252,9 @@ int run_command(const RunOptions& opt) {
                  "{} simulation steps\n",
                  h.ticks, h.rate_hz, h.period_p50_us, h.period_p99_us, h.period_max_us, h.tick_max_us, h.spin_mean_us, h.max_force_n,
                  interactive.max_contacts, interactive.simulation_steps);
+      fmt::print("passivity       observed energy at its least {:.3g} J (below 0: the object gave back more than the hand put in); the "
+                 "controller dissipated {:.3g} J on {} ticks\n",
+                 h.min_observed_energy, h.passivity_dissipated, h.passivity_ticks);
       const ph::LocalModelSummary& m = interactive.local_model;
       if (m.updates > 0)
         fmt::print("local model     over {} updates in contact (mean force {:.3g} N) it strayed from the next by {:.3g} N on "

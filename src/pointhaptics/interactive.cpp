@@ -149,6 +149,9 @@ void add_interactive_summary(RunSummary& summary, const InteractiveResult& inter
   summary.haptic_rate_hz = interactive.haptic.rate_hz;
   summary.haptic_period_p99_us = interactive.haptic.period_p99_us;
   summary.haptic_max_force_n = interactive.haptic.max_force_n;
+  summary.haptic_min_observed_energy = interactive.haptic.min_observed_energy;
+  summary.haptic_passivity_dissipated = interactive.haptic.passivity_dissipated;
+  summary.haptic_passivity_ticks = interactive.haptic.passivity_ticks;
   summary.local_model = interactive.local_model;
 }
 

@@ -99,6 +99,7 @@ InteractiveOptions scene_interactive_options(const Scene& scene, const Model& mo
     o.mapping.origin = Vec3(0.5 * (lo.x() + hi.x()), hi.y() + 2 * scene.probe.radius, 0.5 * (lo.z() + hi.z()));
   }
   o.duration = scene.solver.duration;
+  o.rules.passivity_control = scene.device.passivity_control;
   return o;
 }
 

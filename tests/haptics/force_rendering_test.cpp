@@ -135,6 +135,7 @@ TEST(ForceRenderer, PassivityObserverSeesASpringAsPassiveAndAnActiveForceAsNot) 
   ForceRules rules;
   rules.ramp_time = 0;
   rules.max_change = 100;
+  rules.passivity_control = false;  // the observer alone
   const double k = 200, dt = 1e-3;
   ForceRenderer spring(known_device_specs("touch"), rules), active(known_device_specs("touch"), rules);
   active.render(Vec3::Zero(), Vec3::Zero(), dt);  // engage
@@ -148,6 +149,55 @@ TEST(ForceRenderer, PassivityObserverSeesASpringAsPassiveAndAnActiveForceAsNot) 
   EXPECT_GT(spring.min_observed_energy(), -1e-5);
   EXPECT_NEAR(spring.observed_energy(), 0.0, 1e-5);
   EXPECT_LT(active.observed_energy(), -1e-4);
+}
+
+// The passivity controller (Hannaford & Ryu): a force that pushes the hand along its motion, after the hand
+// put some energy in, is let through until that energy is given back, then damped so that the observer never
+// goes below zero; the damping force never exceeds the force's own part along the velocity plus the device's
+// max damping times the speed. A spring stays untouched.
+TEST(ForceRenderer, PassivityControllerKeepsTheObserverAtOrAboveZero) {
+  ForceRules rules;
+  rules.ramp_time = 0;
+  rules.max_change = 100;
+  const DeviceSpecs touch = known_device_specs("touch");
+  const double dt = 1e-3;
+  ForceRenderer active(touch, rules), spring(touch, rules);
+  active.render(Vec3::Zero(), Vec3::Zero(), dt);  // engage
+  spring.render(Vec3::Zero(), Vec3::Zero(), dt);
+  // 0.5 N against a hand moving at 0.02 m/s for 0.1 s: 1 mJ absorbed
+  for (int t = 0; t < 100; ++t) EXPECT_EQ(active.render(Vec3(-0.5, 0, 0), Vec3(0.02, 0, 0), dt), Vec3(-0.5, 0, 0));
+  EXPECT_NEAR(active.observed_energy(), 1e-3, 1e-12);
+  EXPECT_EQ(active.controller_ticks(), 0);
+  // then 0.5 N along it: 1e-5 J a tick, rendered untouched for 100 ticks, damped after
+  const Vec3 v(0.02, 0.01, 0);
+  double least = 1;
+  for (int t = 0; t < 400; ++t) {
+    const Vec3 f = active.render(Vec3(0.5, 0, 0), v, dt);
+    if (t < 99) {
+      EXPECT_EQ(f, Vec3(0.5, 0, 0)) << t;
+    }
+    const Vec3 damper = f - Vec3(0.5, 0, 0);
+    EXPECT_LE(damper.norm(), Vec3(0.5, 0, 0).dot(v) / v.norm() + touch.max_damping * v.norm() + 1e-12) << t;
+    EXPECT_LE(damper.dot(v), 1e-15) << t;  // against the motion
+    least = std::min(least, active.observed_energy());
+  }
+  EXPECT_GT(least, -1e-12);
+  EXPECT_GT(active.controller_ticks(), 290);
+  EXPECT_NEAR(active.controller_dissipated(), 300 * 0.5 * 0.02 * dt + active.observed_energy(), 1e-9);  // what the force gave beyond 1 mJ
+  // a spring the hand goes into and back out of along the same path needs no control
+  for (int t = 0; t < 2000; ++t) {
+    const double x = 0.005 * std::sin(M_PI * t / 1000.0), speed = 0.005 * M_PI * std::cos(M_PI * t / 1000.0);
+    const Vec3 f = spring.render(Vec3(-200 * std::max(x, 0.0), 0, 0), Vec3(speed, 0, 0), dt);
+    EXPECT_NEAR(f.x(), -200 * std::max(x, 0.0), 1e-3) << t;
+  }
+  EXPECT_LT(spring.controller_dissipated(), 1e-6);
+  // a device without damping still has the force's giving part taken out: the observer stays at zero
+  DeviceSpecs undamped = touch;
+  undamped.max_damping = 0;
+  ForceRenderer bare(undamped, rules);
+  bare.render(Vec3::Zero(), Vec3::Zero(), dt);
+  for (int t = 0; t < 100; ++t) EXPECT_NEAR(bare.render(Vec3(0.5, 0.3, 0), v, dt).dot(v), 0.0, 1e-15);
+  EXPECT_GT(bare.min_observed_energy(), -1e-12);
 }
 
 }  // namespace

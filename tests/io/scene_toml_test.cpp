@@ -441,6 +441,14 @@ TEST(SceneToml, TheContactsSurfaceMapIsChosen) {
 
 // The contact's samples along the surface's edges: the tool's radius by default (0), a spacing given in m,
 // and one that is not positive named.
+TEST(SceneToml, ThePassivityControllerIsOnUnlessTurnedOff) {
+  const std::string text = std::string(full_scene) + probe_section;
+  EXPECT_TRUE(parse_scene(text, "p.toml").device.passivity_control);
+  EXPECT_FALSE(parse_scene(text + "passivity_control = false\n", "p.toml").device.passivity_control);
+  const std::string error = error_of("specs = \"omni\"", "specs = \"omni\"\npassivity_control = 1", text);
+  EXPECT_NE(error.find("device.passivity_control: expected true or false, got an integer"), std::string::npos) << error;
+}
+
 TEST(SceneToml, TheContactsSampleSpacingIsGiven) {
   const std::string text = std::string(full_scene) + held_tool_section;
   EXPECT_EQ(parse_scene(text, "t.toml", ".").probe.sample_spacing, 0.0);

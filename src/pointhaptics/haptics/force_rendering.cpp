@@ -46,9 +46,24 @@ Vec3 ForceRenderer::render(const Vec3& requested, const Vec3& device_velocity, d
   }
   if (engaged_) since_engaged_ += dt;
   f = limited(engaged_ ? f : Vec3::Zero(), specs_.max_force, rules_.max_change, last_);
-  last_ = f;
+  last_ = f;  // the environment's force: the next tick's change is bounded from it, not from the damper's
+  if (!device_velocity.allFinite()) return f;
   // passivity observer: the hand does work -F.v dt on the environment
-  if (device_velocity.allFinite()) energy_ -= f.dot(device_velocity) * dt;
+  const double observed = energy_ - f.dot(device_velocity) * dt;
+  const double damper_work = device_velocity.squaredNorm() * dt;  // per unit damping coefficient
+  if (rules_.passivity_control && engaged_ && observed < 0 && damper_work > 0) {
+    // passivity controller: the damping alpha that dissipates the excess this tick, alpha |v|^2 dt = -E. Its
+    // force takes out at most the force's own part along the velocity (the part that gives the hand energy)
+    // and the device's max damping beyond: it never pushes against the hand harder than the device can damp
+    const double giving = std::max(0.0, f.dot(device_velocity)) * dt / damper_work;
+    const double alpha = std::min(giving + specs_.max_damping, -observed / damper_work);
+    Vec3 damped = f - alpha * device_velocity;
+    if (damped.norm() > specs_.max_force) damped *= specs_.max_force / damped.norm();
+    dissipated_ += (f - damped).dot(device_velocity) * dt;
+    ++controlled_ticks_;
+    f = damped;
+  }
+  energy_ -= f.dot(device_velocity) * dt;
   min_energy_ = std::min(min_energy_, energy_);
   return f;
 }

@@ -19,12 +19,18 @@ struct ForceRules {
   double engage_below = 0.1;    ///< N: forces engage only once the requested force is below this (CHAI3D's start-up rule)
   double ramp_time = 0.5;       ///< s: after engaging, forces ramp in linearly over this time
   double max_change = 0.2;      ///< N per tick: bound on the change of the commanded force
+  /// Passivity controller (Hannaford & Ryu 2002): a tick whose force would leave the observer below zero
+  /// (the environment giving the hand more energy than it ever took) gets a damper against the device's
+  /// velocity that dissipates the excess, its coefficient at most the device's max damping. Off: the
+  /// observer only reports.
+  bool passivity_control = true;
 };
 
 /// Applies the rules to each tick's requested force: engage when small, ramp in, clamp the magnitude
 /// (not each component) to the device's max force, bound the change per tick; and keeps a passivity
 /// observer (Hannaford & Ryu): the energy the virtual environment has absorbed from the hand,
-/// E = -sum F . v dt, which a passive environment keeps >= 0. No allocation; haptic thread only.
+/// E = -sum F . v dt, which a passive environment keeps >= 0; where it would not, the passivity controller
+/// (ForceRules::passivity_control) adds the damping that keeps it there. No allocation; haptic thread only.
 class ForceRenderer {
  public:
   ForceRenderer(const DeviceSpecs& specs, const ForceRules& rules = {});
@@ -40,6 +46,8 @@ class ForceRenderer {
   bool engaged() const { return engaged_; }
   double observed_energy() const { return energy_; }      ///< J; negative: the environment gave energy
   double min_observed_energy() const { return min_energy_; }
+  double controller_dissipated() const { return dissipated_; }  ///< J the passivity controller took out
+  long long controller_ticks() const { return controlled_ticks_; }  ///< ticks the passivity controller damped
   const Vec3& last_force() const { return last_; }
 
  private:
@@ -51,7 +59,8 @@ class ForceRenderer {
   bool engaged_ = false;
   double since_engaged_ = 0;
   Vec3 last_ = Vec3::Zero(), last_torque_ = Vec3::Zero();
-  double energy_ = 0, min_energy_ = 0;
+  double energy_ = 0, min_energy_ = 0, dissipated_ = 0;
+  long long controlled_ticks_ = 0;
 };
 
 }  // namespace pointhaptics

@@ -163,6 +163,8 @@ HapticStats HapticLoop::stats() const {
   s.spin_mean_us = s.ticks > 0 ? spin_us_sum_ / static_cast<double>(s.ticks) : 0.0;
   s.max_force_n = max_force_;
   s.min_observed_energy = renderer_.min_observed_energy();
+  s.passivity_dissipated = renderer_.controller_dissipated();
+  s.passivity_ticks = renderer_.controller_ticks();
   s.device_failed = failed_;
   s.realtime_priority = realtime_priority_;
   s.device_error = error_;

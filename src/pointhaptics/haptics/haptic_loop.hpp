@@ -49,6 +49,8 @@ struct HapticStats {
   double spin_mean_us = 0;             ///< mean busy-wait before a tick (threaded), us: CPU the loop burns
   double max_force_n = 0;              ///< largest commanded force magnitude, N
   double min_observed_energy = 0;      ///< passivity observer's minimum, J (negative: active at some point)
+  double passivity_dissipated = 0;     ///< J the passivity controller took out (ForceRules::passivity_control)
+  long long passivity_ticks = 0;       ///< ticks it damped
   bool device_failed = false;
   std::string device_error;
   bool realtime_priority = false;      ///< the thread got SCHED_FIFO (needs the privilege; else a normal thread)

@@ -91,6 +91,9 @@ struct RunSummary {
   // haptic loop (runs with a probe)
   long long haptic_ticks = 0;
   double haptic_rate_hz = 0, haptic_period_p99_us = 0, haptic_max_force_n = 0;
+  /// the passivity observer's minimum and what the passivity controller dissipated, J, and on how many ticks
+  double haptic_min_observed_energy = 0, haptic_passivity_dissipated = 0;
+  long long haptic_passivity_ticks = 0;
   LocalModelSummary local_model;
   LodSummary lod;
   ToolSummary tool;

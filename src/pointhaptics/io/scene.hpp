@@ -155,6 +155,7 @@ struct DeviceSpec {
   double max_torque = 0;  ///< custom specs: the largest torque it renders, N m (0: none)
   std::string log;                         ///< replay: a recorded session (resolved path)
   std::string library = "libHD.so";        ///< openhaptics: the HD library to load
+  bool passivity_control = true;           ///< ForceRules::passivity_control
 };
 
 /// [lod]: levels of detail around the contact point (design.md, "Levels of detail").

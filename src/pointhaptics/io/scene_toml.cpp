@@ -203,6 +203,12 @@ class TableReader {
     for (int a = 0; a < 3; ++a) v[a] = as_number(*array->get(a), key);
     return v;
   }
+  bool boolean(std::string_view key, bool fallback) {
+    const toml::node* node = find(key);
+    if (!node) return fallback;
+    if (auto b = node->as_boolean()) return b->get();
+    fail_at(*node, key, fmt::format("expected true or false, got {}", type_name(*node)));
+  }
   std::string string(std::string_view key, std::string fallback) {
     const toml::node* node = find(key);
     if (!node) return fallback;
@@ -581,6 +587,7 @@ void read_device(TableReader& r, DeviceSpec& d, const Context& ctx) {
   d.kind = r.choice("kind", "virtual", {"virtual", "replay", "openhaptics"});
   if (d.kind == "openhaptics") d.library = r.string("library", d.library);
   d.specs = r.choice("specs", "touch", {"touch", "omni", "falcon", "custom"});
+  d.passivity_control = r.boolean("passivity_control", d.passivity_control);
   if (d.specs == "custom") {
     for (const char* key : {"max_force", "max_stiffness", "workspace_radius"})
       if (!r.find(key)) r.fail_table(key, "custom specs need max_force, max_stiffness and workspace_radius");
