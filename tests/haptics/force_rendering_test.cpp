@@ -153,8 +153,8 @@ TEST(ForceRenderer, PassivityObserverSeesASpringAsPassiveAndAnActiveForceAsNot) 
 
 // The passivity controller (Hannaford & Ryu): a force that pushes the hand along its motion, after the hand
 // put some energy in, is let through until that energy is given back, then damped so that the observer never
-// goes below zero; the damping force never exceeds the force's own part along the velocity plus the device's
-// max damping times the speed. A spring stays untouched.
+// goes below zero (where the change per tick is not bounded); the damping force never exceeds the force's own
+// part along the velocity plus the device's max damping times the speed. A spring stays untouched.
 TEST(ForceRenderer, PassivityControllerKeepsTheObserverAtOrAboveZero) {
   ForceRules rules;
   rules.ramp_time = 0;
@@ -191,6 +191,21 @@ TEST(ForceRenderer, PassivityControllerKeepsTheObserverAtOrAboveZero) {
     EXPECT_NEAR(f.x(), -200 * std::max(x, 0.0), 1e-3) << t;
   }
   EXPECT_LT(spring.controller_dissipated(), 1e-6);
+  // the rules bound the commanded force's change per tick, the damper's included: the controller then takes a
+  // few ticks to catch up, and the observer dips below zero by no more than what those ticks let through
+  ForceRules bounded = rules;
+  bounded.max_change = 0.2;
+  ForceRenderer gradual(touch, bounded);
+  gradual.render(Vec3::Zero(), Vec3::Zero(), dt);
+  Vec3 last = Vec3::Zero();
+  for (int t = 0; t < 400; ++t) {
+    const Vec3 f = gradual.render(Vec3(0.5, 0, 0), v, dt);
+    EXPECT_LE((f - last).norm(), 0.2 + 1e-12) << t;
+    last = f;
+  }
+  EXPECT_GT(gradual.controller_ticks(), 390);
+  EXPECT_LT(gradual.min_observed_energy(), 0.0);
+  EXPECT_GT(gradual.min_observed_energy(), -3 * 0.5 * v.norm() * dt);  // under three ticks of the force's work
   // a device without damping still has the force's giving part taken out: the observer stays at zero
   DeviceSpecs undamped = touch;
   undamped.max_damping = 0;

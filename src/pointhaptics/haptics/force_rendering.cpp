@@ -46,8 +46,7 @@ Vec3 ForceRenderer::render(const Vec3& requested, const Vec3& device_velocity, d
   }
   if (engaged_) since_engaged_ += dt;
   f = limited(engaged_ ? f : Vec3::Zero(), specs_.max_force, rules_.max_change, last_);
-  last_ = f;  // the environment's force: the next tick's change is bounded from it, not from the damper's
-  if (!device_velocity.allFinite()) return f;
+  if (!device_velocity.allFinite()) return last_ = f;
   // passivity observer: the hand does work -F.v dt on the environment
   const double observed = energy_ - f.dot(device_velocity) * dt;
   const double damper_work = device_velocity.squaredNorm() * dt;  // per unit damping coefficient
@@ -57,15 +56,19 @@ Vec3 ForceRenderer::render(const Vec3& requested, const Vec3& device_velocity, d
     // and the device's max damping beyond: it never pushes against the hand harder than the device can damp
     const double giving = std::max(0.0, f.dot(device_velocity)) * dt / damper_work;
     const double alpha = std::min(giving + specs_.max_damping, -observed / damper_work);
+    // the rules hold for the damped force too (magnitude, change per tick): what a bounded change lets
+    // through this tick the next ticks take out
     Vec3 damped = f - alpha * device_velocity;
     if (damped.norm() > specs_.max_force) damped *= specs_.max_force / damped.norm();
+    const Vec3 change = damped - last_;
+    if (change.norm() > rules_.max_change) damped = last_ + change * (rules_.max_change / change.norm());
     dissipated_ += (f - damped).dot(device_velocity) * dt;
     ++controlled_ticks_;
     f = damped;
   }
   energy_ -= f.dot(device_velocity) * dt;
   min_energy_ = std::min(min_energy_, energy_);
-  return f;
+  return last_ = f;
 }
 
 }  // namespace pointhaptics

@@ -21,8 +21,9 @@ struct ForceRules {
   double max_change = 0.2;      ///< N per tick: bound on the change of the commanded force
   /// Passivity controller (Hannaford & Ryu 2002): a tick whose force would leave the observer below zero
   /// (the environment giving the hand more energy than it ever took) gets a damper against the device's
-  /// velocity that dissipates the excess, its coefficient at most the device's max damping. Off: the
-  /// observer only reports.
+  /// velocity that dissipates the excess, its coefficient at most the force's own part along the velocity
+  /// plus the device's max damping; the damped force keeps the magnitude clamp and the bound on its change
+  /// per tick, so a bounded tick's excess is taken out over the next ones. Off: the observer only reports.
   bool passivity_control = true;
 };
 
