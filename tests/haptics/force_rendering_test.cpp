@@ -159,6 +159,7 @@ TEST(ForceRenderer, PassivityControllerKeepsTheObserverAtOrAboveZero) {
   ForceRules rules;
   rules.ramp_time = 0;
   rules.max_change = 100;
+  rules.passivity_speed = 0;  // the force's part along the velocity taken out at any speed (the default fades it, below)
   const DeviceSpecs touch = known_device_specs("touch");
   const double dt = 1e-3;
   ForceRenderer active(touch, rules), spring(touch, rules);
@@ -213,6 +214,24 @@ TEST(ForceRenderer, PassivityControllerKeepsTheObserverAtOrAboveZero) {
   bare.render(Vec3::Zero(), Vec3::Zero(), dt);
   for (int t = 0; t < 100; ++t) EXPECT_NEAR(bare.render(Vec3(0.5, 0.3, 0), v, dt).dot(v), 0.0, 1e-15);
   EXPECT_GT(bare.min_observed_energy(), -1e-12);
+  // a hand nearly still (1 mm/s) whose velocity turns from tick to tick: taking out the force's part along
+  // each tick's direction makes the force jump; with the default passivity_speed (10 mm/s) the controller
+  // takes out little more than the device's damping, and the force stays within 10 mN of the request
+  ForceRules faded = rules;
+  faded.passivity_speed = ForceRules{}.passivity_speed;
+  ForceRenderer smooth(touch, faded), sharp(touch, rules);
+  smooth.render(Vec3::Zero(), Vec3::Zero(), dt);
+  sharp.render(Vec3::Zero(), Vec3::Zero(), dt);
+  double worst_smooth = 0, worst_sharp = 0;
+  const Vec3 request(0.5, 0, 0);
+  for (int t = 0; t < 200; ++t) {
+    const Vec3 wandering = 1e-3 * Vec3(std::cos(2.4 * t), std::sin(2.4 * t), 0);
+    worst_smooth = std::max(worst_smooth, (smooth.render(request, wandering, dt) - request).norm());
+    worst_sharp = std::max(worst_sharp, (sharp.render(request, wandering, dt) - request).norm());
+  }
+  EXPECT_GT(smooth.controller_ticks(), 0);
+  EXPECT_LT(worst_smooth, 0.01);
+  EXPECT_GT(worst_sharp, 0.3);
 }
 
 }  // namespace

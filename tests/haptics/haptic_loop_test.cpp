@@ -71,3 +71,45 @@ TEST(HapticLoop, TheProbeBalancesThePublishedContactModel) {
 
 }  // namespace
 }  // namespace pointhaptics
+
+namespace pointhaptics {
+namespace {
+
+// A new contact model from the simulation moves the probe at once. The coupling's damper acts on the probe's
+// motion under one model as the device moves, not on that jump: differentiated, the jump was a force impulse
+// b dp/dt at every simulation step (a buzz of 150-500 Hz on the 100k half-sphere after a slide).
+TEST(HapticLoop, ANewContactModelMovesTheProbeWithoutADamperImpulse) {
+  VirtualDevice device = still_device();
+  WorkspaceMapping mapping;
+  const double k = 500, b = 3;
+  ForceRules rules;
+  rules.ramp_time = 0;
+  rules.max_change = 100;
+  rules.passivity_control = false;
+  HapticLoop loop(device, mapping, CouplingGains{k, b}, rules, 1000.0);
+  ContactModel m;
+  m.p0 = Vec3(0, -1e-3, 0);
+  m.f0 = Vec3(0, 0.5, 0);
+  m.K = -5000 * Mat3::Identity();
+  m.contacts = 3;
+  for (int tick = 1; tick <= 10; ++tick) ASSERT_TRUE(loop.tick(tick * 1e-3, 1e-3));  // engaged before the contact
+  loop.contact_models().back() = m;
+  loop.contact_models().publish();
+  for (int tick = 11; tick <= 300; ++tick) ASSERT_TRUE(loop.tick(tick * 1e-3, 1e-3));
+  loop.frames().update();
+  const HapticFrame before = loop.frames().front();
+  // the simulation's next model pushes 0.1 N harder: the probe jumps by 0.1 / (k + 5000) = 18 um up
+  m.f0.y() += 0.1;
+  loop.contact_models().back() = m;
+  loop.contact_models().publish();
+  ASSERT_TRUE(loop.tick(0.301, 1e-3));
+  loop.frames().update();
+  const HapticFrame& after = loop.frames().front();
+  EXPECT_GT((after.probe - before.probe).y(), 15e-6);
+  // the force is the spring's, k (p - d), up to the damper on the device's own slow motion: not b 18 um / 1 ms = 55 mN
+  EXPECT_LT((after.force - k * (after.probe - after.device)).norm(), 5e-3);
+  EXPECT_NEAR((after.force - before.force).y(), k * (after.probe - before.probe).y(), 5e-3);
+}
+
+}  // namespace
+}  // namespace pointhaptics

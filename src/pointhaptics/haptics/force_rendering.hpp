@@ -25,6 +25,9 @@ struct ForceRules {
   /// plus the device's max damping; the damped force keeps the magnitude clamp and the bound on its change
   /// per tick, so a bounded tick's excess is taken out over the next ones. Off: the observer only reports.
   bool passivity_control = true;
+  /// m/s: below about this device speed the controller takes out less of the force's part along the velocity
+  /// (by |v|^2 / (|v|^2 + passivity_speed^2)), and only the device's max damping stays
+  double passivity_speed = 0.01;
 };
 
 /// Applies the rules to each tick's requested force: engage when small, ramp in, clamp the magnitude

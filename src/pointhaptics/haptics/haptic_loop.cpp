@@ -37,9 +37,19 @@ bool HapticLoop::tick(double t, double dt) {
     const ContactModel& m = models_.front();
     // the probe is where the coupling spring balances the local contact model (haptics/coupling.hpp)
     const double k = gains_.stiffness;
-    const Vec3 p = m.contacts > 0 && m.p0.allFinite() ? coupled_probe(m, d, k, device_max_force_) : d;
-    const Vec3 vp = probe_.allFinite() && dt > 0 ? Vec3((p - probe_) / dt) : vd;
+    const bool touching = m.contacts > 0 && m.p0.allFinite();
+    const Vec3 p = touching ? coupled_probe(m, d, k, device_max_force_) : d;
+    // the probe's velocity for the coupling's damper: how far this tick's contact model moves it as the device
+    // moved since the last tick. A new model from the simulation moves the probe at once (the contact solved
+    // again); differentiated, that jump made a force impulse b dp/dt at every simulation step, a buzz of
+    // 150-500 Hz on the 100k half-sphere after a slide (docs/haptics.md)
+    Vec3 vp = vd;
+    if (last_device_.allFinite() && dt > 0) {
+      const Vec3 before = touching ? coupled_probe(m, last_device_, k, device_max_force_) : last_device_;
+      vp = (p - before) / dt;
+    }
     probe_ = p;
+    last_device_ = d;
     // the coupling pulls the device toward the probe (scene forces are rendered unscaled)
     const Vec3 requested = k * (p - d) + gains_.damping * (vp - vd);
     const Vec3 f = renderer_.render(requested, state.velocity, dt);

@@ -103,6 +103,7 @@ class HapticLoop {
   SpscRing<HapticLogRow> log_;
   std::atomic<long long> log_dropped_{0};
   Vec3 probe_ = Vec3::Constant(NAN);
+  Vec3 last_device_ = Vec3::Constant(NAN);  ///< the device point at the last tick, scene m
   bool failed_ = false;
   std::string error_;
   long long ticks_ = 0;
