@@ -48,6 +48,17 @@ Simulation seed_beam(double damping = 5.0, double young = 1e4, const std::string
   return Simulation(build_scene_model(scene), scene.solver, 1);
 }
 
+// the hand presses the probe toward 4.5 cm below the device origin (2.5 cm into the beam's top face) in 2 s,
+// holds 2 s, withdraws in 2 s and rests 2 s
+VirtualDevice press_and_withdraw() {
+  return VirtualDevice(Trajectory({{0.0, Vec3(0, 0, 0), false},
+                                   {2.0, Vec3(0, -0.045, 0), false},
+                                   {4.0, Vec3(0, -0.045, 0), false},
+                                   {6.0, Vec3(0, 0, 0), false},
+                                   {8.0, Vec3(0, 0, 0), false}}),
+                       known_device_specs("touch"));
+}
+
 InteractiveOptions options(double duration, ProbeMode mode = ProbeMode::PUSH) {
   InteractiveOptions o;
   o.duration = duration;
@@ -97,10 +108,8 @@ TEST(Interactive, DeviceForceNeverExceedsItsLimit) {
 // The same three checks with the probe on the object's surface, a proxy kept there (issue 16, item 7): the
 // loop stays passive at the largest coupling stiffness, the force never exceeds the device's limit, and a
 // probe driven through the object at speed makes no NaN. The pressed beam is sampled at half the seed's
-// spacing: at 15 mm (surface edges of 7.5 mm under a 10 mm probe) the probe went through the top face late
-// in the deep press (no vertex pressing on it after), and the beam, then held from below, gave back 4.8 mJ.
-// The contact is with the surface's vertices, which such a press spreads apart (the likely cause, not
-// confirmed).
+// spacing, where the object alone is passive: the passivity controller, on as by default, never acts (at
+// 15 mm it must: ThePassivityControllerKeepsADeepPressPassive below).
 TEST(Interactive, OnTheSurfaceTheLoopStaysPassiveBoundedAndFinite) {
   auto on_surface = [](const Scene& scene, const Simulation& sim, double duration) {
     InteractiveOptions o = options(duration);
@@ -110,19 +119,17 @@ TEST(Interactive, OnTheSurfaceTheLoopStaysPassiveBoundedAndFinite) {
   {
     const Scene scene = seed_beam_scene(5.0, 1e4, "explicit", 0.0075);
     Simulation sim(build_scene_model(scene), scene.solver, 1);
-    VirtualDevice device(Trajectory({{0.0, Vec3(0, 0, 0), false},
-                                     {2.0, Vec3(0, -0.045, 0), false},
-                                     {4.0, Vec3(0, -0.045, 0), false},
-                                     {6.0, Vec3(0, 0, 0), false},
-                                     {8.0, Vec3(0, 0, 0), false}}),
-                         known_device_specs("touch"));
-    const InteractiveResult r = run_interactive(sim, device, on_surface(scene, sim, 8.0));
+    VirtualDevice device = press_and_withdraw();
+    InteractiveOptions o = on_surface(scene, sim, 8.0);
+    o.rules.passivity_control = true;
+    const InteractiveResult r = run_interactive(sim, device, o);
     std::printf("pressed and withdrawn: max force %.3f N, least energy the hand put in %.3g J, beam %.3g mm from rest, moving at %.3g m/s\n",
                 r.haptic.max_force_n, r.haptic.min_observed_energy, 1e3 * sim.state().u.cwiseAbs().maxCoeff(),
                 sim.state().velocity.cwiseAbs().maxCoeff());
     EXPECT_GT(r.max_contacts, 0);
     EXPECT_GT(r.haptic.max_force_n, 0.1);
     EXPECT_GT(r.haptic.min_observed_energy, -1e-4);
+    EXPECT_EQ(r.haptic.passivity_ticks, 0);  // so the object alone kept the observer there
     // two seconds after the hand is back the beam is at rest (0.0044 mm, 0.8 mm/s). Before the explicit step
     // kept its planned stiffening across steps, a corner of it rang at 1.5-3 mm and 2 m/s for good: sub-steps
     // that changed with the ringing's phase pumped energy into it
@@ -159,38 +166,29 @@ TEST(Interactive, OnTheSurfaceTheLoopStaysPassiveBoundedAndFinite) {
 
 // The seed's beam at its own 15 mm spacing pressed 2.6 cm into its 3 cm thickness: the probe slips off the
 // side as the beam twists and the beam springs back over it, and the environment gives the hand energy back
-// (docs/haptics.md). The passivity controller dissipates it: the hand never gets back more than it put in. At
-// 7.5 mm the same press is passive and the controller all but idle.
+// (docs/haptics.md). The passivity controller dissipates it: the hand gets back no more than it put in, up to
+// what the bound on the force's change per tick lets through.
 TEST(Interactive, ThePassivityControllerKeepsADeepPressPassive) {
-  auto deep_press = [](double spacing, bool control) {
-    const Scene scene = seed_beam_scene(5.0, 1e4, "explicit", spacing);
+  auto deep_press = [](bool control) {
+    const Scene scene = seed_beam_scene();
     Simulation sim(build_scene_model(scene), scene.solver, 1);
-    VirtualDevice device(Trajectory({{0.0, Vec3(0, 0, 0), false},
-                                     {2.0, Vec3(0, -0.045, 0), false},
-                                     {4.0, Vec3(0, -0.045, 0), false},
-                                     {6.0, Vec3(0, 0, 0), false},
-                                     {8.0, Vec3(0, 0, 0), false}}),
-                         known_device_specs("touch"));
+    VirtualDevice device = press_and_withdraw();
     InteractiveOptions o = options(8.0);
     o.surface = std::make_shared<const ObjectSurface>(build_object_surface(scene, sim.model()));
     o.rules.passivity_control = control;
     const InteractiveResult r = run_interactive(sim, device, o);
-    std::printf("deep press at %.1f mm, passivity controller %s: observed energy at least %.3g J, dissipated %.3g J on %lld ticks, "
-                "max force %.3f N\n", 1e3 * spacing, control ? "on" : "off", r.haptic.min_observed_energy, r.haptic.passivity_dissipated,
-                r.haptic.passivity_ticks, r.haptic.max_force_n);
+    std::printf("deep press, passivity controller %s: observed energy at least %.3g J, dissipated %.3g J on %lld ticks, max force %.3f N\n",
+                control ? "on" : "off", r.haptic.min_observed_energy, r.haptic.passivity_dissipated, r.haptic.passivity_ticks,
+                r.haptic.max_force_n);
     EXPECT_TRUE(sim.state().u.allFinite());
     return r.haptic;
   };
-  const HapticStats without = deep_press(0.015, false), with = deep_press(0.015, true);
+  const HapticStats without = deep_press(false), with = deep_press(true);
   EXPECT_LT(without.min_observed_energy, -1e-3);  // the environment alone is active here
   EXPECT_EQ(without.passivity_ticks, 0);
   EXPECT_GT(with.passivity_ticks, 0);
   // within the bound on the force's change per tick, which the damper obeys too: -0.20 mJ against -7.3 mJ
   EXPECT_GT(with.min_observed_energy, -2e-3);
-  const HapticStats finer = deep_press(0.0075, true);
-  EXPECT_GT(finer.min_observed_energy, -1e-9);
-  EXPECT_LT(finer.passivity_dissipated, 1e-5);
-  EXPECT_GT(finer.max_force_n, 1.0);
 }
 
 TEST(Interactive, ImplicitStiffBeamTreatsContactLinearlyImplicitly) {
