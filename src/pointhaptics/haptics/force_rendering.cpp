@@ -49,13 +49,13 @@ Vec3 ForceRenderer::render(const Vec3& requested, const Vec3& device_velocity, d
   if (!device_velocity.allFinite()) return last_ = f;
   // passivity observer: the hand does work -F.v dt on the environment
   const double observed = energy_ - f.dot(device_velocity) * dt;
-  const double damper_work = device_velocity.squaredNorm() * dt;  // per unit damping coefficient
+  const double speed2 = device_velocity.squaredNorm(), damper_work = speed2 * dt;  // per unit damping coefficient
   if (rules_.passivity_control && engaged_ && observed < 0 && damper_work > 0) {
     // passivity controller: the damping alpha that dissipates the excess this tick, alpha |v|^2 dt = -E, at
     // most the device's max damping and the part of the force along the velocity (the part that gives the hand
     // energy), the latter faded out below passivity_speed: where the hand is nearly still the velocity's
     // direction wanders, and taking the force's part along it out made the force jump from tick to tick
-    const double speed2 = device_velocity.squaredNorm(), slow2 = rules_.passivity_speed * rules_.passivity_speed;
+    const double slow2 = rules_.passivity_speed * rules_.passivity_speed;
     const double giving = std::max(0.0, f.dot(device_velocity)) / (speed2 + slow2);
     const double alpha = std::min(giving + specs_.max_damping, -observed / damper_work);
     // the rules hold for the damped force too (magnitude, change per tick): what a bounded change lets
