@@ -25,6 +25,10 @@ void ForceRenderer::reset() {
 
 Vec3 ForceRenderer::limited(Vec3 v, double max, double max_change, const Vec3& last) const {
   if (rules_.ramp_time > 0) v *= std::min(1.0, since_engaged_ / rules_.ramp_time);
+  return bounded(v, max, max_change, last);
+}
+
+Vec3 ForceRenderer::bounded(Vec3 v, double max, double max_change, const Vec3& last) {
   const double magnitude = v.norm();
   if (magnitude > max) v *= max / magnitude;  // keep the direction
   const Vec3 change = v - last;
@@ -60,10 +64,7 @@ Vec3 ForceRenderer::render(const Vec3& requested, const Vec3& device_velocity, d
     const double alpha = std::min(giving + specs_.max_damping, -observed / damper_work);
     // the rules hold for the damped force too (magnitude, change per tick): what a bounded change lets
     // through this tick the next ticks take out
-    Vec3 damped = f - alpha * device_velocity;
-    if (damped.norm() > specs_.max_force) damped *= specs_.max_force / damped.norm();
-    const Vec3 change = damped - last_;
-    if (change.norm() > rules_.max_change) damped = last_ + change * (rules_.max_change / change.norm());
+    const Vec3 damped = bounded(f - alpha * device_velocity, specs_.max_force, rules_.max_change, last_);
     dissipated_ += (f - damped).dot(device_velocity) * dt;
     ++controlled_ticks_;
     f = damped;

@@ -55,8 +55,10 @@ class ForceRenderer {
   const Vec3& last_force() const { return last_; }
 
  private:
-  /// v ramped in since engaging, its magnitude clamped to max, its change from `last` bounded by max_change.
+  /// v ramped in since engaging, then bounded().
   Vec3 limited(Vec3 v, double max, double max_change, const Vec3& last) const;
+  /// v with its magnitude clamped to max (its direction kept) and its change from `last` bounded by max_change.
+  static Vec3 bounded(Vec3 v, double max, double max_change, const Vec3& last);
 
   DeviceSpecs specs_;
   ForceRules rules_;
