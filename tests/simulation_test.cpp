@@ -7,6 +7,7 @@
 #include "support/test_scenes.hpp"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <chrono>
 #include <cstdio>
@@ -151,6 +152,31 @@ TEST(Simulation, StepsEndedByTheIterationBudgetAreCountedNotFailures) {
   EXPECT_FALSE(strict.summary().converged);
   EXPECT_NE(strict.summary().failure.find("did not converge"), std::string::npos) << strict.summary().failure;
   EXPECT_THROW(strict.step(), Error);
+}
+
+TEST(Simulation, ReportsTheLongestStepAndWhereTheFactorWasMade) {
+  // the Cholesky preconditioner refactorised in the background (reproducibly: outside real time each factor
+  // is taken up at the next step), with a refresh after any CG solve of more than one iteration
+  Scene scene = parse_scene(cantilever);
+  scene.solver.kind = SolverKind::IMPLICIT;
+  scene.solver.preconditioner = Preconditioner::CHOLESKY;
+  scene.solver.refactor_iterations = 1;
+  scene.solver.refactorisation = Refactorisation::BACKGROUND;
+  Simulation sim(build_scene_model(scene), scene.solver, 1);
+  sim.run(0.02);
+  const RunSummary s = sim.summary();
+  EXPECT_TRUE(s.converged);
+  EXPECT_GE(s.factorisations, 1);
+  EXPECT_GE(s.background_factorisations, 1);
+  EXPECT_EQ(s.background_factorisations, s.factorisations - 1) << "the first factor is made in place";
+  // the longest step: at least the mean, at most all of them
+  EXPECT_GE(s.step_ms_max, s.step_ms_mean);
+  EXPECT_LE(s.step_ms_max, 1e3 * s.wall_s + 1e-9);
+  EXPECT_GT(s.step_ms_max, 0);
+  const auto doc = nlohmann::json::parse(result_json(sim.model(), sim.state(), s));
+  EXPECT_EQ(doc["timing"]["step_ms_max"].get<double>(), s.step_ms_max);
+  EXPECT_EQ(doc["solver"]["background_factorisations"].get<long long>(), s.background_factorisations);
+  EXPECT_GT(doc["solver"]["factor_bytes"].get<double>(), 0);
 }
 
 TEST(Simulation, CantileverSettlesOnTheCalculixDeflection) {

@@ -77,8 +77,10 @@ void print_summary(ph::Simulation& sim, const ph::RunSummary& s, double setup_s)
     fmt::print("solver          {}: {} steps of {:.3g} s, {} sub-steps (stable sub-step {:.3g} s), t = {:.4g} s\n",
                s.solver_kind, s.steps, sim.solver().dt, s.substeps, s.stable_dt, st.time);
   if (s.preconditioner == "cholesky")
-    fmt::print("preconditioner  cholesky: {} factorisation{} of the tangent, factor {:.1f} MB\n", s.factorisations,
-               s.factorisations == 1 ? "" : "s", s.factor_bytes / 1e6);
+    fmt::print("preconditioner  cholesky: {} factorisation{} of the tangent{}, factor {:.1f} MB\n", s.factorisations,
+               s.factorisations == 1 ? "" : "s",
+               s.background_factorisations > 0 ? fmt::format(" ({} in the background)", s.background_factorisations) : "",
+               s.factor_bytes / 1e6);
   if (s.preconditioner == "two_level")
     fmt::print("preconditioner  two_level: a coarse level of {} points, its factor {:.2f} MB{}\n", s.coarse_points,
                s.factor_bytes / 1e6, s.coarse_points == 0 ? " (none: the object is too small; block-Jacobi alone)" : "");
@@ -119,8 +121,8 @@ void print_summary(ph::Simulation& sim, const ph::RunSummary& s, double setup_s)
   if (s.solver_kind == "static")
     fmt::print("timing          set-up {:.3f} s, solve {:.3f} s\n", setup_s, s.wall_s);
   else
-    fmt::print("timing          set-up {:.3f} s, stepping {:.3f} s, {:.3f} ms per step, {:.0f} steps/s\n", setup_s, s.wall_s,
-               s.step_ms_mean, s.steps_per_s);
+    fmt::print("timing          set-up {:.3f} s, stepping {:.3f} s, {:.3f} ms per step (longest {:.3f} ms), {:.0f} steps/s\n",
+               setup_s, s.wall_s, s.step_ms_mean, s.step_ms_max, s.steps_per_s);
 }
 
 // SIGINT or SIGTERM during a run: stop at the next step and write what was reached (issue 21)

@@ -186,6 +186,7 @@ const StepReport& ModelSimulation::step() {
   const auto placed = clock::now();
   // the solver: internal, external and tool forces, time integration or equilibrium, held points
   DynamicForces* tools = probe_ ? static_cast<DynamicForces*>(&probe_->tool) : held_tool_.get();
+  solver_impl_->set_real_time(probe_ && probe_->asynchronous_lod);
   report_ = solver_impl_->step(model_, state_, ws_, tools);
   if (tools && report_.status != StepStatus::FAILED) tools->after_step(model_, state_, ws_);
   const auto solved = clock::now();
@@ -239,6 +240,7 @@ void ModelSimulation::record(const StepReport& report, double seconds) {
   d.iterations += report.iterations;
   d.cg_iterations += report.cg_iterations;
   d.factorisations += report.factorisations;
+  d.background_factorisations += report.background_factorisations;
   d.factor_bytes = std::max(d.factor_bytes, report.factor_bytes);
   d.coarse_points = std::max(d.coarse_points, static_cast<long long>(report.coarse_points));
   if (solver_.kind != SolverKind::EXPLICIT) d.residual = report.residual;

@@ -39,6 +39,7 @@ struct StepDiagnostics {
   long long iterations = 0;     ///< Newton iterations (explicit: sub-steps)
   long long cg_iterations = 0;
   long long factorisations = 0; ///< preconditioner = "cholesky": numeric factorisations of the tangent
+  long long background_factorisations = 0;  ///< ... of them, made on a worker thread
   double factor_bytes = 0;      ///< ... and the largest factor's size, bytes (two_level: the coarse factor's)
   long long coarse_points = 0;  ///< preconditioner = "two_level": the coarse level's points (the largest)
   long long budget_steps = 0;   ///< implicit steps the iteration budget ended above the tolerance
@@ -49,6 +50,7 @@ struct StepDiagnostics {
   StepStatus status = StepStatus::CONVERGED;  ///< of the last step
   bool failed = false;          ///< a step failed: the state is not a result, and no step follows
   std::string failure;          ///< why
+  double max_step_seconds = 0;  ///< the longest step, s (Simulation::step: the active set's selection included)
   double step_seconds = 0;      ///< wall time in steps, s, and in its stages:
   double active_set_seconds = 0, tools_seconds = 0, solve_seconds = 0;
   long long cuts = 0;           ///< cut updates (ModelSimulation::cut: a blade step's sweeps)
@@ -61,7 +63,9 @@ struct StepDiagnostics {
 /// The probe's tool and its settings, as a simulation holds them (carried to the next active model).
 struct ProbeAttachment {
   ProbeTool tool;
-  bool asynchronous_lod = false;  ///< levels of detail re-selected on a worker thread (real time)
+  /// The probe runs in real time: levels of detail are re-selected on a worker thread, and a background
+  /// refactorisation of the Cholesky preconditioner is taken up as soon as it is ready.
+  bool asynchronous_lod = false;
   /// The object's surface the probe pushes on (null: the point spheres), and its contact's settings: with
   /// levels of detail every new active set gets the part of it that it carries (probe_surface_contact()).
   std::shared_ptr<const ObjectSurface> surface;

@@ -40,6 +40,8 @@ const StepReport& Simulation::step() {
     lod_->carry_cuts();  // a blade's cut in the active set reaches the object
     lod_->mark_stale();
   }
+  StepDiagnostics& d = core().diagnostics();  // (the active set's simulation: it may have changed above)
+  d.max_step_seconds = std::max(d.max_step_seconds, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   return report;
 }
 
@@ -279,6 +281,7 @@ RunSummary Simulation::summary() {
   s.cg_iterations = d.cg_iterations;
   if (sim.solver().kind != SolverKind::EXPLICIT) s.preconditioner = std::string(enum_name(sim.solver().preconditioner));
   s.factorisations = d.factorisations;
+  s.background_factorisations = d.background_factorisations;
   s.factor_bytes = d.factor_bytes;
   s.coarse_points = d.coarse_points;
   s.budget_steps = d.budget_steps;
@@ -297,6 +300,7 @@ RunSummary Simulation::summary() {
   s.kinetic_energy = kinetic_energy(model, state.velocity);
   s.wall_s = d.step_seconds;
   s.step_ms_mean = d.steps > 0 ? 1e3 * d.step_seconds / static_cast<double>(d.steps) : 0;
+  s.step_ms_max = 1e3 * d.max_step_seconds;
   s.steps_per_s = d.step_seconds > 0 ? static_cast<double>(d.steps) / d.step_seconds : 0;
   s.active_set_s = d.active_set_seconds;
   s.tools_s = d.tools_seconds;

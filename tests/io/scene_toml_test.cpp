@@ -164,6 +164,14 @@ TEST(SceneToml, ThePreconditionerIsChosen) {
                 .find("solver.preconditioner: unknown value \"ilu\" (expected block_jacobi | cholesky | two_level)"),
             std::string::npos);
   EXPECT_NE(error_of("dt = 2e-3", "dt = 2e-3\nrefactor_iterations = 0").find("solver.refactor_iterations"), std::string::npos);
+  // where its refactorisations run
+  EXPECT_EQ(scene.solver.refactorisation, Refactorisation::AUTO);
+  text = full_scene;
+  text.replace(text.find("dt = 2e-3"), 9, "dt = 2e-3\nrefactorisation = \"background\"");
+  EXPECT_EQ(parse_scene(text).solver.refactorisation, Refactorisation::BACKGROUND);
+  EXPECT_NE(error_of("dt = 2e-3", "dt = 2e-3\nrefactorisation = \"later\"")
+                .find("solver.refactorisation: unknown value \"later\" (expected auto | in_place | background)"),
+            std::string::npos);
 }
 
 TEST(SceneToml, MooneyRivlinTakesC10C01AndBulkInsteadOfYoungAndPoisson) {

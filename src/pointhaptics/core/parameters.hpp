@@ -126,6 +126,15 @@ enum class Preconditioner {
                  ///< spacing): the smooth, global modes in a few iterations; lags like block-Jacobi
 };
 
+/// Where the Cholesky preconditioner's refactorisations run once its first factor is made (that one always
+/// in place: there is nothing to precondition with before it).
+enum class Refactorisation {
+  AUTO,        ///< in the background in real-time sessions (a probe on the wall clock), else in place
+  IN_PLACE,    ///< on the simulation's thread, within the step that needs it
+  BACKGROUND,  ///< on a worker thread while the old factor serves: taken up as soon as it is ready in real
+               ///< time, at the next step's start otherwise (waiting for it there, so a run is reproducible)
+};
+
 /// [solver]: which solver advances the object, and how far.
 struct SolverSpec {
   SolverKind kind = SolverKind::EXPLICIT;
@@ -137,6 +146,7 @@ struct SolverSpec {
   int iteration_budget = 0;    ///< implicit: Newton iterations per step in real time, keeping the iterate (0 = off)
   Preconditioner preconditioner = Preconditioner::BLOCK_JACOBI;  ///< static, implicit
   int refactor_iterations = 8; ///< cholesky: refactorise after a CG solve of more iterations than this
+  Refactorisation refactorisation = Refactorisation::AUTO;  ///< cholesky: where refactorisations run
 };
 
 /// The one table per enum of the names the scene file, the command line and Python use: to_string(),
@@ -167,6 +177,11 @@ template <>
 struct EnumNames<Preconditioner> {
   static constexpr std::array<std::pair<Preconditioner, std::string_view>, 3> table{
       {{Preconditioner::BLOCK_JACOBI, "block_jacobi"}, {Preconditioner::CHOLESKY, "cholesky"}, {Preconditioner::TWO_LEVEL, "two_level"}}};
+};
+template <>
+struct EnumNames<Refactorisation> {
+  static constexpr std::array<std::pair<Refactorisation, std::string_view>, 3> table{
+      {{Refactorisation::AUTO, "auto"}, {Refactorisation::IN_PLACE, "in_place"}, {Refactorisation::BACKGROUND, "background"}}};
 };
 template <>
 struct EnumNames<SolverKind> {

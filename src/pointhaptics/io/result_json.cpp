@@ -44,6 +44,7 @@ std::string result_json(const Model& model, const State& state, const RunSummary
   if (!s.preconditioner.empty()) doc["solver"]["preconditioner"] = s.preconditioner;
   if (s.preconditioner == "cholesky") {
     doc["solver"]["factorisations"] = s.factorisations;
+    doc["solver"]["background_factorisations"] = s.background_factorisations;
     doc["solver"]["factor_bytes"] = s.factor_bytes;
   }
   if (s.preconditioner == "two_level") {
@@ -53,6 +54,7 @@ std::string result_json(const Model& model, const State& state, const RunSummary
   doc["energy"] = {{"strain", s.strain_energy}, {"kinetic", s.kinetic_energy}};
   doc["timing"] = {{"wall_s", s.wall_s},
                    {"step_ms_mean", s.step_ms_mean},
+                   {"step_ms_max", s.step_ms_max},
                    {"steps_per_s", s.steps_per_s},
                    {"stages", {{"active_set_s", s.active_set_s}, {"tools_s", s.tools_s}, {"solve_s", s.solve_s}}}};
   json constraints = json::array();

@@ -68,6 +68,7 @@ struct RunSummary {
   long long steps = 0;          ///< solver steps of dt
   double strain_energy = 0, kinetic_energy = 0;  ///< J
   double wall_s = 0, step_ms_mean = 0, steps_per_s = 0;
+  double step_ms_max = 0;       ///< the longest step, ms
   /// wall time in the step pipeline's stages, s: following the contact (levels of detail), placing the
   /// tools, the solver
   double active_set_s = 0, tools_s = 0, solve_s = 0;
@@ -76,7 +77,9 @@ struct RunSummary {
   long long cg_iterations = 0;  ///< static, implicit: conjugate-gradient iterations in all
   std::string preconditioner;   ///< static, implicit: "block_jacobi", "cholesky" or "two_level"
   long long factorisations = 0; ///< cholesky: numeric factorisations of the tangent
-  double factor_bytes = 0;      ///< cholesky: the largest factor's size, bytes; two_level: the coarse factor's
+  long long background_factorisations = 0;  ///< ... of them, made on a worker thread
+  double factor_bytes = 0;      ///< cholesky: the largest factor's size (with the worker's copy when it refactorised
+                                ///< in the background), bytes; two_level: the coarse factor's
   long long coarse_points = 0;  ///< two_level: the coarse level's points
   long long budget_steps = 0;   ///< implicit with an iteration budget: steps it ended above the tolerance
   std::string failure;          ///< static: why it did not converge (empty when it did)

@@ -418,6 +418,7 @@ void read_solver(TableReader& r, SolverSpec& s) {
   s.iteration_budget = count("iteration_budget", s.iteration_budget, 0, 1000);
   s.preconditioner = r.enumeration("preconditioner", s.preconditioner);
   s.refactor_iterations = count("refactor_iterations", s.refactor_iterations, 1, 1000);
+  s.refactorisation = r.enumeration("refactorisation", s.refactorisation);
 }
 
 // box = { min, max }, sphere = { centre, radius } or cylinder = { centre, axis, radius, half_length }: exactly one

@@ -49,9 +49,9 @@ StepReport ImplicitSolver::step(const Model& model, State& state, Workspace& ws,
   report.iterations = stats.iterations;
   report.cg_iterations = stats.cg_iterations;
   report.factorisations = stats.factorisations;
-  report.factor_bytes = newton_.cholesky_stats().factor_bytes;
+  report.background_factorisations = stats.background_factorisations;
+  report.factor_bytes = newton_.preconditioner_bytes();
   report.coarse_points = newton_.coarse_points();
-  if (report.coarse_points > 0) report.factor_bytes = std::max(report.factor_bytes, newton_.coarse_stats().factor_bytes);
   report.residual = stats.residual;
   if (!stats.converged) {
     report.status = StepStatus::FAILED;

@@ -19,6 +19,9 @@ class ImplicitSolver final : public Solver {
   /// The tools' forces are evaluated once at the step's start and, with their springs, linearised about
   /// it, f(u) = f - S (u - u_n), which keeps stiff contact springs stable at any dt.
   StepReport step(const Model& model, State& state, Workspace& ws, DynamicForces* forces) override;
+  void set_real_time(bool real_time) override { settings_.real_time = real_time; }
+  /// Newton's solver and its preconditioner's state (the Cholesky factor), for inspection.
+  NewtonSolver& newton() { return newton_; }
 
  private:
   double dt_;

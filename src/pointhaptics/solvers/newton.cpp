@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <thread>
 
 namespace pointhaptics {
 namespace {
@@ -30,6 +31,13 @@ void add_problem_blocks(const Model& model, const NewtonProblem& problem, Eigen:
 }
 
 }  // namespace
+
+bool NewtonSettings::refactor_in_background(int threads) const {
+  if (preconditioner != Preconditioner::CHOLESKY) return false;
+  if (refactorisation == Refactorisation::BACKGROUND) return true;
+  const auto cores = static_cast<long long>(std::thread::hardware_concurrency());
+  return refactorisation == Refactorisation::AUTO && real_time && cores >= threads + 2LL;
+}
 
 NewtonSolver::NewtonSolver(const Model&) {}
 
@@ -130,7 +138,7 @@ void NewtonSolver::build_preconditioner(const Model& model, const NewtonProblem&
   }
 }
 
-bool NewtonSolver::factorise(const Model& model, const NewtonProblem& problem, Workspace& ws) {
+void NewtonSolver::assemble(const Model& model, const NewtonProblem& problem, Workspace& ws) {
   if (!cholesky_.analysed_for(model)) {
     build_tangent_pattern(model, matrix_);
     cholesky_.analyse(model, matrix_);
@@ -140,7 +148,26 @@ bool NewtonSolver::factorise(const Model& model, const NewtonProblem& problem, W
   add_problem_blocks(model, problem, added_blocks_);
   for (index_t i = 0; i < model.n_points; ++i)
     Eigen::Map<Mat3>(matrix_.values.data() + 9 * static_cast<std::size_t>(matrix_.diagonal[i])) += Eigen::Map<const Mat3>(added_blocks_.col(i).data());
+}
+
+bool NewtonSolver::factorise(const Model& model, const NewtonProblem& problem, Workspace& ws) {
+  assemble(model, problem, ws);
   return cholesky_.factorise(matrix_);
+}
+
+void NewtonSolver::take_background_factor(NewtonStats& stats) {
+  if (cholesky_.take_background()) {
+    factor_stale_ = false;
+    ++stats.factorisations;
+    ++stats.background_factorisations;
+    refactorise_ = false;
+    return;
+  }
+  // not positive definite. An exact tangent: the factor in use is kept (tried again, and a new one made of the
+  // projected tangent when CG is slow with it); a projected one (never expected): refactorise in place
+  factor_stale_ = false;
+  if (background_mode_ == TangentMode::EXACT) exact_indefinite_ = true;
+  else refactorise_ = true;
 }
 
 void NewtonSolver::precondition(const Points& r, Points& z, Workspace& ws) {
@@ -219,6 +246,10 @@ NewtonStats NewtonSolver::solve(const Model& model, const NewtonProblem& problem
   kind_ = settings.preconditioner;
   SolverScratch& s = ws.solver_scratch();
   Points &r = s.r, &dx = s.dx, &trial = s.trial;
+  const bool background = settings.refactor_in_background(ws.n_threads());
+  // a factor made in the background during an earlier solve (of this model: a new one is analysed again)
+  if (cholesky_.background_pending() && cholesky_.analysed_for(model) && (!settings.real_time || cholesky_.background_ready()))
+    take_background_factor(stats);
   double rel = residual(model, problem, u, ws, r);
   // Pi at the current iterate, evaluated only when a line search needs it (NaN: not yet)
   double pi = NAN;
@@ -242,6 +273,8 @@ NewtonStats NewtonSolver::solve(const Model& model, const NewtonProblem& problem
       return stats;
     }
     ++stats.iterations;
+    // in real time a background factor is taken up as soon as it is ready
+    if (settings.real_time && cholesky_.background_ready() && cholesky_.analysed_for(model)) take_background_factor(stats);
     // inexact Newton: the linear solve is as accurate as the residual (quadratic convergence), at most
     // 1e-2, and never much more accurate than the tolerance needs
     const double eta = std::max(std::min(0.01, rel), 0.5 * settings.tolerance / rel);
@@ -256,19 +289,52 @@ NewtonStats NewtonSolver::solve(const Model& model, const NewtonProblem& problem
       preconditioner_mode_ = mode;
       // the Cholesky factor lags across iterations and solves while CG converges fast with it
       // (an exact tangent found indefinite once is not factorised again: only a projected one, which is not)
-      use_cholesky_ = settings.preconditioner == Preconditioner::CHOLESKY && cholesky_.factorised() && !refactorise_;
-      if (settings.preconditioner == Preconditioner::CHOLESKY && !use_cholesky_ &&
+      use_cholesky_ = settings.preconditioner == Preconditioner::CHOLESKY && cholesky_.factorised() && !refactorise_ && !factor_stale_;
+      if (settings.preconditioner == Preconditioner::CHOLESKY && !use_cholesky_ && !factor_stale_ &&
           (mode == TangentMode::PROJECTED || !exact_indefinite_)) {
         use_cholesky_ = factorise(model, problem, ws);
-        if (use_cholesky_) ++stats.factorisations;
+        if (use_cholesky_) ++stats.factorisations, factor_stale_ = false;
         if (!use_cholesky_ && mode == TangentMode::EXACT) exact_indefinite_ = true;
         refactorise_ = !use_cholesky_;
       }
       const long long cg_before = stats.cg_iterations;
-      const bool positive =
-          conjugate_gradients(model, problem, r, eta, settings.max_cg_iterations, ws, dx, stats.cg_iterations);
-      if (use_cholesky_ && stats.cg_iterations - cg_before > settings.refactor_iterations) refactorise_ = true;
-      if (!use_cholesky_ && positive) note_cg_rate(stats.cg_iterations - cg_before, eta);
+      // while a refactorisation runs in the background the factor can fall far behind the tangent (a contact
+      // that moved: its stiff springs on other points), and CG with it then takes thousands of iterations
+      // (0.5 s of a 1 ms step, measured): cut short, this iteration is solved with block-Jacobi instead
+      const bool may_fall_back = use_cholesky_ && background;
+      const int stale_limit = 4 * settings.refactor_iterations;
+      bool positive = conjugate_gradients(model, problem, r, eta,
+                                          may_fall_back ? std::min(stale_limit, settings.max_cg_iterations) : settings.max_cg_iterations,
+                                          ws, dx, stats.cg_iterations);
+      if (use_cholesky_ && stats.cg_iterations - cg_before > settings.refactor_iterations) {
+        // the factor has aged: refreshed in place at the next iteration, or in the background from this
+        // iteration's tangent while the old factor keeps serving (the tangent is assembled here, a fraction
+        // of the factorisation)
+        if (!background) {
+          refactorise_ = true;
+        } else if (!cholesky_.background_pending()) {
+          // an exact tangent found indefinite before is not factorised again: the projected one at this iterate
+          // (the line search that follows needs no tangent, and the next iteration linearises afresh)
+          const TangentMode factor_mode = exact_indefinite_ ? TangentMode::PROJECTED : mode;
+          if (factor_mode != mode) {
+            tangent_.linearise(model, u, factor_mode, &ws);
+            if (problem.term) problem.term->linearise(model, u, factor_mode);
+          }
+          assemble(model, problem, ws);
+          if (cholesky_.factorise_in_background(matrix_)) background_mode_ = factor_mode;
+          else refactorise_ = true;
+        }
+      }
+      if (may_fall_back && positive && stats.cg_iterations - cg_before >= stale_limit) {
+        use_cholesky_ = false;
+        factor_stale_ = true;  // block-Jacobi until the worker's factor is taken up
+        ++stats.stale_factor_fallbacks;
+        const long long blocks_before = stats.cg_iterations;
+        positive = conjugate_gradients(model, problem, r, eta, settings.max_cg_iterations, ws, dx, stats.cg_iterations);
+        if (positive) note_cg_rate(stats.cg_iterations - blocks_before, eta);
+      } else if (!use_cholesky_ && positive) {
+        note_cg_rate(stats.cg_iterations - cg_before, eta);
+      }
       if (positive && dot(dx, r) > 0) {
         descent = true;
         break;

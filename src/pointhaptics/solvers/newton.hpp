@@ -3,6 +3,7 @@
 /// tangent: the core of the static solver and of implicit dynamics.
 #include <pointhaptics/core/workspace.hpp>
 
+#include <algorithm>
 #include <vector>
 #include <pointhaptics/mechanics/tangent.hpp>
 #include <pointhaptics/mechanics/viscoelasticity.hpp>
@@ -22,6 +23,16 @@ struct NewtonSettings {
   /// CHOLESKY: the factor is refreshed at the next Newton iteration after a CG solve that took more
   /// iterations than this
   int refactor_iterations = 8;
+  /// CHOLESKY: where the refreshes run (in place, or on a worker thread while the old factor serves) ...
+  Refactorisation refactorisation = Refactorisation::AUTO;
+  /// ... and whether the simulation runs on the wall clock: a background factor is then taken up at the first
+  /// Newton iteration after it is ready, else at the start of the next solve (waiting for it: reproducible)
+  bool real_time = false;
+  /// Whether refactorisations run in the background for a simulation on `threads` threads. AUTO: in real time,
+  /// and only where the worker has a core of its own beside them and the haptic loop's. Sharing one it slows
+  /// every step more than it saves (docs/performance.md: on 2 cores the longest steps of a probe pressing the
+  /// stiff cantilever fell from about 65 to 35 ms, but the mean rose by 10-60%).
+  bool refactor_in_background(int threads) const;
 };
 
 /// A term of the energy beyond the material, the loads, the inertia and the per-point springs: a tool's
@@ -64,7 +75,10 @@ struct NewtonStats {
   bool converged = false;
   int iterations = 0;            ///< Newton iterations
   long long cg_iterations = 0;   ///< CG iterations, summed
-  int factorisations = 0;        ///< CHOLESKY: numeric factorisations of the tangent in this solve
+  int factorisations = 0;        ///< CHOLESKY: numeric factorisations of the tangent in this solve (made or taken up)
+  int background_factorisations = 0;  ///< ... of them, made on the worker thread
+  int stale_factor_fallbacks = 0;     ///< CG solves cut short with a factor far behind the tangent (while the worker
+                                      ///< refactorises) and done again with block-Jacobi
   int projected = 0;             ///< iterations that fell back to the positive semi-definite tangent
   double residual = 0;           ///< |r|_free / max(|b|, |f_int|, |k M (u - a)|) at the end
   bool stalled = false;          ///< converged at the round-off floor above the tolerance
@@ -93,9 +107,17 @@ class NewtonSolver {
                        int max_iterations, Workspace& ws);
   /// The Cholesky factor's size and timings (zero unless the CHOLESKY preconditioner ran).
   const CholeskyStats& cholesky_stats() const { return cholesky_.stats(); }
+  /// The Cholesky factor itself (its background work can be watched or, in tests, held back).
+  SparseCholesky& cholesky() { return cholesky_; }
   /// TWO_LEVEL: the coarse level's points (0: none in use) and its factor's size and timings.
   index_t coarse_points() const { return two_level_ ? coarse_.n_coarse() : 0; }
   const CholeskyStats& coarse_stats() const { return coarse_.cholesky_stats(); }
+  /// The preconditioner's factors' memory, bytes: CHOLESKY's L with the worker's copy of A and L when it
+  /// refactorises in the background; TWO_LEVEL's coarse factor (the larger of the two when both were used).
+  double preconditioner_bytes() const {
+    const double coarse = coarse_points() > 0 ? coarse_stats().factor_bytes : 0.0;
+    return std::max(cholesky_stats().factor_bytes + cholesky_stats().background_bytes, coarse);
+  }
 
  private:
   /// Pi(u); `step`: the material within a viscoelastic step (viscoelasticity.hpp)
@@ -104,9 +126,14 @@ class NewtonSolver {
   /// r = -grad Pi at u, zero at held points; returns the relative residual
   double residual(const Model& model, const NewtonProblem& problem, const Points& u, Workspace& ws, Points& r) const;
   void build_preconditioner(const Model& model, const NewtonProblem& problem, const Points& u, Workspace& ws);
-  /// Assemble the problem's tangent (as last linearised) and factorise it; false when it is not positive
-  /// definite (CG then uses the block-Jacobi preconditioner).
+  /// Assemble the problem's tangent (as last linearised) into matrix_ (the pattern analysed once per model).
+  void assemble(const Model& model, const NewtonProblem& problem, Workspace& ws);
+  /// Assemble and factorise it; false when it is not positive definite (CG then uses the block-Jacobi
+  /// preconditioner).
   bool factorise(const Model& model, const NewtonProblem& problem, Workspace& ws);
+  /// Take up a background factorisation (waiting for it if it is not ready): counted in stats when it is
+  /// good, else the next iteration refactorises in place.
+  void take_background_factor(NewtonStats& stats);
   /// z = B r with the preconditioner in use
   void precondition(const Points& r, Points& z, Workspace& ws);
   /// PCG on (K + k M) x = r over the free points to relative tolerance eta; returns false when it meets
@@ -137,6 +164,8 @@ class NewtonSolver {
   bool use_cholesky_ = false;
   bool refactorise_ = true;
   bool exact_indefinite_ = false;  ///< a factorisation of the exact tangent failed: factorise projected ones only
+  TangentMode background_mode_ = TangentMode::EXACT;  ///< of the tangent factorised in the background
+  bool factor_stale_ = false;  ///< CG with the factor was cut short: block-Jacobi until a new factor is taken up
   // TWO_LEVEL: block-Jacobi plus a coarse model's correction (coarse_correction.hpp), built and factorised
   // with the blocks; `kind_` is the last solve's preconditioner
   Preconditioner kind_ = Preconditioner::BLOCK_JACOBI;

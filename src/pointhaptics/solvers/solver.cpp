@@ -17,6 +17,7 @@ NewtonSettings newton_settings(const SolverSpec& spec) {
   s.max_cg_iterations = spec.max_cg_iterations;
   s.preconditioner = spec.preconditioner;
   s.refactor_iterations = spec.refactor_iterations;
+  s.refactorisation = spec.refactorisation;
   if (spec.kind == SolverKind::IMPLICIT && spec.iteration_budget > 0) {
     s.max_iterations = spec.iteration_budget;
     s.accept_at_budget = true;

@@ -48,6 +48,7 @@ struct StepReport {
   int iterations = 0;          ///< Newton iterations (explicit: the sub-steps)
   long long cg_iterations = 0; ///< CG iterations, summed
   int factorisations = 0;      ///< preconditioner = "cholesky": numeric factorisations of the tangent
+  int background_factorisations = 0;  ///< ... of them, made on a worker thread
   double factor_bytes = 0;     ///< ... and the factor's size, bytes (0: none; "two_level": the coarse factor's)
   index_t coarse_points = 0;   ///< preconditioner = "two_level": the coarse level's points (0: none)
   double residual = 0;         ///< Newton's relative residual at the end (0 for explicit steps)
@@ -68,6 +69,10 @@ class Solver {
   /// A solver made for a new model of the same object (a level of detail's new active set, a cut) takes over
   /// what `previous` carried from step to step about the object's state (explicit: the planned stiffening).
   virtual void continue_from(const Solver& /*previous*/) {}
+  /// Whether the simulation runs on the wall clock (a probe in real time): work that can run off the
+  /// simulation's thread (the Cholesky preconditioner's refactorisation) is then taken up when it is ready
+  /// instead of at a reproducible point.
+  virtual void set_real_time(bool /*real_time*/) {}
 };
 
 /// The solver a spec asks for, for `model`. `stable_dt`: explicit only, the stable step if already known

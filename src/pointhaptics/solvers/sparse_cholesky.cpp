@@ -3,10 +3,32 @@
 #include <cholmod.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
+#include <condition_variable>
+#include <mutex>
+#include <thread>
 #include <vector>
 
 namespace pointhaptics {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// a numeric factorisation that succeeded: CHOLMOD reports a failure (not positive definite) by L->minor < n
+bool positive_definite(int ok, const cholmod_common& common, const cholmod_factor* L) {
+  return ok && common.status == CHOLMOD_OK && L->minor == L->n;
+}
+
+double entries_of(const cholmod_factor* L) { return static_cast<double>(L->is_super ? L->xsize : L->nzmax); }
+
+// L's values and indices, bytes
+double bytes_of(const cholmod_factor* L) {
+  return entries_of(L) * static_cast<double>(sizeof(double) + (L->is_super ? 0 : sizeof(int))) +
+         static_cast<double>(L->is_super ? L->ssize : L->n + 1) * sizeof(int);
+}
+
+}  // namespace
 
 struct SparseCholesky::Factor {
   cholmod_common common;
@@ -38,6 +60,69 @@ struct SparseCholesky::Factor {
   }
 };
 
+// A worker thread that factorises a copy of A into a second factor of the same analysis, with its own CHOLMOD
+// workspace (a cholmod_common serves one thread at a time). The simulation's thread hands a job over and never
+// waits for it unless it asks to (take_background()); the two factors are swapped when it is taken up, so the
+// worker's next job refactorises the one that was in use.
+struct SparseCholesky::Background {
+  cholmod_common common;
+  cholmod_sparse* A = nullptr;
+  cholmod_factor* L = nullptr;
+  bool good = false;    // the worker's last result (read after `running` is seen false)
+  double seconds = 0;
+  bool pending = false;  // the simulation's thread only: a job was handed over and not yet taken up
+  std::function<void()> before;  // SparseCholesky::before_background_factorisation, at the hand-over
+  std::mutex mutex;
+  std::condition_variable wake, finished;
+  bool job = false, stop = false;
+  std::atomic<bool> running{false};  // a job handed over that the worker has not finished
+  std::thread worker;
+
+  Background() {
+    cholmod_start(&common);
+    common.print = 0;
+    worker = std::thread([this] { run(); });
+  }
+  ~Background() {
+    {
+      std::lock_guard lock(mutex);
+      stop = true;
+    }
+    wake.notify_one();
+    worker.join();  // a factorisation under way cannot be interrupted: it ends first
+    release();
+    cholmod_finish(&common);
+  }
+  void release() {
+    cholmod_free_factor(&L, &common);
+    cholmod_free_sparse(&A, &common);
+  }
+  void wait() {
+    std::unique_lock lock(mutex);
+    finished.wait(lock, [this] { return !running.load(std::memory_order_acquire); });
+  }
+  void run() {
+    for (;;) {
+      {
+        std::unique_lock lock(mutex);
+        wake.wait(lock, [this] { return job || stop; });
+        if (stop) return;
+        job = false;
+      }
+      if (before) before();
+      const auto start = Clock::now();
+      const int ok = cholmod_factorize(A, L, &common);
+      good = positive_definite(ok, common, L);
+      seconds = std::chrono::duration<double>(Clock::now() - start).count();
+      {
+        std::lock_guard lock(mutex);
+        running.store(false, std::memory_order_release);
+      }
+      finished.notify_all();
+    }
+  }
+};
+
 SparseCholesky::SparseCholesky() : factor_(std::make_unique<Factor>()) {}
 SparseCholesky::~SparseCholesky() = default;
 SparseCholesky::SparseCholesky(SparseCholesky&&) noexcept = default;
@@ -50,8 +135,17 @@ bool SparseCholesky::analysed_for(const Model& model) const {
 }
 bool SparseCholesky::factorised() const { return factor_->good; }
 
+void SparseCholesky::drop_background() {
+  if (!background_) return;
+  background_->wait();
+  background_->release();  // copies of the old analysis
+  background_->pending = false;
+  stats_.background_bytes = 0;
+}
+
 void SparseCholesky::analyse(const Model& model, const TangentMatrix& K) {
   const auto start = std::chrono::steady_clock::now();
+  drop_background();
   Factor& f = *factor_;
   f.release();
   const index_t n = model.n_points;
@@ -111,15 +205,65 @@ bool SparseCholesky::factorise(const TangentMatrix& K) {
   for (std::size_t p = 0; p < f.source.size(); ++p) x[p] = K.values[f.source[p]];
   const int ok = cholmod_factorize(f.A, f.L, &f.common);
   // a failed factorisation leaves L incomplete (minor < n) but reusable by the next attempt
-  f.good = ok && f.common.status == CHOLMOD_OK && f.L->minor == f.L->n;
+  f.good = positive_definite(ok, f.common, f.L);
   ++stats_.factorisations;
   stats_.factorise_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (f.good) {
-    stats_.factor_nonzeros = static_cast<double>(f.L->is_super ? f.L->xsize : f.L->nzmax);
-    stats_.factor_bytes = stats_.factor_nonzeros * (sizeof(double) + (f.L->is_super ? 0 : sizeof(int))) +
-                          static_cast<double>(f.L->is_super ? f.L->ssize : f.L->n + 1) * sizeof(int);
+    stats_.factor_nonzeros = entries_of(f.L);
+    stats_.factor_bytes = bytes_of(f.L);
   }
   return f.good;
+}
+
+bool SparseCholesky::factorise_in_background(const TangentMatrix& K) {
+  Factor& f = *factor_;
+  if (!f.L || (background_ && background_->running.load(std::memory_order_acquire))) return false;
+  if (!background_) background_ = std::make_unique<Background>();
+  Background& b = *background_;
+  if (!b.A) {
+    // the worker's own copy of the analysis (made once per analysis; it allocates)
+    b.A = cholmod_copy_sparse(f.A, &b.common);
+    b.L = b.A ? cholmod_copy_factor(f.L, &b.common) : nullptr;
+    if (!b.L) {
+      b.release();
+      return false;
+    }
+    stats_.background_bytes = bytes_of(b.L) + static_cast<double>(f.source.size()) * (sizeof(double) + sizeof(int));
+  }
+  double* x = static_cast<double*>(b.A->x);
+  for (std::size_t p = 0; p < f.source.size(); ++p) x[p] = K.values[f.source[p]];
+  {
+    std::lock_guard lock(b.mutex);
+    b.before = before_background_factorisation;
+    b.job = true;
+    b.running.store(true, std::memory_order_relaxed);
+  }
+  b.wake.notify_one();
+  b.pending = true;
+  return true;
+}
+
+bool SparseCholesky::background_pending() const { return background_ && background_->pending; }
+
+bool SparseCholesky::background_ready() const {
+  return background_pending() && !background_->running.load(std::memory_order_acquire);
+}
+
+bool SparseCholesky::take_background() {
+  if (!background_pending()) return false;
+  Background& b = *background_;
+  b.wait();
+  b.pending = false;
+  if (!b.good) return false;
+  Factor& f = *factor_;
+  std::swap(f.L, b.L);  // the worker refactorises the old one next time
+  f.good = true;
+  ++stats_.factorisations;
+  ++stats_.background_factorisations;
+  stats_.factorise_s = b.seconds;
+  stats_.factor_nonzeros = entries_of(f.L);
+  stats_.factor_bytes = bytes_of(f.L);
+  return true;
 }
 
 void SparseCholesky::solve(const Points& r, Points& z) {

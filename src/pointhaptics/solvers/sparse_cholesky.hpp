@@ -1,9 +1,11 @@
 #pragma once
 /// @file A sparse Cholesky factorisation of an assembled tangent over the free points (SuiteSparse CHOLMOD,
 /// supernodal): the fill-reducing ordering and symbolic factor once per model, the numeric factor whenever
-/// the caller asks (Newton reuses it over many steps as a preconditioner: a "lagged" factorisation).
+/// the caller asks (Newton reuses it over many steps as a preconditioner: a "lagged" factorisation), either
+/// in place or on a worker thread while the old factor keeps serving (a background refactorisation).
 #include <pointhaptics/mechanics/tangent_matrix.hpp>
 
+#include <functional>
 #include <memory>
 
 namespace pointhaptics {
@@ -12,8 +14,10 @@ struct CholeskyStats {
   double factor_nonzeros = 0;  ///< entries of L
   double factor_bytes = 0;     ///< L's values and indices, bytes
   double analyse_s = 0;        ///< the ordering and symbolic factor, s
-  double factorise_s = 0;      ///< the last numeric factorisation, s
+  double factorise_s = 0;      ///< the last numeric factorisation, s (in the background: on the worker)
   long long factorisations = 0;
+  long long background_factorisations = 0;  ///< of them, made on the worker thread and taken up
+  double background_bytes = 0;  ///< the worker's copy of A and L (0 until a background factorisation), bytes
 };
 
 class SparseCholesky {
@@ -37,9 +41,29 @@ class SparseCholesky {
   void solve(const Points& r, Points& z);
   const CholeskyStats& stats() const { return stats_; }
 
+  /// Start factorising K's current values on a worker thread (with its own CHOLMOD workspace and a second
+  /// factor of the analysed pattern: twice L's memory), while factorised() and solve() keep the factor there
+  /// is. False (nothing started) when a background factorisation is still running or nothing is analysed. The
+  /// values are copied before this returns: K may change at once.
+  bool factorise_in_background(const TangentMatrix& K);
+  /// A background factorisation was started and has not been taken up by take_background() yet.
+  bool background_pending() const;
+  /// ... and it has finished (take_background() will not wait).
+  bool background_ready() const;
+  /// Take up the background factorisation (waiting for it if it is still running): true when it is positive
+  /// definite, and then solve() uses it from now on; false when it is not (the factor in use is kept) or none
+  /// was pending.
+  bool take_background();
+  /// For tests: called on the worker thread before each background factorisation (holds it back at will).
+  std::function<void()> before_background_factorisation;
+
  private:
-  struct Factor;  // CHOLMOD's objects, kept out of this header
+  struct Factor;      // CHOLMOD's objects, kept out of this header
+  struct Background;  // the worker thread and its copy of A and L
+  /// Wait for a background factorisation that is running and drop it (a new analysis is made).
+  void drop_background();
   std::unique_ptr<Factor> factor_;
+  std::unique_ptr<Background> background_;
   CholeskyStats stats_;
 };
 

@@ -29,6 +29,7 @@ StaticStats load_stepping(const Model& model, State& state, Workspace& ws, Newto
     stats.iterations += ns.iterations;
     stats.cg_iterations += ns.cg_iterations;
     stats.factorisations += ns.factorisations;
+    stats.background_factorisations += ns.background_factorisations;
     stats.projected += ns.projected;
     stats.residual = ns.residual;
     if (ns.converged) {
@@ -84,9 +85,9 @@ StepReport StaticSolver::step(const Model& model, State& state, Workspace& ws, D
   report.iterations = stats.iterations;
   report.cg_iterations = stats.cg_iterations;
   report.factorisations = stats.factorisations;
-  report.factor_bytes = newton_.cholesky_stats().factor_bytes;
+  report.background_factorisations = stats.background_factorisations;
+  report.factor_bytes = newton_.preconditioner_bytes();
   report.coarse_points = newton_.coarse_points();
-  if (report.coarse_points > 0) report.factor_bytes = std::max(report.factor_bytes, newton_.coarse_stats().factor_bytes);
   report.residual = stats.residual;
   report.failure = stats.failure;
   return report;

@@ -10,6 +10,7 @@ struct StaticStats {
   int iterations = 0;            ///< Newton iterations over all load steps
   long long cg_iterations = 0;
   int factorisations = 0;        ///< preconditioner = "cholesky": numeric factorisations of the tangent
+  int background_factorisations = 0;  ///< ... of them, made on a worker thread
   int projected = 0;             ///< Newton iterations that used the positive semi-definite tangent
   int load_steps = 0;            ///< converged load increments
   int cutbacks = 0;              ///< failed increments that were retried with a smaller one
