@@ -177,6 +177,12 @@ TEST(Simulation, ReportsTheLongestStepAndWhereTheFactorWasMade) {
   EXPECT_EQ(doc["timing"]["step_ms_max"].get<double>(), s.step_ms_max);
   EXPECT_EQ(doc["solver"]["background_factorisations"].get<long long>(), s.background_factorisations);
   EXPECT_GT(doc["solver"]["factor_bytes"].get<double>(), 0);
+  // the shipped scene that docs/performance.md measures this on
+  const Scene shipped = read_scene_file(PH_SCENES "/stiff_cantilever_probe.toml");
+  EXPECT_EQ(shipped.solver.kind, SolverKind::IMPLICIT);
+  EXPECT_EQ(shipped.solver.preconditioner, Preconditioner::CHOLESKY);
+  EXPECT_EQ(shipped.material.young, 1e8);
+  EXPECT_TRUE(shipped.probe.present);
 }
 
 TEST(Simulation, CantileverSettlesOnTheCalculixDeflection) {

@@ -289,7 +289,7 @@ RefactorRun turning_load(int steps, Refactorisation where, bool real_time,
   settings.real_time = real_time;
   ImplicitSolver solver(model, 1e-3, settings);
   State state = State::at_rest(model);
-  Workspace ws(model, 2);
+  Workspace ws(model, 1);  // one thread: the worker is the only other (and TSan sees no TBB)
   RefactorRun run;
   for (int step = 0; step < steps; ++step) {
     const double angle = 0.05 * step;  // the tip load turns in the x-y plane, ten times larger
