@@ -10,6 +10,7 @@
 #include <pointhaptics/geometry/shape_surfaces.hpp>
 #include <pointhaptics/haptics/surface_contact.hpp>
 #include <pointhaptics/mechanics/model_builder.hpp>
+#include <pointhaptics/mechanics/tangent_matrix.hpp>
 #include <pointhaptics/simulation.hpp>
 
 #include <gtest/gtest.h>
@@ -113,6 +114,43 @@ TEST(SurfaceContact, ForcesAreTheEnergyGradientAndTheTangentTheirDerivative) {
       EXPECT_LT((load.force + f.rowwise().sum()).norm(), 1e-9 * load.force.norm());
       EXPECT_GT(load.contacts, 0);
     }
+  }
+}
+
+// What the Cholesky preconditioner's factor takes of the contact (EnergyTerm::add_to_matrix): the projected
+// tangent with its coupling between the points that carry a vertex. Where a pair of them lies outside the
+// material tangent's pattern it is lumped onto their diagonal blocks, which keeps the matrix at or above the
+// contact's tangent: x^T K x >= x^T H x for every x, and equal where no pair was lumped.
+TEST(SurfaceContact, ItsTangentEntersTheAssembledMatrixWithItsCoupling) {
+  const Block b = block();
+  for (const ToolCase& t : tools()) {
+    SCOPED_TRACE(t.name);
+    SurfaceContact contact(b.model, b.surface, build_surface_map(b.model, b.surface.V), t.shape);
+    contact.set_pose(t.pose);
+    const Points u = random_field(b.model.n_points, 1e-4, 3);
+    contact.linearise(b.model, u, TangentMode::PROJECTED);
+    TangentMatrix K;
+    build_tangent_pattern(b.model, K);
+    K.values.assign(9 * static_cast<std::size_t>(K.n_blocks()), 0.0);
+    ASSERT_TRUE(contact.add_to_matrix(K));
+    double worst = 0, scale = 0, coupled = 0;
+    for (unsigned seed = 10; seed < 20; ++seed) {
+      const Points x = random_field(b.model.n_points, 1.0, seed);
+      Points Hx = Points::Zero(3, b.model.n_points), Kx;
+      contact.add_tangent_product(x, Hx);
+      multiply(K, x, Kx);
+      const double exact = dot(x, Hx), assembled = dot(x, Kx);
+      ASSERT_GT(exact, 0);
+      EXPECT_GE(assembled, exact * (1 - 1e-12)) << "the lumped matrix is a bound of the contact's tangent";
+      worst = std::max(worst, (Kx - Hx).norm());
+      scale = std::max(scale, Hx.norm());
+    }
+    // the coupling is there: K's off-diagonal blocks carry most of the contact (a diagonal alone would be far off)
+    for (index_t j = 0; j < b.model.n_points; ++j)
+      for (index_t e = K.pattern.begin(j); e < K.pattern.end(j); ++e)
+        if (K.pattern.index[e] != j) coupled += Eigen::Map<const Mat3>(K.values.data() + 9 * static_cast<std::size_t>(e)).norm();
+    EXPECT_GT(coupled, 0);
+    EXPECT_LT(worst, 0.5 * scale) << "close to the contact's own tangent";
   }
 }
 

@@ -101,5 +101,47 @@ TEST(TangentMatrix, TheHourglassPartBoundsThePenaltysHessianAndLeavesLinearField
   EXPECT_LT(hourglass.norm(), 1e-8 * product(K0, x).norm() + 1e-12);
 }
 
+// A coupling a S between two points enters both off-diagonal blocks where the pattern has them, and is
+// lumped onto the two diagonal blocks as |a| S where it has not; either way x^T K x only grows by at least
+// a x_j^T S x_k (the lumped form bounds it from above).
+TEST(TangentMatrix, ACouplingEntersItsBlocksOrIsLumpedOntoTheDiagonal) {
+  const Model model = make_model(MaterialModel::SVK, 0);
+  TangentMatrix K;
+  build_tangent_pattern(model, K);
+  const auto is_block = [&](index_t j, index_t k) {
+    for (index_t e = K.pattern.begin(j); e < K.pattern.end(j); ++e)
+      if (K.pattern.index[e] == k) return e;
+    return index_t{-1};
+  };
+  index_t near = -1, far = -1;
+  for (index_t k = 1; k < model.n_points; ++k) {
+    if (near < 0 && is_block(0, k) >= 0) near = k;
+    if (far < 0 && is_block(0, k) < 0) far = k;
+  }
+  ASSERT_GE(near, 0);
+  ASSERT_GE(far, 0) << "the box is wider than two stencils";
+  Mat3 S;
+  S << 2, 0.5, 0, 0.5, 1, 0.2, 0, 0.2, 3;  // symmetric positive definite
+  const auto block = [&](index_t e) { return Mat3(Eigen::Map<const Mat3>(K.values.data() + 9 * static_cast<std::size_t>(e))); };
+  for (const double a : {0.7, -0.7}) {
+    SCOPED_TRACE(a);
+    K.values.assign(9 * static_cast<std::size_t>(K.n_blocks()), 0.0);
+    add_coupling(K, 0, near, a, S);
+    EXPECT_TRUE(block(is_block(0, near)).isApprox(a * S));
+    EXPECT_TRUE(block(is_block(near, 0)).isApprox(a * S));
+    EXPECT_EQ(block(K.diagonal[0]).norm(), 0.0);
+    K.values.assign(9 * static_cast<std::size_t>(K.n_blocks()), 0.0);
+    add_coupling(K, 0, far, a, S);
+    EXPECT_TRUE(block(K.diagonal[0]).isApprox(std::abs(a) * S));
+    EXPECT_TRUE(block(K.diagonal[far]).isApprox(std::abs(a) * S));
+    const Points x = test::random_field(model.n_points, 1.0, 3);
+    const double exact = a * (x.col(0).dot(S * x.col(far)) + x.col(far).dot(S * x.col(0)));
+    EXPECT_GE(x.cwiseProduct(product(K, x)).sum(), exact);
+  }
+  K.values.assign(9 * static_cast<std::size_t>(K.n_blocks()), 0.0);
+  add_coupling(K, 4, 4, 0.5, S);
+  EXPECT_TRUE(block(K.diagonal[4]).isApprox(0.5 * S)) << "a point with itself: once";
+}
+
 }  // namespace
 }  // namespace pointhaptics

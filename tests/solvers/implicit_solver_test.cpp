@@ -62,13 +62,16 @@ TEST_P(ImplicitStiffness, FreeVibrationNeverGainsEnergyAtOneMillisecond) {
   settings.tolerance = 1e-9;
   ImplicitSolver solver(model, 1e-3, settings);
   double energy = total_energy(model, state);
+  // Newton stops at the model's force floor (1e-9 E L^2, solvers/reactions.hpp): below 1e-15 of the kick's
+  // energy (the stiff beams' vibration falls to 1e-30 J within the run) what is left is round-off
+  const double resolved = 1e-15 * energy;
   for (int k = 0; k < 200; ++k) {
     const StepReport report = solver.step(model, state, ws, nullptr);
     ASSERT_EQ(report.status, StepStatus::CONVERGED) << "step " << k;
     const double e = total_energy(model, state);
     ASSERT_TRUE(std::isfinite(e));
     // backward Euler dissipates: the energy of a free vibration can only fall
-    ASSERT_LE(e, energy * (1 + 1e-6)) << "step " << k;
+    ASSERT_LE(e, energy * (1 + 1e-6) + resolved) << "step " << k;
     energy = e;
   }
   EXPECT_NEAR(state.time, 0.2, 1e-12);

@@ -284,6 +284,16 @@ void SurfaceContact::add_diagonal_blocks(Eigen::Matrix<double, 9, Eigen::Dynamic
     for_each_squared_weight(a.vertex, [&](index_t j, double w2) { Eigen::Map<Mat3>(blocks.col(j).data()) += w2 * a.preconditioner; });
 }
 
+bool SurfaceContact::add_to_matrix(TangentMatrix& K) const {
+  for (const Active& a : active_)
+    for_each_surface_vertex(a.vertex, [&](index_t vertex, double b) {
+      for (index_t e = map_.points.begin(vertex); e < map_.points.end(vertex); ++e)
+        for (index_t f = e; f < map_.points.end(vertex); ++f)
+          add_coupling(K, map_.points.index[e], map_.points.index[f], b * map_.weight[e] * map_.weight[f], a.preconditioner);
+    });
+  return true;
+}
+
 bool SurfaceContact::update_multipliers(const Model& model, const Points& u) {
   bool met = load(model, u).penetration <= tolerance_;
   for (index_t v = 0; v < static_cast<index_t>(anchors_.size()); ++v) {

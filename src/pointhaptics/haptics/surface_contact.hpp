@@ -117,6 +117,10 @@ class SurfaceContact final : public EnergyTerm {
   void linearise(const Model& model, const Points& u, TangentMode mode) override;
   void add_tangent_product(const Points& dx, Points& out) const override;
   void add_diagonal_blocks(Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks) const override;
+  /// Each pressing vertex's positive part P coupled over the points that carry it, w_j w_k P: the Cholesky
+  /// preconditioner's factor then holds the contact's stiffness as it is (at a sample its parents' rows, each
+  /// weighted by b_k, a bound of the sample's own row in the same way as its squared weights).
+  bool add_to_matrix(TangentMatrix& K) const override;
   /// The tool's coupling to the points, at the last linearise(): b += W^T sum_v H_v e, the load on the points
   /// when the tool moves by e with them held (H_v the vertex's positive stiffness, k_v n_v n_v^T pressing, the
   /// friction's sticking); returns sum_v H_v, the tool's stiffness against the held object.

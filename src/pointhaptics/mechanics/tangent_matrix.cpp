@@ -123,6 +123,31 @@ void assemble_tangent(const Model& model, const Tangent& tangent, TangentMatrix&
   });
 }
 
+namespace {
+// the entry of block (j, k) in row j, -1 when the pattern has none (rows are sorted)
+index_t find_block(const TangentMatrix& K, index_t j, index_t k) {
+  const auto first = K.pattern.index.begin() + K.pattern.begin(j), last = K.pattern.index.begin() + K.pattern.end(j);
+  const auto it = std::lower_bound(first, last, k);
+  return it != last && *it == k ? static_cast<index_t>(it - K.pattern.index.begin()) : -1;
+}
+Eigen::Map<Mat3> block(TangentMatrix& K, index_t e) { return Eigen::Map<Mat3>(K.values.data() + 9 * static_cast<std::size_t>(e)); }
+}  // namespace
+
+void add_coupling(TangentMatrix& K, index_t j, index_t k, double a, const Mat3& S) {
+  if (j == k) {
+    block(K, K.diagonal[j]) += a * S;
+    return;
+  }
+  const index_t jk = find_block(K, j, k), kj = find_block(K, k, j);
+  if (jk >= 0 && kj >= 0) {
+    block(K, jk) += a * S;
+    block(K, kj) += a * S;
+    return;
+  }
+  block(K, K.diagonal[j]) += std::abs(a) * S;
+  block(K, K.diagonal[k]) += std::abs(a) * S;
+}
+
 void multiply(const TangentMatrix& K, const Points& x, Points& y) {
   y.setZero(3, x.cols());
   for (index_t j = 0; j < K.pattern.n_rows(); ++j)

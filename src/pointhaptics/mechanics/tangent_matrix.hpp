@@ -30,6 +30,12 @@ void build_tangent_pattern(const Model& model, TangentMatrix& K);
 /// add_hourglass_bound): a preconditioner needs to be close, not exact. On ws's threads when given (no allocation after the first call for a model size).
 void assemble_tangent(const Model& model, const Tangent& tangent, TangentMatrix& K, Workspace* ws = nullptr);
 
+/// K_jk += a S and K_kj += a S (S symmetric, 3x3; j == k: once), the coupling of a term whose tangent is
+/// w w^T (x) S over a few points (a contact vertex carried by its points). A pair outside K's pattern is lumped
+/// onto the two diagonal blocks as |a| S each: with S positive semi-definite the result stays at or above the
+/// exact sum, so a preconditioner made from it stays positive definite.
+void add_coupling(TangentMatrix& K, index_t j, index_t k, double a, const Mat3& S);
+
 /// y = K x over all points (checks and tests: the solvers use K through its factor).
 void multiply(const TangentMatrix& K, const Points& x, Points& y);
 

@@ -2,6 +2,7 @@
 
 #include <pointhaptics/mechanics/energy.hpp>
 #include <pointhaptics/mechanics/forces.hpp>
+#include <pointhaptics/solvers/reactions.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -19,10 +20,12 @@ void precondition_blocks(const Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks,
   for (Eigen::Index i = 0; i < r.cols(); ++i) z.col(i) = Eigen::Map<const Mat3>(blocks.col(i).data()) * r.col(i);
 }
 
-// blocks += the problem's own 3x3 diagonal terms beyond the material: its further term's, the inertia's and the
-// springs' (both preconditioners take them; the term's coupling between points is left out)
-void add_problem_blocks(const Model& model, const NewtonProblem& problem, Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks) {
-  if (problem.term) problem.term->add_diagonal_blocks(blocks);
+// blocks += the problem's own 3x3 diagonal terms beyond the material: the inertia's, the springs' and, unless
+// `term` is false, its further term's (block-Jacobi takes only these; the Cholesky factor takes the term's
+// coupling between points where the term gives it: EnergyTerm::add_to_matrix)
+void add_problem_blocks(const Model& model, const NewtonProblem& problem, Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks,
+                        bool term = true) {
+  if (problem.term && term) problem.term->add_diagonal_blocks(blocks);
   for (index_t i = 0; i < model.n_points; ++i) {
     Eigen::Map<Mat3> B(blocks.col(i).data());
     B.diagonal().array() += problem.inertia * model.mass[i];
@@ -88,7 +91,7 @@ double NewtonSolver::residual(const Model& model, const NewtonProblem& problem, 
     term_forces = f.norm();
   }
   mask_held(model, r);
-  const double scale = std::max({problem.load->norm(), ws.f_int.norm(), std::sqrt(inertial), term_forces, 1e-300});
+  const double scale = std::max({problem.load->norm(), ws.f_int.norm(), std::sqrt(inertial), term_forces, force_floor_, 1e-300});
   return r.norm() / scale;
 }
 
@@ -144,8 +147,9 @@ void NewtonSolver::assemble(const Model& model, const NewtonProblem& problem, Wo
     cholesky_.analyse(model, matrix_);
   }
   assemble_tangent(model, tangent_, matrix_, &ws);
+  const bool coupled = problem.term && problem.term->add_to_matrix(matrix_);
   added_blocks_.setZero(9, model.n_points);
-  add_problem_blocks(model, problem, added_blocks_);
+  add_problem_blocks(model, problem, added_blocks_, !coupled);
   for (index_t i = 0; i < model.n_points; ++i)
     Eigen::Map<Mat3>(matrix_.values.data() + 9 * static_cast<std::size_t>(matrix_.diagonal[i])) += Eigen::Map<const Mat3>(added_blocks_.col(i).data());
 }
@@ -246,6 +250,10 @@ NewtonStats NewtonSolver::solve(const Model& model, const NewtonProblem& problem
   kind_ = settings.preconditioner;
   SolverScratch& s = ws.solver_scratch();
   Points &r = s.r, &dx = s.dx, &trial = s.trial;
+  // with nothing pushing but round-off (a tool only touching, no load) the residual is measured against the
+  // model's force floor, not against that round-off, which no iterate lowers (the shipped indentation scene
+  // took 700 Newton iterations to report "not converged")
+  force_floor_ = force_floor(model);
   const bool background = settings.refactor_in_background(ws.n_threads());
   // a factor made in the background during an earlier solve (of this model: a new one is analysed again)
   if (cholesky_.background_pending() && cholesky_.analysed_for(model) && (!settings.real_time || cholesky_.background_ready()))

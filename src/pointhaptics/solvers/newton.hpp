@@ -51,6 +51,10 @@ class EnergyTerm {
   virtual void add_tangent_product(const Points& dx, Points& out) const = 0;
   /// The tangent's 3x3 diagonal blocks added into `blocks` (9 x n, column-major), for the preconditioner.
   virtual void add_diagonal_blocks(Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks) const = 0;
+  /// The tangent's blocks (its positive semi-definite part, or a bound of it) added into the assembled tangent
+  /// that the Cholesky preconditioner factorises, with its coupling between points: true if the term did so;
+  /// false, and the factor takes its diagonal blocks only.
+  virtual bool add_to_matrix(TangentMatrix&) const { return false; }
   /// A constrained term (augmented Lagrangian) checks its constraint at the minimiser u: true when it is met,
   /// else it updates its multipliers and the solver minimises again. Unconstrained terms: true.
   virtual bool update_multipliers(const Model&, const Points&) { return true; }
@@ -80,7 +84,7 @@ struct NewtonStats {
   int stale_factor_fallbacks = 0;     ///< CG solves cut short with a factor far behind the tangent (while the worker
                                       ///< refactorises) and done again with block-Jacobi
   int projected = 0;             ///< iterations that fell back to the positive semi-definite tangent
-  double residual = 0;           ///< |r|_free / max(|b|, |f_int|, |k M (u - a)|) at the end
+  double residual = 0;           ///< |r|_free / max(|b|, |f_int|, |k M (u - a)|, |tool forces|, force_floor) at the end
   bool stalled = false;          ///< converged at the round-off floor above the tolerance
   const char* failure = "";      ///< why it stopped without converging
 };
@@ -150,6 +154,7 @@ class NewtonSolver {
   void note_cg_rate(long long iterations, double eta);
 
   Tangent tangent_;
+  double force_floor_ = 0;  ///< N: the force scale's floor for this solve's model (reactions.hpp, force_floor)
   TangentMode preconditioner_mode_ = TangentMode::EXACT;
   // the block-Jacobi blocks lag across Newton iterations and solves (steps) like the Cholesky factor: made
   // for one model and problem, refreshed when CG's iterations per decade of residual grow by half
