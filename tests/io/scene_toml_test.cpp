@@ -151,24 +151,24 @@ TEST(SceneToml, UnknownChoicesListTheAllowedOnes) {
 }
 
 TEST(SceneToml, ThePreconditionerIsChosen) {
+  // the full scene with `lines` added to its [solver]
+  const auto with_solver = [](const std::string& lines) {
+    std::string text = full_scene;
+    text.replace(text.find("dt = 2e-3"), 9, "dt = 2e-3\n" + lines);
+    return parse_scene(text);
+  };
   EXPECT_EQ(parse_scene(std::string(full_scene)).solver.preconditioner, Preconditioner::BLOCK_JACOBI);
-  std::string text = full_scene;
-  text.replace(text.find("dt = 2e-3"), 9, "dt = 2e-3\npreconditioner = \"cholesky\"\nrefactor_iterations = 4");
-  const Scene scene = parse_scene(text);
+  const Scene scene = with_solver("preconditioner = \"cholesky\"\nrefactor_iterations = 4");
   EXPECT_EQ(scene.solver.preconditioner, Preconditioner::CHOLESKY);
   EXPECT_EQ(scene.solver.refactor_iterations, 4);
-  text = full_scene;
-  text.replace(text.find("dt = 2e-3"), 9, "dt = 2e-3\npreconditioner = \"two_level\"");
-  EXPECT_EQ(parse_scene(text).solver.preconditioner, Preconditioner::TWO_LEVEL);
+  EXPECT_EQ(with_solver("preconditioner = \"two_level\"").solver.preconditioner, Preconditioner::TWO_LEVEL);
   EXPECT_NE(error_of("dt = 2e-3", "dt = 2e-3\npreconditioner = \"ilu\"")
                 .find("solver.preconditioner: unknown value \"ilu\" (expected block_jacobi | cholesky | two_level)"),
             std::string::npos);
   EXPECT_NE(error_of("dt = 2e-3", "dt = 2e-3\nrefactor_iterations = 0").find("solver.refactor_iterations"), std::string::npos);
   // where its refactorisations run
   EXPECT_EQ(scene.solver.refactorisation, Refactorisation::AUTO);
-  text = full_scene;
-  text.replace(text.find("dt = 2e-3"), 9, "dt = 2e-3\nrefactorisation = \"background\"");
-  EXPECT_EQ(parse_scene(text).solver.refactorisation, Refactorisation::BACKGROUND);
+  EXPECT_EQ(with_solver("refactorisation = \"background\"").solver.refactorisation, Refactorisation::BACKGROUND);
   EXPECT_NE(error_of("dt = 2e-3", "dt = 2e-3\nrefactorisation = \"later\"")
                 .find("solver.refactorisation: unknown value \"later\" (expected auto | in_place | background)"),
             std::string::npos);
