@@ -301,7 +301,10 @@ NewtonStats NewtonSolver::solve(const Model& model, const NewtonProblem& problem
       if (settings.preconditioner == Preconditioner::CHOLESKY && !use_cholesky_ && !factor_stale_ &&
           (mode == TangentMode::PROJECTED || !exact_indefinite_)) {
         use_cholesky_ = factorise(model, problem, ws);
-        if (use_cholesky_) ++stats.factorisations, factor_stale_ = false;
+        if (use_cholesky_) {
+          ++stats.factorisations;
+          factor_stale_ = false;
+        }
         if (!use_cholesky_ && mode == TangentMode::EXACT) exact_indefinite_ = true;
         refactorise_ = !use_cholesky_;
       }
@@ -314,10 +317,21 @@ NewtonStats NewtonSolver::solve(const Model& model, const NewtonProblem& problem
       bool positive = conjugate_gradients(model, problem, r, eta,
                                           may_fall_back ? std::min(stale_limit, settings.max_cg_iterations) : settings.max_cg_iterations,
                                           ws, dx, stats.cg_iterations);
-      if (use_cholesky_ && stats.cg_iterations - cg_before > settings.refactor_iterations) {
+      const long long factor_cg = use_cholesky_ ? stats.cg_iterations - cg_before : 0;
+      if (may_fall_back && positive && factor_cg >= stale_limit) {
+        use_cholesky_ = false;
+        factor_stale_ = true;  // block-Jacobi until the worker's factor is taken up
+        ++stats.stale_factor_fallbacks;
+        const long long blocks_before = stats.cg_iterations;
+        positive = conjugate_gradients(model, problem, r, eta, settings.max_cg_iterations, ws, dx, stats.cg_iterations);
+        if (positive) note_cg_rate(stats.cg_iterations - blocks_before, eta);
+      } else if (!use_cholesky_ && positive) {
+        note_cg_rate(stats.cg_iterations - cg_before, eta);
+      }
+      if (factor_cg > settings.refactor_iterations) {
         // the factor has aged: refreshed in place at the next iteration, or in the background from this
-        // iteration's tangent while the old factor keeps serving (the tangent is assembled here, a fraction
-        // of the factorisation)
+        // iteration's tangent while the old factor keeps serving (assembled here, a fraction of the
+        // factorisation; after this iteration's CG, which needs the tangent as it was linearised)
         if (!background) {
           refactorise_ = true;
         } else if (!cholesky_.background_pending()) {
@@ -332,16 +346,6 @@ NewtonStats NewtonSolver::solve(const Model& model, const NewtonProblem& problem
           if (cholesky_.factorise_in_background(matrix_)) background_mode_ = factor_mode;
           else refactorise_ = true;
         }
-      }
-      if (may_fall_back && positive && stats.cg_iterations - cg_before >= stale_limit) {
-        use_cholesky_ = false;
-        factor_stale_ = true;  // block-Jacobi until the worker's factor is taken up
-        ++stats.stale_factor_fallbacks;
-        const long long blocks_before = stats.cg_iterations;
-        positive = conjugate_gradients(model, problem, r, eta, settings.max_cg_iterations, ws, dx, stats.cg_iterations);
-        if (positive) note_cg_rate(stats.cg_iterations - blocks_before, eta);
-      } else if (!use_cholesky_ && positive) {
-        note_cg_rate(stats.cg_iterations - cg_before, eta);
       }
       if (positive && dot(dx, r) > 0) {
         descent = true;
