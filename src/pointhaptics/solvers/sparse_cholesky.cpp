@@ -42,6 +42,12 @@ struct SparseCholesky::Factor {
   index_t n_points = 0, n_pairs = 0, n_free = 0;
   bool good = false;  // L holds a positive definite factor
 
+  // K's values into A (this factor's, or the worker's copy of it: the same pattern)
+  void copy_values(const TangentMatrix& K, cholmod_sparse* target) const {
+    double* x = static_cast<double*>(target->x);
+    for (std::size_t p = 0; p < source.size(); ++p) x[p] = K.values[source[p]];
+  }
+
   Factor() {
     cholmod_start(&common);
     common.print = 0;  // failures are reported by return values, never printed
@@ -144,7 +150,7 @@ void SparseCholesky::drop_background() {
 }
 
 void SparseCholesky::analyse(const Model& model, const TangentMatrix& K) {
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = Clock::now();
   drop_background();
   Factor& f = *factor_;
   f.release();
@@ -194,20 +200,19 @@ void SparseCholesky::analyse(const Model& model, const TangentMatrix& K) {
   f.n_free = dofs / 3;
   stats_ = {};
   stats_.factor_nonzeros = f.common.lnz;
-  stats_.analyse_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  stats_.analyse_s = std::chrono::duration<double>(Clock::now() - start).count();
 }
 
 bool SparseCholesky::factorise(const TangentMatrix& K) {
   Factor& f = *factor_;
   if (!f.L) return false;
-  const auto start = std::chrono::steady_clock::now();
-  double* x = static_cast<double*>(f.A->x);
-  for (std::size_t p = 0; p < f.source.size(); ++p) x[p] = K.values[f.source[p]];
+  const auto start = Clock::now();
+  f.copy_values(K, f.A);
   const int ok = cholmod_factorize(f.A, f.L, &f.common);
   // a failed factorisation leaves L incomplete (minor < n) but reusable by the next attempt
   f.good = positive_definite(ok, f.common, f.L);
   ++stats_.factorisations;
-  stats_.factorise_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  stats_.factorise_s = std::chrono::duration<double>(Clock::now() - start).count();
   if (f.good) {
     stats_.factor_nonzeros = entries_of(f.L);
     stats_.factor_bytes = bytes_of(f.L);
@@ -230,8 +235,7 @@ bool SparseCholesky::factorise_in_background(const TangentMatrix& K) {
     }
     stats_.background_bytes = bytes_of(b.L) + static_cast<double>(f.source.size()) * (sizeof(double) + sizeof(int));
   }
-  double* x = static_cast<double*>(b.A->x);
-  for (std::size_t p = 0; p < f.source.size(); ++p) x[p] = K.values[f.source[p]];
+  f.copy_values(K, b.A);
   {
     std::lock_guard lock(b.mutex);
     b.before = before_background_factorisation;
