@@ -6,3 +6,4 @@ option(PH_BUILD_PYTHON "Build the Python bindings (pybind11, NumPy)" ${PROJECT_I
 option(PH_BUILD_VIEWER "Build the interactive viewer (GLFW, OpenGL, Dear ImGui; not in sanitizer builds)" ${PROJECT_IS_TOP_LEVEL})
 option(PH_BUILD_FUZZERS "Build the libFuzzer targets (clang, with PH_SANITIZE including fuzzer-no-link)" OFF)
 set(PH_SANITIZE "" CACHE STRING "Sanitizers to build with: address,undefined | thread | empty")
+option(PH_WARNINGS_AS_ERRORS "Treat compiler warnings as errors (CI: scripts/test sets it when CI is set)" OFF)

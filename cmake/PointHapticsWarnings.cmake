@@ -4,6 +4,9 @@ add_library(pointhaptics_build_flags INTERFACE)
 add_library(pointhaptics::build_flags ALIAS pointhaptics_build_flags)
 target_compile_options(pointhaptics_build_flags INTERFACE
   $<BUILD_INTERFACE:$<$<CXX_COMPILER_ID:GNU,Clang>:-Wall -Wextra -Wpedantic>>)
+if(PH_WARNINGS_AS_ERRORS)
+  target_compile_options(pointhaptics_build_flags INTERFACE $<BUILD_INTERFACE:-Werror>)
+endif()
 if(PH_NATIVE)
   # exported too: Eigen's allocation alignment depends on the instruction set, so code that shares
   # Eigen objects with a -march=native build must be compiled with the same flag

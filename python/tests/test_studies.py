@@ -1,6 +1,9 @@
 """Tests of studies and identification on Dask (docs/studies.md): scene settings and scene text, a study's table
 on a local cluster and on a real scheduler with two worker processes (the same table; a worker killed mid-study
 loses no run; a failing run is reported, not fatal), and fits that recover a known material and CalculiX's."""
+# Tier: long (label `long`, scripts/test --long): it starts several local Dask clusters and a scheduler with
+# worker processes (about 125 s); `cli_study` runs a 64-run study on Dask through the same package in the
+# default tier.
 import json
 import os
 import pickle

@@ -5,6 +5,9 @@ between Hertz's and 1.2 times it (the block's finite depth); refined to R/8 near
 sphere than 1% of the depth; first contact is within 0.05 R of the true surface; frictionless sliding keeps
 the normal force's ripple under 5% and the tangential force under 2% of it. Then a scene with a tool held
 at a position, solved statically, writes the result JSON's tool block."""
+# Tier: long (label `long`, scripts/test --long). Its mesh-converged CalculiX contact model takes about 300 s of
+# a 2-core machine, more than the rest of the optimised suite; the contact's force and depth stay guarded in the
+# default tier by ProbeOnSurface.* and SurfaceContact.* and by experiment_materials_quick's punch.
 import csv
 import json
 import os

@@ -7,6 +7,8 @@ stay pressed in (the hand feels the object) throughout. Before the fixes it ende
 within 4-40 s of simulated time in 9 of 10 runs here.
 Usage: realtime_lod_soak.py CLI SCENES WORK
 """
+# Tier: long (label `long`, scripts/test --long): a soak, 40 s of wall clock alone on the machine; the
+# re-selection on a worker thread is held in the default tier by LevelsOfDetail.* (under TSan too).
 import json
 import os
 import re
