@@ -52,8 +52,8 @@ const Model& bench_model(int n) {
 // (a neo-Hookean inclusion, ten times stiffer, in the svk box: a stiff nodule in soft tissue), and a
 // viscoelastic neo-Hookean (two Prony terms: the force loop with its history's update, as in an implicit step's
 // solve or an explicit step of one sub-step)
-const std::array<std::string_view, 6> material_variants = {"svk", "neo_hookean", "mooney_rivlin", "corotated", "regions",
-                                                           "viscoelastic"};
+const std::array<std::string_view, 6> material_variants = {"svk",       "neo_hookean", "mooney_rivlin",
+                                                           "corotated", "regions",     "viscoelastic"};
 
 const Model& material_model(int n, int variant) {
   static std::map<std::pair<int, int>, std::unique_ptr<Model>> cache;
@@ -74,7 +74,8 @@ const Model& material_model(int n, int variant) {
       materials = {m, inclusion};
       const Vec3 centre = 0.5 * (base.X.rowwise().minCoeff() + base.X.rowwise().maxCoeff());
       const double radius = 0.3 * (base.X.rowwise().maxCoeff() - base.X.rowwise().minCoeff()).maxCoeff();
-      for (index_t i = 0; i < base.n_points; ++i) material_of.push_back((base.X.col(i) - centre).norm() < radius ? 1 : 0);
+      for (index_t i = 0; i < base.n_points; ++i)
+        material_of.push_back((base.X.col(i) - centre).norm() < radius ? 1 : 0);
     } else if (name == "viscoelastic") {
       m.model = MaterialModel::NEO_HOOKEAN;
       m.prony = {{0.3, 0.1}, {0.2, 1.0}};
@@ -154,7 +155,8 @@ void stream_benchmark(benchmark::State& state) {
 }
 
 void material_benchmark(benchmark::State& state) {
-  time_forces(state, material_model(static_cast<int>(state.range(0)), static_cast<int>(state.range(2))), static_cast<int>(state.range(1)));
+  time_forces(state, material_model(static_cast<int>(state.range(0)), static_cast<int>(state.range(2))),
+              static_cast<int>(state.range(1)));
 }
 
 void step_benchmark(benchmark::State& state) {
@@ -175,8 +177,8 @@ void step_benchmark(benchmark::State& state) {
 // points' displacement through the MLS map (y = Y + W u), as a frame or a contact query needs it
 void surface_benchmark(benchmark::State& state) {
   const Model& model = bench_model(static_cast<int>(state.range(0)));
-  const TriangleMesh surface = box_surface(model.X.rowwise().minCoeff(), model.X.rowwise().maxCoeff() - model.X.rowwise().minCoeff(),
-                                           0.5 * model.spacing);
+  const TriangleMesh surface = box_surface(
+      model.X.rowwise().minCoeff(), model.X.rowwise().maxCoeff() - model.X.rowwise().minCoeff(), 0.5 * model.spacing);
   const SurfaceMap map = build_surface_map(model, surface.V);
   const Points u = random_displacement(model);
   Points y;
@@ -229,8 +231,8 @@ void beam_benchmark(benchmark::State& state) {
   }
   state.counters["points"] = model.n_points;
   state.counters["threads"] = threads;
-  state.counters["compute_s_per_simulated_s"] =
-      benchmark::Counter(static_cast<double>(state.iterations()) * simulated, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["compute_s_per_simulated_s"] = benchmark::Counter(
+      static_cast<double>(state.iterations()) * simulated, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
 // the seed's cantilever, 0.15 x 0.03 x 0.03 m, clamped at x = 0 (nu = 0.4, 1000 kg/m^3, damping 20 / s)
@@ -279,10 +281,11 @@ void stiff_cantilever_benchmark(benchmark::State& state) {
   }
   state.counters["points"] = model.n_points;
   state.counters["threads"] = static_cast<double>(state.range(1));
-  state.counters["cg_per_step"] = static_cast<double>(summary.cg_iterations) / static_cast<double>(std::max(1LL, summary.steps));
+  state.counters["cg_per_step"] =
+      static_cast<double>(summary.cg_iterations) / static_cast<double>(std::max(1LL, summary.steps));
   state.counters["factorisations"] = static_cast<double>(summary.factorisations);
-  state.counters["compute_s_per_simulated_s"] =
-      benchmark::Counter(static_cast<double>(state.iterations()) * simulated, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["compute_s_per_simulated_s"] = benchmark::Counter(
+      static_cast<double>(state.iterations()) * simulated, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
 // the Cholesky factor of the tangent of a cube of about n points (bench_model) with the inertia of a 1 ms
@@ -295,7 +298,8 @@ void cholesky_benchmark(benchmark::State& state) {
   TangentMatrix K;
   assemble_tangent(model, tangent, K);
   for (index_t i = 0; i < model.n_points; ++i)
-    Eigen::Map<Mat3>(K.values.data() + 9 * static_cast<std::size_t>(K.diagonal[i])).diagonal().array() += model.mass[i] / 1e-6;
+    Eigen::Map<Mat3>(K.values.data() + 9 * static_cast<std::size_t>(K.diagonal[i])).diagonal().array() +=
+        model.mass[i] / 1e-6;
   SparseCholesky chol;
   const bool numeric = model.n_points <= 20000;
   if (numeric) chol.analyse(model, K);
@@ -333,8 +337,9 @@ void haptic_benchmark(benchmark::State& state) {
   double wall = 0;
   for (auto _ : state) {
     Simulation sim(model, s.solver, 1);  // one core for the simulation, one for the haptic loop
-    VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), false}, {1.0, Vec3(0, -0.02, 0), false}, {2.0, Vec3::Zero(), false}}),
-                         known_device_specs("touch"));
+    VirtualDevice device(
+        Trajectory({{0.0, Vec3::Zero(), false}, {1.0, Vec3(0, -0.02, 0), false}, {2.0, Vec3::Zero(), false}}),
+        known_device_specs("touch"));
     InteractiveOptions o;
     o.duration = 2.0;
     o.probe.radius = 0.01;
@@ -366,7 +371,8 @@ const std::array<std::string_view, 3> blade_parts = {"update", "sever", "stable_
 // A blade's edge along z (z0 to z1) in the plane x, drawn down from `top` to `bottom` 0.7 mm per update (0.7 m/s
 // at 1 kHz), then again from the top after fresh() (untimed); update(sweep) cuts and returns the pairs severed.
 template <class Fresh, class Update>
-void blade_strokes(benchmark::State& state, double x, double z0, double z1, double top, double bottom, Fresh&& fresh, Update&& update) {
+void blade_strokes(benchmark::State& state, double x, double z0, double z1, double top, double bottom, Fresh&& fresh,
+                   Update&& update) {
   const double stroke = 0.0007;
   double y = top;
   fresh();
@@ -403,8 +409,8 @@ void blade_benchmark(benchmark::State& state) {
     const CutReport report = cut(cut_model, cut_model.X, sweep, false);
     state.ResumeTiming();
     if (!report.cut_points.empty())
-      benchmark::DoNotOptimize(local_stable_time_step(cut_model, report.cut_points, ModelSimulation::cut_patch_rings, 0.8,
-                                                      ModelSimulation::cut_lanczos_steps));
+      benchmark::DoNotOptimize(local_stable_time_step(cut_model, report.cut_points, ModelSimulation::cut_patch_rings,
+                                                      0.8, ModelSimulation::cut_lanczos_steps));
     return report.severed_pairs;
   });
   state.counters["points"] = model.n_points;
@@ -458,8 +464,9 @@ void blade_lod_benchmark(benchmark::State& state) {
 class CollectingReporter : public benchmark::ConsoleReporter {
  public:
   nlohmann::json force = nlohmann::json::array(), step = nlohmann::json::array(), beam = nlohmann::json::array(),
-                 haptic = nlohmann::json::array(), materials = nlohmann::json::array(), surface = nlohmann::json::array(),
-                 stiff_cantilever = nlohmann::json::array(), cholesky = nlohmann::json::array(), force_streams = nlohmann::json::array(),
+                 haptic = nlohmann::json::array(), materials = nlohmann::json::array(),
+                 surface = nlohmann::json::array(), stiff_cantilever = nlohmann::json::array(),
+                 cholesky = nlohmann::json::array(), force_streams = nlohmann::json::array(),
                  blade = nlohmann::json::array();
   void ReportRuns(const std::vector<Run>& runs) override {
     ConsoleReporter::ReportRuns(runs);
@@ -469,8 +476,8 @@ class CollectingReporter : public benchmark::ConsoleReporter {
       if (run.run_type == Run::RT_Aggregate && run.aggregate_name != "median") continue;
       if (run.benchmark_name().rfind("haptic", 0) == 0) {
         nlohmann::json row;
-        for (const char* key : {"points", "rate_hz", "period_p50_us", "period_p99_us", "period_max_us", "tick_max_us",
-                                "sim_steps_per_s"})
+        for (const char* key :
+             {"points", "rate_hz", "period_p50_us", "period_p99_us", "period_max_us", "tick_max_us", "sim_steps_per_s"})
           row[key] = static_cast<double>(run.counters.at(key).value);
         haptic.push_back(row);
         continue;
@@ -495,21 +502,23 @@ class CollectingReporter : public benchmark::ConsoleReporter {
       if (run.benchmark_name().rfind("force_streams/", 0) == 0) {
         const std::string name = run.benchmark_name();
         const size_t slash = name.find('/', 14);
-        force_streams.push_back({{"neighbours", name.substr(14, slash - 14)},
-                                 {"hourglass", name.find("hourglass:on") != std::string::npos},
-                                 {"points", static_cast<long long>(run.counters.at("points").value)},
-                                 {"ns_per_pair", static_cast<double>(run.counters.at("ns_per_pair").value)},
-                                 {"point_steps_per_s", static_cast<double>(run.counters.at("point_steps_per_s").value)}});
+        force_streams.push_back(
+            {{"neighbours", name.substr(14, slash - 14)},
+             {"hourglass", name.find("hourglass:on") != std::string::npos},
+             {"points", static_cast<long long>(run.counters.at("points").value)},
+             {"ns_per_pair", static_cast<double>(run.counters.at("ns_per_pair").value)},
+             {"point_steps_per_s", static_cast<double>(run.counters.at("point_steps_per_s").value)}});
         continue;
       }
       if (run.benchmark_name().rfind("stiff_cantilever/", 0) == 0) {
         const std::string name = run.benchmark_name().substr(std::string("stiff_cantilever/").size());
-        stiff_cantilever.push_back({{"preconditioner", name.substr(0, name.find('/'))},
-                                    {"threads", static_cast<int>(run.counters.at("threads").value)},
-                                    {"points", static_cast<long long>(run.counters.at("points").value)},
-                                    {"cg_per_step", static_cast<double>(run.counters.at("cg_per_step").value)},
-                                    {"factorisations", static_cast<double>(run.counters.at("factorisations").value)},
-                                    {"compute_s_per_simulated_s", static_cast<double>(run.counters.at("compute_s_per_simulated_s").value)}});
+        stiff_cantilever.push_back(
+            {{"preconditioner", name.substr(0, name.find('/'))},
+             {"threads", static_cast<int>(run.counters.at("threads").value)},
+             {"points", static_cast<long long>(run.counters.at("points").value)},
+             {"cg_per_step", static_cast<double>(run.counters.at("cg_per_step").value)},
+             {"factorisations", static_cast<double>(run.counters.at("factorisations").value)},
+             {"compute_s_per_simulated_s", static_cast<double>(run.counters.at("compute_s_per_simulated_s").value)}});
         continue;
       }
       if (run.benchmark_name().rfind("blade/", 0) == 0) {
@@ -520,14 +529,16 @@ class CollectingReporter : public benchmark::ConsoleReporter {
                            {"threads", static_cast<int>(run.counters.at("threads").value)},
                            {"pairs_per_update", static_cast<double>(run.counters.at("pairs_per_update").value)},
                            {"ms", run.GetAdjustedRealTime() / 1e3}};  // the benchmark's unit is microseconds
-        for (const char* key : {"simulated", "object_pairs_cut"})  // with levels of detail
-          if (auto it = run.counters.find(key); it != run.counters.end()) row[key] = static_cast<double>(it->second.value);
+        for (const char* key : {"simulated", "object_pairs_cut"})     // with levels of detail
+          if (auto it = run.counters.find(key); it != run.counters.end())
+            row[key] = static_cast<double>(it->second.value);
         blade.push_back(row);
         continue;
       }
       if (run.benchmark_name().rfind("cholesky/", 0) == 0) {
         nlohmann::json row{{"points", static_cast<long long>(run.counters.at("points").value)}};
-        for (const char* key : {"blocks_per_row", "factor_nonzeros", "factor_mb", "analyse_s"}) row[key] = static_cast<double>(run.counters.at(key).value);
+        for (const char* key : {"blocks_per_row", "factor_nonzeros", "factor_mb", "analyse_s"})
+          row[key] = static_cast<double>(run.counters.at(key).value);
         row["numeric"] = run.counters.at("numeric").value > 0;
         // the benchmark's time is a numeric factorisation, or the analysis alone
         row[row["numeric"].get<bool>() ? "factorise_s" : "analysis_only_s"] = run.GetAdjustedRealTime() / 1e3;
@@ -535,10 +546,11 @@ class CollectingReporter : public benchmark::ConsoleReporter {
         continue;
       }
       if (run.benchmark_name().rfind("beam4x1x1", 0) == 0) {
-        beam.push_back({{"solver", run.benchmark_name().find("implicit") != std::string::npos ? "implicit" : "explicit"},
-                        {"threads", static_cast<int>(run.counters.at("threads").value)},
-                        {"points", static_cast<long long>(run.counters.at("points").value)},
-                        {"compute_s_per_simulated_s", static_cast<double>(run.counters.at("compute_s_per_simulated_s").value)}});
+        beam.push_back(
+            {{"solver", run.benchmark_name().find("implicit") != std::string::npos ? "implicit" : "explicit"},
+             {"threads", static_cast<int>(run.counters.at("threads").value)},
+             {"points", static_cast<long long>(run.counters.at("points").value)},
+             {"compute_s_per_simulated_s", static_cast<double>(run.counters.at("compute_s_per_simulated_s").value)}});
         continue;
       }
       nlohmann::json row;
@@ -559,47 +571,87 @@ int run_bench_suite(const BenchOptions& options) {
   for (int n : options.sizes)
     for (int t : options.threads) {
       benchmark::RegisterBenchmark(fmt::format("forces/points:{}/threads:{}", n, t).c_str(), force_benchmark)
-          ->Args({n, t})->Unit(benchmark::kMicrosecond)->MinTime(options.min_time)->UseRealTime();
+          ->Args({n, t})
+          ->Unit(benchmark::kMicrosecond)
+          ->MinTime(options.min_time)
+          ->UseRealTime();
       benchmark::RegisterBenchmark(fmt::format("step/points:{}/threads:{}", n, t).c_str(), step_benchmark)
-          ->Args({n, t})->Unit(benchmark::kMicrosecond)->MinTime(options.min_time)->UseRealTime();
+          ->Args({n, t})
+          ->Unit(benchmark::kMicrosecond)
+          ->MinTime(options.min_time)
+          ->UseRealTime();
       for (int v = 0; v < static_cast<int>(material_variants.size()); ++v)
-        benchmark::RegisterBenchmark(fmt::format("materials/{}/points:{}/threads:{}", material_variants[v], n, t).c_str(),
-                                     material_benchmark)
-            ->Args({n, t, v})->Unit(benchmark::kMicrosecond)->MinTime(options.min_time)->UseRealTime();
+        benchmark::RegisterBenchmark(
+            fmt::format("materials/{}/points:{}/threads:{}", material_variants[v], n, t).c_str(), material_benchmark)
+            ->Args({n, t, v})
+            ->Unit(benchmark::kMicrosecond)
+            ->MinTime(options.min_time)
+            ->UseRealTime();
     }
   for (int n : options.sizes)
     benchmark::RegisterBenchmark(fmt::format("surface/points:{}/threads:1", n).c_str(), surface_benchmark)
-        ->Args({n})->Unit(benchmark::kMicrosecond)->MinTime(options.min_time)->UseRealTime();
+        ->Args({n})
+        ->Unit(benchmark::kMicrosecond)
+        ->MinTime(options.min_time)
+        ->UseRealTime();
   for (int t : options.threads)
     for (int solver : {0, 1})
       benchmark::RegisterBenchmark(fmt::format("beam4x1x1/{}/threads:{}", solver ? "implicit" : "explicit", t).c_str(),
                                    beam_benchmark)
-          ->Args({solver, t})->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
+          ->Args({solver, t})
+          ->Unit(benchmark::kMillisecond)
+          ->Iterations(1)
+          ->UseRealTime();
   for (int variant = 0; variant < static_cast<int>(stream_variants.size()); ++variant)
     for (int hourglass : {1, 0})
-      benchmark::RegisterBenchmark(fmt::format("force_streams/{}/hourglass:{}/threads:1", stream_variants[variant], hourglass ? "on" : "off").c_str(),
-                                   stream_benchmark)
-          ->Args({variant, hourglass})->Unit(benchmark::kMicrosecond)->MinTime(options.min_time)->UseRealTime();
+      benchmark::RegisterBenchmark(
+          fmt::format("force_streams/{}/hourglass:{}/threads:1", stream_variants[variant], hourglass ? "on" : "off")
+              .c_str(),
+          stream_benchmark)
+          ->Args({variant, hourglass})
+          ->Unit(benchmark::kMicrosecond)
+          ->MinTime(options.min_time)
+          ->UseRealTime();
   for (std::size_t preconditioner = 0; preconditioner < stiff_preconditioners.size(); ++preconditioner)
-    benchmark::RegisterBenchmark(fmt::format("stiff_cantilever/{}/threads:{}", enum_name(stiff_preconditioners[preconditioner]),
-                                             options.threads.back()).c_str(), stiff_cantilever_benchmark)
-        ->Args({static_cast<int64_t>(preconditioner), options.threads.back()})->Unit(benchmark::kMillisecond)->Iterations(3)->UseRealTime();
+    benchmark::RegisterBenchmark(fmt::format("stiff_cantilever/{}/threads:{}",
+                                             enum_name(stiff_preconditioners[preconditioner]), options.threads.back())
+                                     .c_str(),
+                                 stiff_cantilever_benchmark)
+        ->Args({static_cast<int64_t>(preconditioner), options.threads.back()})
+        ->Unit(benchmark::kMillisecond)
+        ->Iterations(3)
+        ->UseRealTime();
   for (int n : options.sizes)
     benchmark::RegisterBenchmark(fmt::format("cholesky/points:{}", n).c_str(), cholesky_benchmark)
-        ->Args({n})->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
+        ->Args({n})
+        ->Unit(benchmark::kMillisecond)
+        ->Iterations(1)
+        ->UseRealTime();
   for (int part = 0; part < static_cast<int>(blade_parts.size()); ++part)
     for (int t : part == 0 ? options.threads : std::vector<int>{1})
-      benchmark::RegisterBenchmark(fmt::format("blade/{}/points:10309/threads:{}", blade_parts[part], t).c_str(), blade_benchmark)
-          ->Args({part, t})->Unit(benchmark::kMicrosecond)->MinTime(options.min_time)->UseRealTime();
-  benchmark::RegisterBenchmark(fmt::format("blade/update_lod/points:100000/threads:{}", options.threads.back()).c_str(), blade_lod_benchmark)
-      ->Args({options.threads.back()})->Unit(benchmark::kMicrosecond)->MinTime(options.min_time)->UseRealTime();
+      benchmark::RegisterBenchmark(fmt::format("blade/{}/points:10309/threads:{}", blade_parts[part], t).c_str(),
+                                   blade_benchmark)
+          ->Args({part, t})
+          ->Unit(benchmark::kMicrosecond)
+          ->MinTime(options.min_time)
+          ->UseRealTime();
+  benchmark::RegisterBenchmark(fmt::format("blade/update_lod/points:100000/threads:{}", options.threads.back()).c_str(),
+                               blade_lod_benchmark)
+      ->Args({options.threads.back()})
+      ->Unit(benchmark::kMicrosecond)
+      ->MinTime(options.min_time)
+      ->UseRealTime();
   benchmark::RegisterBenchmark("haptic/points:10000", haptic_benchmark)
-      ->Args({10000})->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
+      ->Args({10000})
+      ->Unit(benchmark::kMillisecond)
+      ->Iterations(1)
+      ->UseRealTime();
   // a bad pattern or one that matches nothing is an error, not an empty table and exit 0
   try {
     const std::regex check(options.filter, std::regex::extended);
   } catch (const std::regex_error& e) {
-    fmt::print(stderr, "pointhaptics bench: --filter '{}' is not a valid regular expression ({})\n", options.filter, e.what());
+    fmt::print(stderr, "pointhaptics bench: --filter '{}' is not a valid regular expression ({})\n", options.filter,
+               e.what());
     return 1;
   }
   if (!options.json_path.empty()) {
@@ -613,7 +665,8 @@ int run_bench_suite(const BenchOptions& options) {
   std::string filter_flag = "--benchmark_filter=" + options.filter;
   std::string name = "pointhaptics-bench";
   // repetitions in random order, so that a shared machine's slow spells fall on every benchmark alike
-  std::string repetitions = fmt::format("--benchmark_repetitions={}", options.repetitions), interleave = "--benchmark_enable_random_interleaving=true",
+  std::string repetitions = fmt::format("--benchmark_repetitions={}", options.repetitions),
+              interleave = "--benchmark_enable_random_interleaving=true",
               aggregates = "--benchmark_report_aggregates_only=true";
   std::vector<char*> argv = {name.data(), filter_flag.data()};
   if (options.repetitions > 1) argv.insert(argv.end(), {repetitions.data(), interleave.data(), aggregates.data()});
@@ -636,13 +689,21 @@ int run_bench_suite(const BenchOptions& options) {
   for (nlohmann::json& row : reporter.surface)
     for (const nlohmann::json& step : reporter.step)
       if (step["points"] == row["points"] && step["threads"] == 1)
-        row["relative_to_step"] = row["carry_us"].get<double>() * step["point_steps_per_s"].get<double>() / (1e6 * step["points"].get<double>());
+        row["relative_to_step"] = row["carry_us"].get<double>() * step["point_steps_per_s"].get<double>() /
+                                  (1e6 * step["points"].get<double>());
   if (!options.json_path.empty()) {
-    const std::string text =
-        nlohmann::json{{"force", reporter.force}, {"step", reporter.step}, {"beam_4x1x1", reporter.beam}, {"haptic", reporter.haptic},
-                       {"materials", reporter.materials}, {"surface", reporter.surface},
-                       {"stiff_cantilever", reporter.stiff_cantilever}, {"cholesky", reporter.cholesky},
-                       {"force_streams", reporter.force_streams}, {"blade", reporter.blade}}.dump(1);
+    const std::string text = nlohmann::json{
+        {"force", reporter.force},
+        {"step", reporter.step},
+        {"beam_4x1x1", reporter.beam},
+        {"haptic", reporter.haptic},
+        {"materials", reporter.materials},
+        {"surface", reporter.surface},
+        {"stiff_cantilever", reporter.stiff_cantilever},
+        {"cholesky", reporter.cholesky},
+        {"force_streams", reporter.force_streams},
+        {"blade",
+         reporter.blade}}.dump(1);
     try {
       write_text_file(options.json_path, "--json", [&](TextOutput& out) { out.print("{}\n", text); });
     } catch (const Error& e) {

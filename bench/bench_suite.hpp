@@ -6,12 +6,12 @@
 namespace pointhaptics::bench {
 
 struct BenchOptions {
-  std::string json_path;        ///< write design.md's bench JSON here ("" = don't)
-  std::string filter = ".";     ///< benchmark name regex
-  double min_time = 0.2;        ///< seconds per benchmark
+  std::string json_path;                        ///< write design.md's bench JSON here ("" = don't)
+  std::string filter = ".";                     ///< benchmark name regex
+  double min_time = 0.2;                        ///< seconds per benchmark
   std::vector<int> sizes{1000, 10000, 100000};  ///< approximate point counts
   std::vector<int> threads{1, 2};
-  int repetitions = 1;          ///< > 1: each benchmark this many times, interleaved at random, medians reported
+  int repetitions = 1;  ///< > 1: each benchmark this many times, interleaved at random, medians reported
 };
 
 /// Register the suite, run it, print a table on stdout and write the JSON. Returns a process exit code.

@@ -27,7 +27,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     } else if (format == ".nii" || format == ".nrrd") {
       // the image libraries read files: one per process, rewritten for every input
       static const std::string path = "/tmp/ph_fuzz_" + std::to_string(getpid()) + std::string(format);
-      std::ofstream(path, std::ios::binary | std::ios::trunc).write(input.data(), static_cast<std::streamsize>(input.size()));
+      std::ofstream(path, std::ios::binary | std::ios::trunc)
+          .write(input.data(), static_cast<std::streamsize>(input.size()));
       const pointhaptics::VolumeImage image = pointhaptics::read_volume(path);
       if (image.values.size() != static_cast<std::size_t>(image.nx) * image.ny * image.nz) __builtin_trap();
     } else {

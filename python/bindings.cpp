@@ -30,8 +30,8 @@ using RowPoints = py::array_t<double, py::array::c_style | py::array::forcecast>
 
 // A read-only (n, 3) view of a 3 x n column-major Points buffer owned by `owner`.
 py::array view(const ph::Points& P, py::handle owner) {
-  py::array a(py::dtype::of<double>(), {P.cols(), Eigen::Index{3}}, {Eigen::Index{3 * sizeof(double)}, Eigen::Index{sizeof(double)}},
-              P.data(), owner);
+  py::array a(py::dtype::of<double>(), {P.cols(), Eigen::Index{3}},
+              {Eigen::Index{3 * sizeof(double)}, Eigen::Index{sizeof(double)}}, P.data(), owner);
   py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
   return a;
 }
@@ -74,12 +74,12 @@ void raise_if_failed(const ph::StepReport& report) {
 struct PySimulation {
   std::unique_ptr<ph::Simulation> sim;
   ph::Scene scene;
-  bool from_scene = false;                  ///< scene.object describes the object (not from_points)
-  ph::InteractiveOptions interactive;        ///< with a device's [probe]: its session (run_scene())
+  bool from_scene = false;                            ///< scene.object describes the object (not from_points)
+  ph::InteractiveOptions interactive;                 ///< with a device's [probe]: its session (run_scene())
   std::optional<ph::InteractiveResult> last_session;  ///< the last run_scene() with a device's probe, for summary()
-  std::optional<ph::ObjectSurface> surface;  ///< built on the first surface_* call
-  ph::Points surface_vertices;               ///< its deformed vertices, 3 x m, kept current after every step
-  std::optional<ph::CutSurface> cut;         ///< the surface split along the cuts (cut_surface(); split when they change)
+  std::optional<ph::ObjectSurface> surface;           ///< built on the first surface_* call
+  ph::Points surface_vertices;                        ///< its deformed vertices, 3 x m, kept current after every step
+  std::optional<ph::CutSurface> cut;  ///< the surface split along the cuts (cut_surface(); split when they change)
   std::mutex mutex;
 
   // the surface's vertices follow the points (after every step, run or probe, once asked for)
@@ -91,8 +91,8 @@ struct PySimulation {
       const ph::Model& model = sim->model();
       // from points: reconstructed from them (the half level of their kernel density), edges of half the spacing
       surface = from_scene ? ph::build_object_surface(scene, model)
-                           : ph::carried_surface(ph::reconstruct_surface(model, 0.5 * model.spacing), "reconstructed from the points", model,
-                                                 "the points' surface");
+                           : ph::carried_surface(ph::reconstruct_surface(model, 0.5 * model.spacing),
+                                                 "reconstructed from the points", model, "the points' surface");
       carry_surface();
     }
     return *surface;
@@ -136,8 +136,9 @@ std::string toml_value(const std::string& key, py::handle v) {
     return out + " }";
   }
   if (py::hasattr(v, "item")) return toml_value(key, v.attr("item")());  // a NumPy scalar
-  throw ph::Error(fmt::format("settings: {}: a value of type {} is not a scene value (numbers, booleans, strings, lists, dicts)", key,
-                              py::str(py::type::of(v).attr("__name__")).cast<std::string>()));
+  throw ph::Error(
+      fmt::format("settings: {}: a value of type {} is not a scene value (numbers, booleans, strings, lists, dicts)",
+                  key, py::str(py::type::of(v).attr("__name__")).cast<std::string>()));
 }
 
 // {key: value} -> scene settings
@@ -176,9 +177,10 @@ std::unique_ptr<PySimulation> from_scene_text(const std::string& text, const std
 py::list vec_list(const ph::Vec3& v) { return py::cast(std::vector<double>{v.x(), v.y(), v.z()}); }
 
 std::unique_ptr<PySimulation> from_points(const RowPoints& X, double spacing, py::object fixed, py::object forces,
-                                          double young, double poisson, double density, double damping, const std::string& kernel,
-                                          double support_factor, const std::string& solver, double dt, int threads,
-                                          const std::string& model_name, const std::vector<std::pair<double, double>>& prony) {
+                                          double young, double poisson, double density, double damping,
+                                          const std::string& kernel, double support_factor, const std::string& solver,
+                                          double dt, int threads, const std::string& model_name,
+                                          const std::vector<std::pair<double, double>>& prony) {
   // the same rules as scene files and the point-cloud readers (issue 21: these were accepted here)
   if (!(spacing > 0) || !std::isfinite(spacing)) throw ph::Error("spacing: must be > 0 (m)");
   if (!(dt >= 1e-9 && dt <= 1)) throw ph::Error("dt: must lie in [1e-9, 1] (s)");
@@ -194,8 +196,9 @@ std::unique_ptr<PySimulation> from_points(const RowPoints& X, double spacing, py
   for (const auto& [g, tau] : prony) material.prony.push_back({g, tau});  // build_model checks it, as every material
   if (!(young > 0 && young <= 1e13) || !(poisson > -1 && poisson < 0.5) || !(density >= 1e-3 && density <= 1e5) ||
       !(damping >= 0 && std::isfinite(damping)))
-    throw ph::Error("material: 0 < young <= 1e13 Pa, -1 < poisson < 0.5, 1e-3 <= density <= 1e5 kg/m^3 and damping >= 0 are "
-                    "needed (as in scene files)");
+    throw ph::Error(
+        "material: 0 < young <= 1e13 Pa, -1 < poisson < 0.5, 1e-3 <= density <= 1e5 kg/m^3 and damping >= 0 are "
+        "needed (as in scene files)");
   ph::KernelParams k;
   k.type = enum_value<ph::KernelType>("kernel", "type", kernel);
   k.support_factor = support_factor;
@@ -205,7 +208,8 @@ std::unique_ptr<PySimulation> from_points(const RowPoints& X, double spacing, py
   ph::Model model = ph::build_model(cloud, material, k);
   if (!fixed.is_none()) {
     const auto mask = py::array_t<bool, py::array::c_style | py::array::forcecast>::ensure(fixed);
-    if (!mask || mask.ndim() != 1 || mask.shape(0) != model.n_points) throw ph::Error("fixed: expected a boolean array of n values");
+    if (!mask || mask.ndim() != 1 || mask.shape(0) != model.n_points)
+      throw ph::Error("fixed: expected a boolean array of n values");
     ph::FixedGroup group;
     group.name = "fixed";
     for (ph::index_t i = 0; i < model.n_points; ++i)
@@ -259,8 +263,8 @@ PYBIND11_MODULE(_pointhaptics, m) {
         return forces;
       },
       py::arg("depths"), py::arg("sphere_radius") = 0.01, py::arg("block_radius") = 0.04, py::arg("height") = 0.04,
-      py::arg("young") = 1e5, py::arg("poisson") = 0.3, py::arg("model") = "neo_hookean", py::arg("elements_per_radius") = 20,
-      py::arg("threads") = 1,
+      py::arg("young") = 1e5, py::arg("poisson") = 0.3, py::arg("model") = "neo_hookean",
+      py::arg("elements_per_radius") = 20, py::arg("threads") = 1,
       "CalculiX's force (N) of a rigid frictionless sphere (sphere_radius, m) pressed into a cylinder (block_radius, "
       "height; m; bottom held) to each of `depths` (m): an axisymmetric CAX8 model, NLGEOM, with the material "
       "`model` (svk | neo_hookean | mooney_rivlin with young and poisson its small-strain moduli), elements of "
@@ -278,31 +282,36 @@ every array still speaks of all n points.
 Calls on one Simulation from several threads follow each other (each object has a lock); step(), run() and
 probe() release the GIL while they work. Errors are pointhaptics.Error (a ValueError) with a message that
 names the problem.)doc")
-      .def_static("from_scene", &from_scene, py::arg("path"), py::arg("threads") = 0, py::arg("settings") = py::none(),
-                  "Load a scene file (TOML: [object], [material], [kernel], [solver], [[fixed]], [[load]], [lod] ...) and "
-                  "prepare its simulation, with its levels of detail. threads: of the force evaluation (0: all). settings: "
-                  "{key: value} set over the file's, as `pointhaptics run --set` (e.g. {'material.young': 2e5, "
-                  "'load.0.total': [0, -0.02, 0]}).")
-      .def_static("from_scene_text", &from_scene_text, py::arg("text"), py::arg("base_dir") = ".", py::arg("threads") = 0,
-                  py::arg("settings") = py::none(), py::arg("name") = "<string>",
-                  "As from_scene, from the scene's text: relative file paths are taken from base_dir, and messages name "
-                  "`name` for the file (what a study sends to its workers).")
+      .def_static(
+          "from_scene", &from_scene, py::arg("path"), py::arg("threads") = 0, py::arg("settings") = py::none(),
+          "Load a scene file (TOML: [object], [material], [kernel], [solver], [[fixed]], [[load]], [lod] ...) and "
+          "prepare its simulation, with its levels of detail. threads: of the force evaluation (0: all). settings: "
+          "{key: value} set over the file's, as `pointhaptics run --set` (e.g. {'material.young': 2e5, "
+          "'load.0.total': [0, -0.02, 0]}).")
+      .def_static(
+          "from_scene_text", &from_scene_text, py::arg("text"), py::arg("base_dir") = ".", py::arg("threads") = 0,
+          py::arg("settings") = py::none(), py::arg("name") = "<string>",
+          "As from_scene, from the scene's text: relative file paths are taken from base_dir, and messages name "
+          "`name` for the file (what a study sends to its workers).")
       .def("__reduce__",
            [](const PySimulation&) -> py::object {
-             throw ph::Error("a Simulation does not travel to another process: send its scene (path or text) and settings, "
-                             "and open it there (pointhaptics.study does)");
+             throw ph::Error(
+                 "a Simulation does not travel to another process: send its scene (path or text) and settings, "
+                 "and open it there (pointhaptics.study does)");
            })
-      .def_static("from_points", &from_points, py::arg("points"), py::arg("spacing"), py::arg("fixed") = py::none(),
-                  py::arg("forces") = py::none(), py::arg("young") = 1e5, py::arg("poisson") = 0.4, py::arg("density") = 1000.0,
-                  py::arg("damping") = 0.0, py::arg("kernel") = "poly6", py::arg("support_factor") = 2.0,
-                  py::arg("solver") = "explicit", py::arg("dt") = 1e-3, py::arg("threads") = 0, py::arg("model") = "svk",
-                  py::arg("prony") = std::vector<std::pair<double, double>>{},
-                  "Build a model from an (n, 3) array of points (m) sampled at `spacing`, with an optional boolean "
-                  "`fixed` mask and (n, 3) constant `forces` (N); `model`: svk | neo_hookean | mooney_rivlin | corotated "
-                  "(young and poisson are its small-strain moduli); `prony`: [(g, tau), ...], a viscoelastic shear part "
-                  "(young and poisson then the instantaneous moduli). Scene files take every material key, [[region]] too.")
+      .def_static(
+          "from_points", &from_points, py::arg("points"), py::arg("spacing"), py::arg("fixed") = py::none(),
+          py::arg("forces") = py::none(), py::arg("young") = 1e5, py::arg("poisson") = 0.4, py::arg("density") = 1000.0,
+          py::arg("damping") = 0.0, py::arg("kernel") = "poly6", py::arg("support_factor") = 2.0,
+          py::arg("solver") = "explicit", py::arg("dt") = 1e-3, py::arg("threads") = 0, py::arg("model") = "svk",
+          py::arg("prony") = std::vector<std::pair<double, double>>{},
+          "Build a model from an (n, 3) array of points (m) sampled at `spacing`, with an optional boolean "
+          "`fixed` mask and (n, 3) constant `forces` (N); `model`: svk | neo_hookean | mooney_rivlin | corotated "
+          "(young and poisson are its small-strain moduli); `prony`: [(g, tau), ...], a viscoelastic shear part "
+          "(young and poisson then the instantaneous moduli). Scene files take every material key, [[region]] too.")
       .def(
-          "step", [](PySimulation& p) {
+          "step",
+          [](PySimulation& p) {
             py::gil_scoped_release release;
             const std::lock_guard<std::mutex> lock(p.mutex);
             const ph::StepReport report = p.sim->step();
@@ -313,7 +322,8 @@ names the problem.)doc")
           "dynamics; a static solver solves for the equilibrium under the full load. Raises pointhaptics.Error on a "
           "divergence or a failed solve (then summary() says so). Releases the GIL.")
       .def(
-          "run", [](PySimulation& p, double duration) {
+          "run",
+          [](PySimulation& p, double duration) {
             if (!(duration >= 0)) throw ph::Error("run: duration must be >= 0 (s)");
             py::gil_scoped_release release;
             const std::lock_guard<std::mutex> lock(p.mutex);
@@ -333,17 +343,18 @@ names the problem.)doc")
           "Simulated time so far (s)")
       .def_property_readonly(
           "n_points", [](PySimulation& p) { return p.sim->model().n_points; }, "Points of the object, n")
-      .def(
-          "__repr__",
-          [](PySimulation& p) {
-            const auto lock = locked(p);
-            const ph::Model& m = p.sim->simulated_model();
-            std::string lod;
-            if (const ph::ActiveSet* a = p.sim->active_set()) lod = ", " + std::to_string(a->n_selected) + " simulated";
-            return "<pointhaptics.Simulation: " + std::to_string(m.n_points) + " points" + lod + ", " +
-                   std::string(ph::to_string(p.sim->solver().kind)) + " solver, dt = " + fmt::format("{:g}", p.sim->solver().dt) +
-                   " s, t = " + fmt::format("{:g}", p.sim->state().time) + " s>";
-          })
+      .def("__repr__",
+           [](PySimulation& p) {
+             const auto lock = locked(p);
+             const ph::Model& m = p.sim->simulated_model();
+             std::string lod;
+             if (const ph::ActiveSet* a = p.sim->active_set())
+               lod = ", " + std::to_string(a->n_selected) + " simulated";
+             return "<pointhaptics.Simulation: " + std::to_string(m.n_points) + " points" + lod + ", " +
+                    std::string(ph::to_string(p.sim->solver().kind)) +
+                    " solver, dt = " + fmt::format("{:g}", p.sim->solver().dt) +
+                    " s, t = " + fmt::format("{:g}", p.sim->state().time) + " s>";
+           })
       .def_property_readonly(
           "reference", [](py::object self) { return view(self.cast<PySimulation&>().sim->model().X, self); },
           "Reference (rest) positions X, an (n, 3) read-only view (m)")
@@ -368,8 +379,8 @@ names the problem.)doc")
           [](PySimulation& p) {
             const auto lock = locked(p);
             const ph::Points x = p.sim->model().X + p.sim->state().u;
-            return py::array_t<double>({x.cols(), Eigen::Index{3}}, {Eigen::Index{3 * sizeof(double)}, Eigen::Index{sizeof(double)}},
-                                       x.data());
+            return py::array_t<double>({x.cols(), Eigen::Index{3}},
+                                       {Eigen::Index{3 * sizeof(double)}, Eigen::Index{sizeof(double)}}, x.data());
           },
           "Current positions X + u, an (n, 3) array (a copy)")
       .def_property_readonly(
@@ -378,26 +389,28 @@ names the problem.)doc")
             const auto lock = locked(p);
             const ph::Model& m = p.sim->simulated_model();
             ph::Workspace ws(m, 1);
-            ph::viscous_stress_at_state(m, p.sim->simulated_state(), ws, p.sim->solver().kind == ph::SolverKind::STATIC);
+            ph::viscous_stress_at_state(m, p.sim->simulated_state(), ws,
+                                        p.sim->solver().kind == ph::SolverKind::STATIC);
             ph::compute_internal_forces(m, p.sim->simulated_state().u, ws);
             // one row per point of the object, as every other array (with levels of detail the simulated
             // points carry theirs, the others none)
             ph::Points f = ph::Points::Zero(3, p.sim->model().n_points);
             const ph::ActiveSet* active = p.sim->active_set();
             for (ph::index_t k = 0; k < m.n_points; ++k) f.col(active ? active->full_of[k] : k) = ws.f_int.col(k);
-            return py::array_t<double>({f.cols(), Eigen::Index{3}}, {Eigen::Index{3 * sizeof(double)}, Eigen::Index{sizeof(double)}},
-                                       f.data());
+            return py::array_t<double>({f.cols(), Eigen::Index{3}},
+                                       {Eigen::Index{3 * sizeof(double)}, Eigen::Index{sizeof(double)}}, f.data());
           },
           "Internal elastic forces, an (n, 3) array (a copy; N), one row per point of the object like every other "
           "array; with levels of detail, zero on the points not simulated")
-      .def_property_readonly("fixed",
-                             [](PySimulation& p) {
-                               const ph::Model& m = p.sim->simulated_model();
-                               py::array_t<bool> a(m.n_points);
-                               for (ph::index_t i = 0; i < m.n_points; ++i) a.mutable_at(i) = m.fixed[i] != 0;
-                               return a;
-                             },
-                             "Held points, an (n,) boolean array (a copy): the [[fixed]] boxes or the `fixed` mask")
+      .def_property_readonly(
+          "fixed",
+          [](PySimulation& p) {
+            const ph::Model& m = p.sim->simulated_model();
+            py::array_t<bool> a(m.n_points);
+            for (ph::index_t i = 0; i < m.n_points; ++i) a.mutable_at(i) = m.fixed[i] != 0;
+            return a;
+          },
+          "Held points, an (n,) boolean array (a copy): the [[fixed]] boxes or the `fixed` mask")
       .def_property_readonly(
           "surface_vertices",
           [](py::object self) {
@@ -417,7 +430,8 @@ names the problem.)doc")
             py::array_t<std::int64_t> a({static_cast<py::ssize_t>(surface.mesh.F.size()), py::ssize_t{3}});
             auto w = a.mutable_unchecked<2>();
             for (std::size_t t = 0; t < surface.mesh.F.size(); ++t)
-              for (int k = 0; k < 3; ++k) w(static_cast<py::ssize_t>(t), k) = surface.mesh.F[t][static_cast<std::size_t>(k)];
+              for (int k = 0; k < 3; ++k)
+                w(static_cast<py::ssize_t>(t), k) = surface.mesh.F[t][static_cast<std::size_t>(k)];
             return a;
           },
           "The object's surface triangles, a (t, 3) integer array of rows of surface_vertices (a copy), counter-clockwise "
@@ -436,7 +450,8 @@ names the problem.)doc")
             py::array_t<std::int64_t> triangles({static_cast<py::ssize_t>(split.mesh.F.size()), py::ssize_t{3}});
             auto t = triangles.mutable_unchecked<2>();
             for (std::size_t f = 0; f < split.mesh.F.size(); ++f)
-              for (int k = 0; k < 3; ++k) t(static_cast<py::ssize_t>(f), k) = split.mesh.F[f][static_cast<std::size_t>(k)];
+              for (int k = 0; k < 3; ++k)
+                t(static_cast<py::ssize_t>(f), k) = split.mesh.F[f][static_cast<std::size_t>(k)];
             return py::make_tuple(vertices, triangles, static_cast<long long>(split.cut_faces));
           },
           "The object's surface split along the cuts so far (docs/cutting.md): (vertices, triangles, cut_faces), copies "
@@ -445,7 +460,8 @@ names the problem.)doc")
       .def(
           "run_scene",
           [](PySimulation& p) {
-            if (!p.from_scene) throw ph::Error("run_scene: this Simulation was made from_points; it has no scene to run");
+            if (!p.from_scene)
+              throw ph::Error("run_scene: this Simulation was made from_points; it has no scene to run");
             py::gil_scoped_release release;
             const std::lock_guard<std::mutex> lock(p.mutex);
             if (p.scene.probe.present && !p.scene.probe.held()) {
@@ -503,16 +519,17 @@ names the problem.)doc")
           "The tool now (None without one), as the result JSON's tool block: kind, position (m), force (N, the object "
           "on the tool, scene axes), torque (N m), friction (N), contacts, penetration (m); a held tool adds start "
           "(its scene position) and direction (the unit vector it presses along, [probe] direction).")
-      .def("energy",
-           [](PySimulation& p) {
-             const auto lock = locked(p);
-             const ph::EnergyTerms e = ph::strain_energy(p.sim->simulated_model(), p.sim->simulated_state().u);
-             py::dict d;
-             d["strain"] = e.total();
-             d["kinetic"] = ph::kinetic_energy(p.sim->simulated_model(), p.sim->simulated_state().velocity);
-             return d;
-           },
-           "Energies of the simulated points now, a dict: strain (the elastic energy whose gradient the forces are) and "
+      .def(
+          "energy",
+          [](PySimulation& p) {
+            const auto lock = locked(p);
+            const ph::EnergyTerms e = ph::strain_energy(p.sim->simulated_model(), p.sim->simulated_state().u);
+            py::dict d;
+            d["strain"] = e.total();
+            d["kinetic"] = ph::kinetic_energy(p.sim->simulated_model(), p.sim->simulated_state().velocity);
+            return d;
+          },
+          "Energies of the simulated points now, a dict: strain (the elastic energy whose gradient the forces are) and "
           "kinetic (J)")
       .def(
           "summary",
@@ -564,10 +581,20 @@ names the problem.)doc")
             auto w = log.mutable_unchecked<2>();
             for (std::size_t k = 0; k < r.log.size(); ++k) {
               const ph::HapticLogRow& row = r.log[k];
-              const double v[14] = {row.t,          row.position.x(), row.position.y(), row.position.z(),
-                                    row.velocity.x(), row.velocity.y(), row.velocity.z(), static_cast<double>(row.buttons),
-                                    row.force.x(),  row.force.y(),    row.force.z(),    row.torque.x(),
-                                    row.torque.y(), row.torque.z()};
+              const double v[14] = {row.t,
+                                    row.position.x(),
+                                    row.position.y(),
+                                    row.position.z(),
+                                    row.velocity.x(),
+                                    row.velocity.y(),
+                                    row.velocity.z(),
+                                    static_cast<double>(row.buttons),
+                                    row.force.x(),
+                                    row.force.y(),
+                                    row.force.z(),
+                                    row.torque.x(),
+                                    row.torque.y(),
+                                    row.torque.z()};
               for (int c = 0; c < 14; ++c) w(static_cast<py::ssize_t>(k), c) = v[c];
             }
             py::dict d;

@@ -49,7 +49,10 @@ TEST(Blade, ADevicesBladeCutsTheCantileverThroughAndTheHandFeelsTheResistance) {
   // the blade's centre in the plane x = 3.375 cm, moved from 2 cm above the beam to 2 cm below it between
   // t = 0.05 s and 0.25 s (0.35 m/s), button held
   const Vec3 above(0.03375, 0.05, 0.015), below(0.03375, -0.02, 0.015);
-  VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), true}, {0.05, Vec3::Zero(), true}, {0.25, below - above, true}, {0.4, below - above, true}}),
+  VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), true},
+                                   {0.05, Vec3::Zero(), true},
+                                   {0.25, below - above, true},
+                                   {0.4, below - above, true}}),
                        known_device_specs("touch"));
   InteractiveOptions o = blade(above, 0.4);
   double work = 0, largest = 0, largest_step = 0;
@@ -90,9 +93,10 @@ TEST(Blade, ADevicesBladeCutsTheCantileverThroughAndTheHandFeelsTheResistance) {
     sent = std::max(sent, tick.force.norm());
   }
   EXPECT_LE(sent, known_device_specs("touch").max_force + 1e-9);
-  std::printf("cut pairs %lld, area %.4g m^2, work %.4g J (G A = %.4g J), largest force %.3g N (G x 3 cm = %.3g N), "
-              "largest step-to-step change %.3g N, longest sweep %.3g ms\n",
-              s.cut.cut_pairs, area, work, resistance * area, largest, resistance * 0.03, largest_step, s.cut.max_update_ms);
+  std::printf(
+      "cut pairs %lld, area %.4g m^2, work %.4g J (G A = %.4g J), largest force %.3g N (G x 3 cm = %.3g N), "
+      "largest step-to-step change %.3g N, longest sweep %.3g ms\n",
+      s.cut.cut_pairs, area, work, resistance * area, largest, resistance * 0.03, largest_step, s.cut.max_update_ms);
 }
 
 // Levels of detail around the root (the points within 2.25 cm of the top of the cut plane, part of those to 2.85 cm;
@@ -150,8 +154,9 @@ void lifted_blade_stops_at_the_cut_face(bool levels_of_detail) {
   // once the button was let go the probe's surface was split along the stroke's sheets, once
   EXPECT_EQ(s.cut.surface_splits, 1);
   // (with levels of detail, than the part of the uncut surface the active set carries)
-  const index_t uncut = levels_of_detail ? restrict_surface(whole->mesh, whole->map, *sim.active_set(), reach).map.n_vertices()
-                                         : whole->map.n_vertices();
+  const index_t uncut = levels_of_detail
+                            ? restrict_surface(whole->mesh, whole->map, *sim.active_set(), reach).map.n_vertices()
+                            : whole->map.n_vertices();
   EXPECT_GT(vertices, uncut);
   const double face = 0.03375 + 0.001;
   if (levels_of_detail) {
@@ -168,14 +173,19 @@ void lifted_blade_stops_at_the_cut_face(bool levels_of_detail) {
     // 0.84 N along x with the contact's samples on the face's triangles, 0.05 for 0.92 on its vertices alone)
     EXPECT_LT(std::abs(force.y()), 0.25 * force.x());
   }
-  std::printf("lifted blade%s: at (%.5f, %.5f, %.5f) m against the face at x = %.5f m, force (%.3g, %.3g, %.3g) N, split in %.2f ms\n",
-              levels_of_detail ? " (levels of detail)" : "", probe.x(), probe.y(), probe.z(), face, force.x(), force.y(), force.z(),
-              s.cut.max_split_ms);
+  std::printf(
+      "lifted blade%s: at (%.5f, %.5f, %.5f) m against the face at x = %.5f m, force (%.3g, %.3g, %.3g) N, split in %.2f ms\n",
+      levels_of_detail ? " (levels of detail)" : "", probe.x(), probe.y(), probe.z(), face, force.x(), force.y(),
+      force.z(), s.cut.max_split_ms);
 }
 
-TEST(Blade, LiftedAfterAStrokeTheBladePushesOnTheSplitSurfaceAndStopsAtTheCutFace) { lifted_blade_stops_at_the_cut_face(false); }
+TEST(Blade, LiftedAfterAStrokeTheBladePushesOnTheSplitSurfaceAndStopsAtTheCutFace) {
+  lifted_blade_stops_at_the_cut_face(false);
+}
 
-TEST(Blade, WithLevelsOfDetailTheLiftedBladeTouchesTheActiveSetsPartOfTheSplitSurfaceAndIsHeldOnThePiece) { lifted_blade_stops_at_the_cut_face(true); }
+TEST(Blade, WithLevelsOfDetailTheLiftedBladeTouchesTheActiveSetsPartOfTheSplitSurfaceAndIsHeldOnThePiece) {
+  lifted_blade_stops_at_the_cut_face(true);
+}
 
 TEST(Blade, SawingForASecondStaysFiniteBoundedAndWithinTheDevice) {
   // the blade sawed back and forth along the beam's root region while it sinks, a thousand steps: every step
@@ -208,7 +218,8 @@ TEST(Blade, SawingForASecondStaysFiniteBoundedAndWithinTheDevice) {
   EXPECT_LE(sheets, 2u * 1000u);
   // and the surface split along them all (sheets sawn back and forth over one another): finite, and carried
   const auto start = std::chrono::steady_clock::now();
-  const ObjectSurface split = split_surface(build_object_surface(scene, sim.model()), sim.model(), sim.cut_sheets().triangles);
+  const ObjectSurface split =
+      split_surface(build_object_surface(scene, sim.model()), sim.model(), sim.cut_sheets().triangles);
   const double split_ms = 1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   EXPECT_GT(split.cut_faces, 0);
   EXPECT_TRUE(split.mesh.V.allFinite());
@@ -264,7 +275,8 @@ TEST(Blade, WithLevelsOfDetailAScriptedCutInTheActiveSetReachesTheObjectAndTheNe
   // rim, where the sheets mapped back and the current positions may differ)
   ASSERT_EQ(s.cut.piece_points.size(), 2u);
   EXPECT_EQ(s.cut.piece_points, p.cut.piece_points);
-  EXPECT_NEAR(static_cast<double>(s.cut.cut_pairs), static_cast<double>(p.cut.cut_pairs), 0.05 * static_cast<double>(p.cut.cut_pairs));
+  EXPECT_NEAR(static_cast<double>(s.cut.cut_pairs), static_cast<double>(p.cut.cut_pairs),
+              0.05 * static_cast<double>(p.cut.cut_pairs));
   index_t severed = 0;
   EXPECT_EQ(pairs_across_the_cut(sim.model(), severed), 0);
   EXPECT_EQ(severed, s.cut.cut_pairs);
@@ -282,9 +294,11 @@ TEST(Blade, WithLevelsOfDetailAScriptedCutInTheActiveSetReachesTheObjectAndTheNe
   sim.run(0.35);
   ASSERT_FALSE(sim.diagnostics().failed) << sim.diagnostics().failure;
   EXPECT_TRUE(sim.state().u.allFinite());
-  std::printf("levels of detail: %lld of %lld points simulated; %lld pairs cut in the object (%lld without levels of detail), "
-              "pieces %zu\n", static_cast<long long>(simulated), static_cast<long long>(object_points), s.cut.cut_pairs,
-              p.cut.cut_pairs, s.cut.piece_points.size());
+  std::printf(
+      "levels of detail: %lld of %lld points simulated; %lld pairs cut in the object (%lld without levels of detail), "
+      "pieces %zu\n",
+      static_cast<long long>(simulated), static_cast<long long>(object_points), s.cut.cut_pairs, p.cut.cut_pairs,
+      s.cut.piece_points.size());
 }
 
 TEST(Blade, WithLevelsOfDetailADevicesBladeCutsTheObjectThrough) {
@@ -293,7 +307,10 @@ TEST(Blade, WithLevelsOfDetailADevicesBladeCutsTheObjectThrough) {
   Simulation sim(build_scene_model(scene), scene.solver, 2);
   sim.enable_lod(root_lod(), cut_top);
   const Vec3 above(0.03375, 0.05, 0.015), below(0.03375, -0.02, 0.015);
-  VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), true}, {0.05, Vec3::Zero(), true}, {0.25, below - above, true}, {0.4, below - above, true}}),
+  VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), true},
+                                   {0.05, Vec3::Zero(), true},
+                                   {0.25, below - above, true},
+                                   {0.4, below - above, true}}),
                        known_device_specs("touch"));
   InteractiveOptions o = blade(above, 0.4);
   double largest = 0;
@@ -311,8 +328,9 @@ TEST(Blade, WithLevelsOfDetailADevicesBladeCutsTheObjectThrough) {
   EXPECT_GT(largest, 0.6 * resistance * 0.03);
   EXPECT_LT(largest, 1.6 * resistance * 0.03);
   for (const auto& tick : r.log) ASSERT_TRUE(tick.force.allFinite());
-  std::printf("a blade with levels of detail: %lld pairs cut, %lld selections, largest force %.3g N, longest update %.3g ms\n",
-              s.cut.cut_pairs, s.lod.selections, largest, s.cut.max_update_ms);
+  std::printf(
+      "a blade with levels of detail: %lld pairs cut, %lld selections, largest force %.3g N, longest update %.3g ms\n",
+      s.cut.cut_pairs, s.lod.selections, largest, s.cut.max_update_ms);
 }
 
 }  // namespace

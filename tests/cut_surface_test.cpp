@@ -26,7 +26,8 @@ struct Block {
 
 Block block() {
   Block b;
-  b.scene = parse_scene("[object]\nshape = \"box\"\nsize = [0.06, 0.03, 0.03]\nspacing = 0.005\n[material]\nyoung = 1e5\npoisson = 0.3\n");
+  b.scene = parse_scene(
+      "[object]\nshape = \"box\"\nsize = [0.06, 0.03, 0.03]\nspacing = 0.005\n[material]\nyoung = 1e5\npoisson = 0.3\n");
   b.model = build_scene_model(b.scene);
   b.whole = build_object_surface(b.scene, b.model);
   b.lo = b.whole.mesh.V.rowwise().minCoeff();
@@ -40,7 +41,9 @@ BladeSweep plane(const Block& b, double x_cut, double z_from, double z_to) {
   return BladeSweep{Vec3(x_cut, y0, z_from), Vec3(x_cut, y1, z_from), Vec3(x_cut, y0, z_to), Vec3(x_cut, y1, z_to)};
 }
 
-std::vector<SheetTriangle> sheets_of(const BladeSweep& s) { return {SheetTriangle{s.a0, s.b0, s.b1}, SheetTriangle{s.a0, s.b1, s.a1}}; }
+std::vector<SheetTriangle> sheets_of(const BladeSweep& s) {
+  return {SheetTriangle{s.a0, s.b0, s.b1}, SheetTriangle{s.a0, s.b1, s.a1}};
+}
 
 double cut_face_area(const ObjectSurface& s) {
   double area = 0;
@@ -100,9 +103,11 @@ TEST(CutSurface, ASlitGainsFacesOfTwiceItsAreaCarriedByThePointsOnTheirSide) {
   // bottom, where the material is whole
   const double bottom = b.hi.z() - depth;
   int faces = 0;
-  for (std::size_t t = split.mesh.F.size() - static_cast<std::size_t>(split.cut_faces); t < split.mesh.F.size(); ++t, ++faces) {
+  for (std::size_t t = split.mesh.F.size() - static_cast<std::size_t>(split.cut_faces); t < split.mesh.F.size();
+       ++t, ++faces) {
     const auto& f = split.mesh.F[t];
-    const Vec3 normal = (split.mesh.V.col(f[1]) - split.mesh.V.col(f[0])).cross(split.mesh.V.col(f[2]) - split.mesh.V.col(f[0]));
+    const Vec3 normal =
+        (split.mesh.V.col(f[1]) - split.mesh.V.col(f[0])).cross(split.mesh.V.col(f[2]) - split.mesh.V.col(f[0]));
     ASSERT_GT(std::abs(normal.normalized().x()), 1 - 1e-9);
     for (const index_t v : f)
       for (index_t e = split.map.points.begin(v); e < split.map.points.end(v); ++e)
@@ -115,7 +120,8 @@ TEST(CutSurface, ASlitGainsFacesOfTwiceItsAreaCarriedByThePointsOnTheirSide) {
   for (Eigen::Index v = 0; v < b.whole.mesh.V.cols(); ++v) {
     const Vec3 Y = split.mesh.V.col(v);
     if (Y.z() < bottom) continue;
-    for (index_t e = split.map.points.begin(static_cast<index_t>(v)); e < split.map.points.end(static_cast<index_t>(v)); ++e) {
+    for (index_t e = split.map.points.begin(static_cast<index_t>(v)); e < split.map.points.end(static_cast<index_t>(v));
+         ++e) {
       const Vec3 X = b.model.X.col(split.map.points.index[e]);
       if ((Y.x() - x_cut) * (X.x() - x_cut) < 0) {
         ASSERT_LT(X.z(), bottom) << v;
@@ -167,7 +173,8 @@ TEST(CutSurface, RandomSheetsGiveAFiniteSurfaceCarriedByWeightsThatSumToOne) {
     }
   }
   for (const auto& f : split.mesh.F)
-    for (const index_t v : f) ASSERT_GT(split.map.points.end(v), split.map.points.begin(v)) << "a drawn vertex without points";
+    for (const index_t v : f)
+      ASSERT_GT(split.map.points.end(v), split.map.points.begin(v)) << "a drawn vertex without points";
   const Points y = deformed_surface(split, Points::Constant(3, b.model.n_points, 0.001));
   EXPECT_TRUE(y.allFinite());
   EXPECT_NEAR((y - split.mesh.V).cwiseAbs().maxCoeff(), 0.001, 1e-9);  // a translation is carried exactly

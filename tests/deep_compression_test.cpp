@@ -30,7 +30,8 @@ box = {{ min = [-1.0, 0.05, -1.0], max = [1.0, 1.0, 1.0] }}
 displacement = [0.0, {}, 0.0]
 [solver]
 kind = "static"
-)", spacing, model, -0.05 * strain);
+)",
+                                       spacing, model, -0.05 * strain);
   SceneSession session = open_scene(parse_scene(text, "compression.toml"));
   session.simulation->step();
   return session.simulation->summary();
@@ -108,7 +109,8 @@ specs = "custom"
 max_force = 100.0
 max_stiffness = 1e5
 workspace_radius = 0.2
-)", model);
+)",
+                                         model);
     SessionOptions options;
     options.make_device = true;
     SceneSession session = open_scene(parse_scene(text, "press.toml"), options);

@@ -16,7 +16,8 @@ const Vec3 size(0.04, 0.03, 0.04), inclusion_centre(0.01, 0.0175, 0.02);
 const double inclusion_radius = 0.006, punch_half = 0.00375, depth = 3e-4, spacing = 0.0025;
 
 Aabb punch_box(double x) {
-  return {Vec3(x - punch_half, size.y(), size.z() / 2 - punch_half), Vec3(x + punch_half, 1, size.z() / 2 + punch_half)};
+  return {Vec3(x - punch_half, size.y(), size.z() / 2 - punch_half),
+          Vec3(x + punch_half, 1, size.z() / 2 + punch_half)};
 }
 
 double point_force(double x, bool with_inclusion) {
@@ -80,8 +81,8 @@ TEST(Heterogeneous, AStiffInclusionIsFeltAsCalculixFeelsIt) {
   RecordProperty("contrast", std::to_string(contrast));
   RecordProperty("fem_contrast", std::to_string(fem_contrast));
   EXPECT_GT(contrast, 1.1);  // the nodule is felt (1.21 here; CalculiX 1.17)
-  EXPECT_NEAR(contrast, fem_contrast, 0.05 * fem_contrast) << "over " << over << " N, plain " << plain << " N; CalculiX "
-                                                           << fem_over << " N, " << fem_plain << " N";
+  EXPECT_NEAR(contrast, fem_contrast, 0.05 * fem_contrast)
+      << "over " << over << " N, plain " << plain << " N; CalculiX " << fem_over << " N, " << fem_plain << " N";
   EXPECT_NEAR(side, fem_side, 0.05 * fem_side) << "beside " << beside << " N; CalculiX " << fem_beside << " N";
   // and the plain block's force itself, footprint and all
   EXPECT_NEAR(plain, fem_plain, 0.25 * fem_plain);

@@ -21,17 +21,21 @@ namespace pointhaptics {
 namespace {
 
 // the seed's beam (both ends held), by default soft enough to be pushed in by a hand
-Scene seed_beam_scene(double damping = 5.0, double young = 1e4, const std::string& solver = "explicit", double spacing = 0.015) {
+Scene seed_beam_scene(double damping = 5.0, double young = 1e4, const std::string& solver = "explicit",
+                      double spacing = 0.015) {
   const std::string text = R"(
 [object]
 shape = "box"
 size = [0.135, 0.03, 0.03]
-spacing = )" + std::to_string(spacing) + R"(
+spacing = )" + std::to_string(spacing) +
+                           R"(
 [material]
-young = )" + std::to_string(young) + R"(
+young = )" + std::to_string(young) +
+                           R"(
 poisson = 0.4
 density = 1000.0
-damping = )" + std::to_string(damping) + R"(
+damping = )" + std::to_string(damping) +
+                           R"(
 [[fixed]]
 box = { min = [-1.0, -1.0, -1.0], max = [0.0, 1.0, 1.0] }
 [[fixed]]
@@ -66,8 +70,8 @@ InteractiveOptions options(double duration, ProbeMode mode = ProbeMode::PUSH) {
   o.probe.radius = 0.01;
   o.probe.mode = mode;
   o.mapping.origin = Vec3(0.0675, 0.05, 0.015);  // device origin above the middle of the top face
-  o.coupling_safety = 1.0;                        // the largest stiffness the coupling allows
-  o.rules.passivity_control = false;              // the environment's own passivity is what these tests observe
+  o.coupling_safety = 1.0;                       // the largest stiffness the coupling allows
+  o.rules.passivity_control = false;             // the environment's own passivity is what these tests observe
   return o;
 }
 
@@ -96,8 +100,9 @@ TEST(Interactive, ClosedLoopPushDoesNotGainEnergy) {
 TEST(Interactive, DeviceForceNeverExceedsItsLimit) {
   Simulation sim = seed_beam(20.0, 1e6);  // stiff: the probe cannot go through
   // the hand tries to go far through the object: the coupling asks for more than the device can give
-  VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), false}, {1.0, Vec3(0, -0.2, 0), false}, {3.0, Vec3(0, -0.2, 0), false}}),
-                       known_device_specs("touch"));
+  VirtualDevice device(
+      Trajectory({{0.0, Vec3::Zero(), false}, {1.0, Vec3(0, -0.2, 0), false}, {3.0, Vec3(0, -0.2, 0), false}}),
+      known_device_specs("touch"));
   const InteractiveResult r = run_interactive(sim, device, options(3.0));
   EXPECT_LE(r.haptic.max_force_n, 3.3 + 1e-12);
   EXPECT_GT(r.haptic.max_force_n, 1.0);
@@ -123,9 +128,10 @@ TEST(Interactive, OnTheSurfaceTheLoopStaysPassiveBoundedAndFinite) {
     InteractiveOptions o = on_surface(scene, sim, 8.0);
     o.rules.passivity_control = true;
     const InteractiveResult r = run_interactive(sim, device, o);
-    std::printf("pressed and withdrawn: max force %.3f N, least energy the hand put in %.3g J, beam %.3g mm from rest, moving at %.3g m/s\n",
-                r.haptic.max_force_n, r.haptic.min_observed_energy, 1e3 * sim.state().u.cwiseAbs().maxCoeff(),
-                sim.state().velocity.cwiseAbs().maxCoeff());
+    std::printf(
+        "pressed and withdrawn: max force %.3f N, least energy the hand put in %.3g J, beam %.3g mm from rest, moving at %.3g m/s\n",
+        r.haptic.max_force_n, r.haptic.min_observed_energy, 1e3 * sim.state().u.cwiseAbs().maxCoeff(),
+        sim.state().velocity.cwiseAbs().maxCoeff());
     EXPECT_GT(r.max_contacts, 0);
     EXPECT_GT(r.haptic.max_force_n, 0.1);
     EXPECT_GT(r.haptic.min_observed_energy, -1e-4);
@@ -139,8 +145,9 @@ TEST(Interactive, OnTheSurfaceTheLoopStaysPassiveBoundedAndFinite) {
   {
     const Scene scene = seed_beam_scene(20.0, 1e6);
     Simulation sim(build_scene_model(scene), scene.solver, 1);
-    VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), false}, {1.0, Vec3(0, -0.2, 0), false}, {2.0, Vec3(0, -0.2, 0), false}}),
-                         known_device_specs("touch"));
+    VirtualDevice device(
+        Trajectory({{0.0, Vec3::Zero(), false}, {1.0, Vec3(0, -0.2, 0), false}, {2.0, Vec3(0, -0.2, 0), false}}),
+        known_device_specs("touch"));
     const InteractiveResult r = run_interactive(sim, device, on_surface(scene, sim, 2.0));
     std::printf("pushed far into a stiff beam: max force %.3f N\n", r.haptic.max_force_n);
     EXPECT_GT(r.haptic.max_force_n, 1.0);
@@ -153,7 +160,8 @@ TEST(Interactive, OnTheSurfaceTheLoopStaysPassiveBoundedAndFinite) {
     HandDynamics stiff_hand;
     stiff_hand.stiffness = 5000;  // a hand that goes where it wants, at 1 m/s
     stiff_hand.damping = 40;
-    VirtualDevice device(Trajectory({{0.0, Vec3(-0.1, -0.035, 0), false}, {0.2, Vec3(0.1, -0.035, 0), false},
+    VirtualDevice device(Trajectory({{0.0, Vec3(-0.1, -0.035, 0), false},
+                                     {0.2, Vec3(0.1, -0.035, 0), false},
                                      {0.4, Vec3(-0.1, -0.035, 0), false}}),
                          known_device_specs("touch"), stiff_hand);
     const InteractiveResult r = run_interactive(sim, device, on_surface(scene, sim, 0.5));
@@ -177,9 +185,10 @@ TEST(Interactive, ThePassivityControllerKeepsADeepPressPassive) {
     o.surface = std::make_shared<const ObjectSurface>(build_object_surface(scene, sim.model()));
     o.rules.passivity_control = control;
     const InteractiveResult r = run_interactive(sim, device, o);
-    std::printf("deep press, passivity controller %s: observed energy at least %.3g J, dissipated %.3g J on %lld ticks, max force %.3f N\n",
-                control ? "on" : "off", r.haptic.min_observed_energy, r.haptic.passivity_dissipated, r.haptic.passivity_ticks,
-                r.haptic.max_force_n);
+    std::printf(
+        "deep press, passivity controller %s: observed energy at least %.3g J, dissipated %.3g J on %lld ticks, max force %.3f N\n",
+        control ? "on" : "off", r.haptic.min_observed_energy, r.haptic.passivity_dissipated, r.haptic.passivity_ticks,
+        r.haptic.max_force_n);
     EXPECT_TRUE(sim.state().u.allFinite());
     return r.haptic;
   };
@@ -196,8 +205,11 @@ TEST(Interactive, ImplicitStiffBeamTreatsContactLinearlyImplicitly) {
   // linearly implicit contact the run is stable, the force reaches the device's limit, and after the
   // hand lets go the beam is back at rest
   Simulation sim = seed_beam(5.0, 1e6, "implicit");
-  VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), false}, {1.0, Vec3(0, -0.04, 0), false}, {2.0, Vec3(0, -0.04, 0), false},
-                                   {2.5, Vec3::Zero(), false}, {3.0, Vec3::Zero(), false}}),
+  VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), false},
+                                   {1.0, Vec3(0, -0.04, 0), false},
+                                   {2.0, Vec3(0, -0.04, 0), false},
+                                   {2.5, Vec3::Zero(), false},
+                                   {3.0, Vec3::Zero(), false}}),
                        known_device_specs("touch"));
   const InteractiveResult r = run_interactive(sim, device, options(3.0));
   EXPECT_FALSE(r.haptic.device_failed);
@@ -212,8 +224,9 @@ TEST(Interactive, ContactSpringsStifferThanTheMaterialShortenTheExplicitStep) {
   // stable sub-step ignored the contact springs; pressed in and held, the run now stays bounded
   for (const double stiffness : {1e4, 1e5}) {
     Simulation sim = seed_beam();
-    VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), false}, {0.5, Vec3(0, -0.04, 0), false}, {1.0, Vec3(0, -0.04, 0), false}}),
-                         known_device_specs("touch"));
+    VirtualDevice device(
+        Trajectory({{0.0, Vec3::Zero(), false}, {0.5, Vec3(0, -0.04, 0), false}, {1.0, Vec3(0, -0.04, 0), false}}),
+        known_device_specs("touch"));
     InteractiveOptions o = options(1.0);
     o.probe.stiffness = stiffness;
     InteractiveResult r;
@@ -229,7 +242,8 @@ TEST(Interactive, FastProbeThroughTheWholeObjectNeitherCrashesNorMakesNaN) {
   HandDynamics stiff_hand;
   stiff_hand.stiffness = 5000;  // a hand that goes where it wants, at 1 m/s
   stiff_hand.damping = 40;
-  VirtualDevice device(Trajectory({{0.0, Vec3(-0.1, -0.035, 0), false}, {0.2, Vec3(0.1, -0.035, 0), false},
+  VirtualDevice device(Trajectory({{0.0, Vec3(-0.1, -0.035, 0), false},
+                                   {0.2, Vec3(0.1, -0.035, 0), false},
                                    {0.4, Vec3(-0.1, -0.035, 0), false}}),
                        known_device_specs("touch"), stiff_hand);
   const InteractiveResult r = run_interactive(sim, device, options(0.5));
@@ -252,7 +266,8 @@ TEST(Interactive, GrabPullsThePointUpAndLetsItGo) {
   EXPECT_GT(held.max_contacts, 0);
   double top = -1;
   for (index_t i = 0; i < sim.model().n_points; ++i)
-    if (std::abs(sim.model().X(0, i) - 0.06) < 0.01 && sim.model().X(1, i) == 0.03) top = std::max(top, sim.state().u(1, i));
+    if (std::abs(sim.model().X(0, i) - 0.06) < 0.01 && sim.model().X(1, i) == 0.03)
+      top = std::max(top, sim.state().u(1, i));
   EXPECT_GT(top, 1e-3);  // pulled up by about a centimetre
   o.duration = 2.5;      // released at 2 s: it springs back
   run_interactive(sim, device, o);
@@ -261,10 +276,9 @@ TEST(Interactive, GrabPullsThePointUpAndLetsItGo) {
 
 TEST(Interactive, DisplayFramesCarryTheForceTheGrabbedPointsAndTheHapticTicks) {
   Simulation sim = seed_beam();
-  VirtualDevice device(Trajectory({{0.0, Vec3(0, -0.02, 0), false},
-                                   {0.1, Vec3(0, -0.02, 0), true},
-                                   {0.5, Vec3(0, 0.01, 0), true}}),
-                       known_device_specs("touch"));
+  VirtualDevice device(
+      Trajectory({{0.0, Vec3(0, -0.02, 0), false}, {0.1, Vec3(0, -0.02, 0), true}, {0.5, Vec3(0, 0.01, 0), true}}),
+      known_device_specs("touch"));
   InteractiveOptions o = options(0.5, ProbeMode::PUSH_GRAB);
   DisplayFrame blank;
   blank.u = Points::Zero(3, sim.model().n_points);
@@ -302,7 +316,7 @@ TEST(Interactive, AStopFlagEndsAnEndlessRealTimeRun) {
   stopper.join();
   EXPECT_GT(r.simulation_steps, 0);
   EXPECT_LT(r.simulation_wall_s, 30.0);  // ended by the flag, not by a duration
-  o.log = true;  // a log of an endless run cannot be reserved
+  o.log = true;                          // a log of an endless run cannot be reserved
   EXPECT_THROW(run_interactive(sim, device, o), Error);
 }
 
@@ -338,7 +352,8 @@ TEST(Interactive, AFailingDeviceStopsTheRunWithZeroForce) {
 
 TEST(Interactive, RealTimeRunTicksAtTheHapticRateAndPublishesFrames) {
   Simulation sim = seed_beam();
-  VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), false}, {0.3, Vec3(0, -0.04, 0), false}}), known_device_specs("touch"));
+  VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), false}, {0.3, Vec3(0, -0.04, 0), false}}),
+                       known_device_specs("touch"));
   InteractiveOptions o = options(0.3);
   o.real_time = true;
   // an output thread reads the published frames while the simulation and the haptic loop run

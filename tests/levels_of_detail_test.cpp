@@ -136,7 +136,8 @@ TEST(LevelsOfDetail, ReselectionCarriesTheStateWithoutAJumpInTheContactForce) {
   const std::vector<index_t> new_index = sim.update_lod(sim.lod_contact_of_probe(probe_at));
   ASSERT_FALSE(new_index.empty()) << "no re-selection";
   const Vec3 after = felt();
-  EXPECT_LE((after - slid).norm(), 1e-9 * slid.norm()) << "force before " << slid.transpose() << ", after " << after.transpose();
+  EXPECT_LE((after - slid).norm(), 1e-9 * slid.norm())
+      << "force before " << slid.transpose() << ", after " << after.transpose();
   // every point simulated before and after kept its displacement
   const Points u_after = sim.state().u;
   for (index_t k = 0; k < static_cast<index_t>(new_index.size()); ++k)
@@ -385,7 +386,8 @@ index_t unsevered_across(const Model& model) {
   for (index_t i = 0; i < model.n_points; ++i)
     for (index_t e = model.neighbours.begin(i); e < model.neighbours.end(i); ++e) {
       const index_t j = model.neighbours.index[e];
-      whole += j > i && (model.X(0, i) < 0.065) != (model.X(0, j) < 0.065) && (model.severed.empty() || !model.severed[e]);
+      whole +=
+          j > i && (model.X(0, i) < 0.065) != (model.X(0, j) < 0.065) && (model.severed.empty() || !model.severed[e]);
     }
   return whole;
 }
@@ -401,7 +403,8 @@ TEST(LevelsOfDetail, ACutWhileAReselectionIsBuiltOnAWorkerReachesTheObjectAndThe
   ASSERT_GT(unsevered_across(sim.model()), 0);
   // a re-selection around x = 9 cm built on a worker, and meanwhile a blade down through the plane x = 6.5 cm
   EXPECT_TRUE(sim.update_lod(Vec3(0.09, 0.04, 0.03), true, true).empty());
-  const BladeSweep blade{Vec3(0.065, 0.05, -0.01), Vec3(0.065, 0.05, 0.07), Vec3(0.065, -0.01, -0.01), Vec3(0.065, -0.01, 0.07)};
+  const BladeSweep blade{Vec3(0.065, 0.05, -0.01), Vec3(0.065, 0.05, 0.07), Vec3(0.065, -0.01, -0.01),
+                         Vec3(0.065, -0.01, 0.07)};
   const CutReport report = sim.cut(blade);
   EXPECT_GT(report.severed_pairs, 0);
   EXPECT_EQ(unsevered_across(sim.simulated_model()), 0);

@@ -24,7 +24,9 @@
 namespace pointhaptics {
 namespace {
 
-std::string temp(const std::string& name) { return (std::filesystem::temp_directory_path() / ("ph_surface_" + name)).string(); }
+std::string temp(const std::string& name) {
+  return (std::filesystem::temp_directory_path() / ("ph_surface_" + name)).string();
+}
 
 TEST(ObjectSurface, EveryShapeGetsItsClosedSurfaceAtTheAskedEdge) {
   const std::string material = "\n[material]\nyoung = 1e5\npoisson = 0.3\n";
@@ -54,7 +56,8 @@ TEST(ObjectSurface, AMeshFileIsBroughtToTheAskedEdgeAndAPointCloudGetsOneReconst
   // the file's 48 triangles (edges of about 23 mm) split twice toward the 4 mm asked
   EXPECT_EQ(surface.mesh.F.size(), 48u * 16);
   EXPECT_NE(surface.source.find("split 2 times"), std::string::npos) << surface.source;
-  EXPECT_NEAR(enclosed_volume(surface.mesh), 0.04 * 0.04 * 0.04, 1e-6 * 0.04 * 0.04 * 0.04);  // the STL's single precision
+  EXPECT_NEAR(enclosed_volume(surface.mesh), 0.04 * 0.04 * 0.04,
+              1e-6 * 0.04 * 0.04 * 0.04);  // the STL's single precision
 
   const std::string cloud_path = temp("cloud.xyz");
   {
@@ -91,11 +94,13 @@ TEST(ReconstructSurface, ASampledSphereComesBackCloseToTheSphereAtTwoSpacings) {
     EXPECT_NO_THROW(check_closed_manifold(mesh, "reconstructed sphere"));
     EXPECT_GT(enclosed_volume(mesh), 0);
     const auto [rms, worst] = distances_to_sphere(mesh, c, R);
-    std::printf("reconstructed sphere, spacing %.3g m: RMS %.3f, max %.3f spacings from the sphere\n", spacing, rms / spacing, worst / spacing);
+    std::printf("reconstructed sphere, spacing %.3g m: RMS %.3f, max %.3f spacings from the sphere\n", spacing,
+                rms / spacing, worst / spacing);
     EXPECT_LT(rms, 0.25 * spacing) << spacing;
     EXPECT_LT(worst, 0.5 * spacing) << spacing;
   }
-  EXPECT_THROW(reconstruct_surface(build_model(sample_sphere(c, R, 0.008), MaterialParams{}, KernelParams{}), 1e-6), Error);
+  EXPECT_THROW(reconstruct_surface(build_model(sample_sphere(c, R, 0.008), MaterialParams{}, KernelParams{}), 1e-6),
+               Error);
 }
 
 TEST(WriteMesh, StlPlyAndObjReadBackClosedAndUnchanged) {

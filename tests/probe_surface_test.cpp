@@ -37,7 +37,9 @@ box = { min = [-1.0, -1.0, -1.0], max = [1.0, 0.0, 1.0] }
 kind = "explicit"
 dt = 1e-3
 )");
-  s.solver.kind = solver == "implicit" ? SolverKind::IMPLICIT : solver == "static" ? SolverKind::STATIC : SolverKind::EXPLICIT;
+  s.solver.kind = solver == "implicit" ? SolverKind::IMPLICIT
+                  : solver == "static" ? SolverKind::STATIC
+                                       : SolverKind::EXPLICIT;
   return s;
 }
 
@@ -47,7 +49,9 @@ struct Block {
   Simulation sim;
   ObjectSurface surface;
   explicit Block(const std::string& solver)
-      : scene(block_scene(solver)), sim(build_scene_model(scene), scene.solver, 1), surface(build_object_surface(scene, sim.model())) {}
+      : scene(block_scene(solver)),
+        sim(build_scene_model(scene), scene.solver, 1),
+        surface(build_object_surface(scene, sim.model())) {}
 };
 
 // a probe of radius R on the block's surface, the device's origin 2 R above its top face, in simulated time
@@ -63,10 +67,10 @@ InteractiveOptions probe_options(const ObjectSurface& surface, double duration) 
 }
 
 struct Press {
-  Vec3 probe;      // the probe's final position
-  Vec3 felt;       // the last force rendered to the device
+  Vec3 probe;  // the probe's final position
+  Vec3 felt;   // the last force rendered to the device
   int contacts = 0;
-  double penetration = 0;  // the deepest surface vertex inside the probe at the end, m
+  double penetration = 0;    // the deepest surface vertex inside the probe at the end, m
   long long selections = 0;  // of the active set, with levels of detail
 };
 
@@ -81,7 +85,9 @@ Press press(const std::string& solver, bool lod = false) {
     params.levels = {{3.0, 6}};
     sim.enable_lod(params, Vec3(0, 0.02, 0));
   }
-  VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), false}, {0.4, Vec3(0, -2 * R - 0.0015, 0), false}, {0.6, Vec3(0, -2 * R - 0.0015, 0), false}}),
+  VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), false},
+                                   {0.4, Vec3(0, -2 * R - 0.0015, 0), false},
+                                   {0.6, Vec3(0, -2 * R - 0.0015, 0), false}}),
                        known_device_specs("touch"));
   InteractiveOptions o = probe_options(surface, 0.6);
   Press p;
@@ -106,7 +112,8 @@ double static_force(const Vec3& probe) {
   Block block("static");
   Simulation& sim = block.sim;
   const ObjectSurface& surface = block.surface;
-  sim.hold_tool(ToolShape{ToolKind::SPHERE, R, 0}, ToolPose{probe, Eigen::Quaterniond::Identity()}, surface.mesh, surface.map);
+  sim.hold_tool(ToolShape{ToolKind::SPHERE, R, 0}, ToolPose{probe, Eigen::Quaterniond::Identity()}, surface.mesh,
+                surface.map);
   const StepReport& report = sim.step();
   EXPECT_NE(report.status, StepStatus::FAILED) << report.failure;
   return sim.summary().tool.force.y();
@@ -138,8 +145,8 @@ TEST(ProbeOnSurface, ASlowPressRendersTheMaterialsForceInBothSolversWithTheProbe
 TEST(ProbeOnSurface, WithLevelsOfDetailTheProbeTouchesTheActiveSetsSurface) {
   const Press full = press("explicit"), lod = press("explicit", true);
   const double depth = 0.02 + R - lod.probe.y();
-  std::printf("levels of detail: felt %.4f N (full model %.4f N), penetration %.3g m of %.3g m, %lld selections\n", lod.felt.y(),
-              full.felt.y(), lod.penetration, depth, lod.selections);
+  std::printf("levels of detail: felt %.4f N (full model %.4f N), penetration %.3g m of %.3g m, %lld selections\n",
+              lod.felt.y(), full.felt.y(), lod.penetration, depth, lod.selections);
   ASSERT_GT(lod.contacts, 0);
   EXPECT_GE(lod.selections, 1);
   EXPECT_LT(lod.penetration, 0.01 * depth);
@@ -180,9 +187,10 @@ ToolSummary press_capsule(double tilt, double max_torque = 0, Vec3* rendered = n
 TEST(ProbeOnSurface, ATiltedCapsulePressesWithItsLowerEndAndFeelsTheTorque) {
   const ToolSummary level = press_capsule(0.0), right = press_capsule(0.15), left = press_capsule(-0.15);
   for (const ToolSummary* t : {&level, &right, &left}) {
-    std::printf("%s at y = %.5f m: force (%.4f, %.4f, %.4f) N, torque (%.3g, %.3g, %.3g) N m, %d contacts, %.3g m inside\n",
-                t->kind.c_str(), t->position.y(), t->force.x(), t->force.y(), t->force.z(), t->torque.x(), t->torque.y(), t->torque.z(),
-                t->contacts, t->penetration);
+    std::printf(
+        "%s at y = %.5f m: force (%.4f, %.4f, %.4f) N, torque (%.3g, %.3g, %.3g) N m, %d contacts, %.3g m inside\n",
+        t->kind.c_str(), t->position.y(), t->force.x(), t->force.y(), t->force.z(), t->torque.x(), t->torque.y(),
+        t->torque.z(), t->contacts, t->penetration);
     EXPECT_EQ(t->kind, "capsule");
     EXPECT_GT(t->contacts, 0);
     EXPECT_GT(t->force.y(), 0.05);
@@ -198,8 +206,8 @@ TEST(ProbeOnSurface, ATiltedCapsulePressesWithItsLowerEndAndFeelsTheTorque) {
   Vec3 rendered = Vec3::Constant(NAN), on_touch = Vec3::Constant(NAN);
   const ToolSummary six_dof = press_capsule(0.15, 0.1, &rendered);
   press_capsule(0.15, 0.0, &on_touch);
-  std::printf("rendered torque (%.3g, %.3g, %.3g) N m, the tool's (%.3g, %.3g, %.3g) N m\n", rendered.x(), rendered.y(), rendered.z(),
-              six_dof.torque.x(), six_dof.torque.y(), six_dof.torque.z());
+  std::printf("rendered torque (%.3g, %.3g, %.3g) N m, the tool's (%.3g, %.3g, %.3g) N m\n", rendered.x(), rendered.y(),
+              rendered.z(), six_dof.torque.x(), six_dof.torque.y(), six_dof.torque.z());
   EXPECT_NEAR(rendered.z(), six_dof.torque.z(), 0.05 * six_dof.torque.z());
   EXPECT_GT(rendered.z(), 0.2 * lever);
   EXPECT_EQ(on_touch.norm(), 0.0);
@@ -230,10 +238,11 @@ TEST(ProbeOnSurface, TheLocalModelsStiffnessIsTheObjectsAndPredictsTheNextUpdate
     const InteractiveResult r = run_interactive(sim, device, o);
     ASSERT_FALSE(sim.diagnostics().failed) << sim.diagnostics().failure;
     const LocalModelSummary& m = r.local_model;
-    std::printf("%s: %lld updates, mean force %.4f N; stray mean / max: rendered %.3g / %.3g N, hold %.3g / %.3g N, held object "
-                "%.3g / %.3g N; K_yy %.4g N/m, held %.4g N/m\n",
-                solver.c_str(), m.updates, m.force_mean_n, m.rendered_mean_n, m.rendered_max_n, m.hold_mean_n, m.hold_max_n,
-                m.held_object_mean_n, m.held_object_max_n, K(1, 1), held(1, 1));
+    std::printf(
+        "%s: %lld updates, mean force %.4f N; stray mean / max: rendered %.3g / %.3g N, hold %.3g / %.3g N, held object "
+        "%.3g / %.3g N; K_yy %.4g N/m, held %.4g N/m\n",
+        solver.c_str(), m.updates, m.force_mean_n, m.rendered_mean_n, m.rendered_max_n, m.hold_mean_n, m.hold_max_n,
+        m.held_object_mean_n, m.held_object_max_n, K(1, 1), held(1, 1));
     EXPECT_GT(m.updates, 300);
     EXPECT_LT(m.rendered_mean_n, m.held_object_mean_n);
     EXPECT_LT(m.rendered_mean_n, m.hold_mean_n);
@@ -296,8 +305,8 @@ TEST(ProbeOnSurface, WithFrictionTheProbeRestsWhereTheHandPushesInsideTheConeAnd
   EXPECT_LT(std::abs(frictionless.felt.x()), 0.02 * frictionless.felt.y());
   for (const std::string solver : {"explicit", "implicit"}) {
     const Slide rests = slide(solver, mu, 0.001, 0.1, 0.7);
-    std::printf("%s, resting: probe at %.3f mm, device at %.3f mm, felt (%.4f, %.4f) N\n", solver.c_str(), 1e3 * rests.probe_x,
-                1e3 * rests.device_x, rests.felt.x(), rests.felt.y());
+    std::printf("%s, resting: probe at %.3f mm, device at %.3f mm, felt (%.4f, %.4f) N\n", solver.c_str(),
+                1e3 * rests.probe_x, 1e3 * rests.device_x, rests.felt.x(), rests.felt.y());
     // it stays (what moves is mostly the block's shear under it), and the hand feels what holds it
     EXPECT_LT(std::abs(rests.probe_x), 0.3 * rests.device_x);
     EXPECT_LT(rests.felt.x(), -0.05 * rests.felt.y());
@@ -305,8 +314,8 @@ TEST(ProbeOnSurface, WithFrictionTheProbeRestsWhereTheHandPushesInsideTheConeAnd
   }
   // dragged 6 mm over 0.4 s: it slides behind the hand with friction mu x pressure
   const Slide slides = slide("explicit", mu, 0.006, 0.4, 0.8);
-  std::printf("sliding: probe at %.3f mm, device at %.3f mm, felt (%.4f, %.4f) N, friction / pressure %.4f\n", 1e3 * slides.probe_x,
-              1e3 * slides.device_x, slides.felt.x(), slides.felt.y(), slides.sliding_ratio);
+  std::printf("sliding: probe at %.3f mm, device at %.3f mm, felt (%.4f, %.4f) N, friction / pressure %.4f\n",
+              1e3 * slides.probe_x, 1e3 * slides.device_x, slides.felt.x(), slides.felt.y(), slides.sliding_ratio);
   EXPECT_GT(slides.probe_x, 0.5 * slides.device_x);
   EXPECT_NEAR(slides.sliding_ratio, mu, 0.05 * mu);
 }
@@ -339,7 +348,8 @@ DomeRun press_and_slide_on_the_soft_dome(bool levels_of_detail) {
     ++run.steps;
     ASSERT_TRUE(sim.probe() && sim.probe()->surface_contact());
     run.probe = sim.probe()->probe();
-    if (sim.time() > 0.75 && sim.time() < 1.5) run.behind = std::max(run.behind, sim.probe()->device().x() - run.probe.x());
+    if (sim.time() > 0.75 && sim.time() < 1.5)
+      run.behind = std::max(run.behind, sim.probe()->device().x() - run.probe.x());
     const std::optional<SurfaceSide> side = sim.probe()->surface_contact()->side_of(run.probe, 2 * run.radius);
     if (!side || !side->sure || side->distance >= 0) return;
     ++run.inside;
@@ -347,10 +357,11 @@ DomeRun press_and_slide_on_the_soft_dome(bool levels_of_detail) {
   };
   run_interactive(sim, *session.device, o);
   EXPECT_FALSE(sim.diagnostics().failed) << sim.diagnostics().failure;
-  std::printf("soft dome%s: the probe's centre inside the surface at %lld of %lld steps' ends, at most %.2f mm; ends at (%.1f, %.1f, %.1f) mm; "
-              "at most %.1f mm behind the hand as it slides\n",
-              levels_of_detail ? " with levels of detail" : "", run.inside, run.steps, -1e3 * run.deepest, 1e3 * run.probe.x(),
-              1e3 * run.probe.y(), 1e3 * run.probe.z(), 1e3 * run.behind);
+  std::printf(
+      "soft dome%s: the probe's centre inside the surface at %lld of %lld steps' ends, at most %.2f mm; ends at (%.1f, %.1f, %.1f) mm; "
+      "at most %.1f mm behind the hand as it slides\n",
+      levels_of_detail ? " with levels of detail" : "", run.inside, run.steps, -1e3 * run.deepest, 1e3 * run.probe.x(),
+      1e3 * run.probe.y(), 1e3 * run.probe.z(), 1e3 * run.behind);
   return run;
 }
 
@@ -382,7 +393,7 @@ TEST(ProbeOnSurface, WithLevelsOfDetailTheProbeFollowsTheHandAsOnTheWholeDome) {
   const DomeRun run = press_and_slide_on_the_soft_dome(true);
   EXPECT_EQ(run.steps, 2000);
   EXPECT_LT(run.behind, 1.5 * run.radius);  // 7.8 mm (16.7 mm before)
-  EXPECT_GT(run.probe.x(), 0.015);           // 21.5 mm (6.5 mm before)
+  EXPECT_GT(run.probe.x(), 0.015);          // 21.5 mm (6.5 mm before)
   EXPECT_GT(run.probe.y(), 0.04);
   // its centre found inside at the end of a step as the surface flows over it (177 steps, at most 0.69 mm;
   // before, never: the surface sank into the probe instead)

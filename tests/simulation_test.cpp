@@ -54,8 +54,9 @@ TEST(SceneBuilder, FixedTablesSelectBySphereOrCylinder) {
   ASSERT_EQ(ball.fixed_groups.size(), 1u);
   EXPECT_EQ(ball.fixed_groups[0].points.size(), 6u);  // the centre and its 5 lattice neighbours (faces included)
   text = cantilever;
-  text.replace(text.find(box), box.size(),
-               "cylinder = { centre = [0.075, 0.015, 0.015], axis = [1, 0, 0], radius = 0.0075, half_length = 0.0375 }");
+  text.replace(
+      text.find(box), box.size(),
+      "cylinder = { centre = [0.075, 0.015, 0.015], axis = [1, 0, 0], radius = 0.0075, half_length = 0.0375 }");
   const Model rod = build_scene_model(parse_scene(text));
   EXPECT_EQ(rod.fixed_groups[0].points.size(), 11u * 5u);  // 11 cross-sections of the centre and its 4 neighbours
   for (const index_t i : rod.fixed_groups[0].points) {
@@ -93,7 +94,7 @@ TEST(SceneBuilder, ObjectsTooBigForTheMachineAreRefusedBeforeTheyAreBuilt) {
   EXPECT_EQ(estimated_points(scene), 21 * 5 * 5);
   const ModelEstimate e = estimate_model(estimated_points(scene), scene.kernel, scene.object.spacing);
   EXPECT_NEAR(e.neighbours_per_point, 32.5, 0.1);  // h = 2 spacings: 4/3 pi 2^3 - 1
-  scene.object.spacing = 1e-5;  // 1.5e4 x 3e3 x 3e3 points
+  scene.object.spacing = 1e-5;                     // 1.5e4 x 3e3 x 3e3 points
   const auto start = std::chrono::steady_clock::now();
   try {
     build_scene_model(scene);
@@ -237,10 +238,13 @@ TEST(Simulation, AtTenThousandPointsABladesStepsKeepAStableStepBelowTheCutModels
   };
   double y = 0.035;
   for (int strip = 1; strip <= 60; ++strip, y -= 0.0007) {
-    sim.cut(BladeSweep{Vec3(0.03625, y, -0.01), Vec3(0.03625, y, 0.04), Vec3(0.03625, y - 0.0007, -0.01), Vec3(0.03625, y - 0.0007, 0.04)});
+    sim.cut(BladeSweep{Vec3(0.03625, y, -0.01), Vec3(0.03625, y, 0.04), Vec3(0.03625, y - 0.0007, -0.01),
+                       Vec3(0.03625, y - 0.0007, 0.04)});
     if (strip % 20 == 0) check("strips");
   }
-  const index_t chipped = sim.cut(BladeSweep{Vec3(0.14, 0.0401, 0.015), Vec3(0.16, 0.0401, 0.015), Vec3(0.14, 0.0151, 0.04), Vec3(0.16, 0.0151, 0.04)}).severed_pairs;
+  const index_t chipped = sim.cut(BladeSweep{Vec3(0.14, 0.0401, 0.015), Vec3(0.16, 0.0401, 0.015),
+                                             Vec3(0.14, 0.0151, 0.04), Vec3(0.16, 0.0151, 0.04)})
+                              .severed_pairs;
   ASSERT_GT(chipped, 0);
   std::printf("the chip: %lld pairs\n", static_cast<long long>(chipped));
   check("a chip");

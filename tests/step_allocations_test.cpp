@@ -65,10 +65,13 @@ namespace {
 // "implicit_two_level" (the coarse level made in the first step is reused)
 Simulation beam(const std::string& kind) {
   const bool viscous = kind.ends_with("_viscoelastic");
-  const std::string preconditioner = kind.ends_with("_cholesky") ? "cholesky" : kind.ends_with("_two_level") ? "two_level" : "";
+  const std::string preconditioner = kind.ends_with("_cholesky")    ? "cholesky"
+                                     : kind.ends_with("_two_level") ? "two_level"
+                                                                    : "";
   std::string text = test::cantilever_scene(kind.substr(0, kind.find('_')), "2e-3");
   if (viscous) text.replace(text.find("damping"), 0, "prony = [[0.3, 0.05], [0.2, 1.0]]\n");
-  if (!preconditioner.empty()) text.replace(text.find("[solver]") + 9, 0, "preconditioner = \"" + preconditioner + "\"\n");
+  if (!preconditioner.empty())
+    text.replace(text.find("[solver]") + 9, 0, "preconditioner = \"" + preconditioner + "\"\n");
   const Scene scene = parse_scene(text);
   return Simulation(build_scene_model(scene), scene.solver, 1);
 }
@@ -103,9 +106,10 @@ TEST_P(StepTest, KeepsTheStateBuffersAndAllocatesNothing) {
   EXPECT_LT(sim.state().u.minCoeff(), -1e-6);  // the beam did move
 }
 
-INSTANTIATE_TEST_SUITE_P(Solvers, StepTest, ::testing::Values("explicit", "implicit", "static", "explicit_viscoelastic",
-                                                               "implicit_viscoelastic", "static_viscoelastic", "implicit_cholesky",
-                                                               "implicit_two_level"),
+INSTANTIATE_TEST_SUITE_P(Solvers, StepTest,
+                         ::testing::Values("explicit", "implicit", "static", "explicit_viscoelastic",
+                                           "implicit_viscoelastic", "static_viscoelastic", "implicit_cholesky",
+                                           "implicit_two_level"),
                          [](const auto& info) { return info.param; });
 
 }  // namespace

@@ -35,7 +35,8 @@ TEST(Prony, StepCoefficientsRelaxToTheSeriesShareAndJoinAtTheSeriesSwitch) {
     }
   }
   // the short-step series and the closed form meet where the code switches (x = 1e-3)
-  const PronyStep below = prony_step({{0.5, 1.0}}, 1e-3 * (1 - 1e-14)), above = prony_step({{0.5, 1.0}}, 1e-3 * (1 + 1e-14));
+  const PronyStep below = prony_step({{0.5, 1.0}}, 1e-3 * (1 - 1e-14)),
+                  above = prony_step({{0.5, 1.0}}, 1e-3 * (1 + 1e-14));
   EXPECT_NEAR(below.c[0] / above.c[0], 1.0, 1e-11);
   EXPECT_NEAR(below.b[0] / above.b[0], 1.0, 1e-11);
 }
@@ -102,7 +103,8 @@ INSTANTIATE_TEST_SUITE_P(Models, HeldStretch,
                          [](const auto& info) { return std::string(to_string(info.param)); });
 
 TEST(ShearStress, IsTheDeviatoricStressAtSmallStrainAndFrameInvariant) {
-  for (const MaterialModel kind : {MaterialModel::SVK, MaterialModel::NEO_HOOKEAN, MaterialModel::MOONEY_RIVLIN, MaterialModel::COROTATED}) {
+  for (const MaterialModel kind :
+       {MaterialModel::SVK, MaterialModel::NEO_HOOKEAN, MaterialModel::MOONEY_RIVLIN, MaterialModel::COROTATED}) {
     const Model model = cube(kind, {{0.5, 1.0}});
     const index_t centre = model.n_points / 2;
     // small strain: S_s = 2 mu dev(eps)
@@ -217,7 +219,8 @@ damping = 40
 [solver]
 kind = "{}"
 dt = {}
-)", young, poisson, viscous ? fmt::format("prony = [[{}, {}]]", g, tau) : "", ends, solver, dt);
+)",
+                     young, poisson, viscous ? fmt::format("prony = [[{}, {}]]", g, tau) : "", ends, solver, dt);
 }
 
 // the mean y-displacement of the points at y = y0
@@ -273,8 +276,8 @@ total = [0, -0.004, 0]
     sim.run(t - sim.time());
     const double expected = elastic_elongation * young * sls.creep_compliance(sim.time());
     EXPECT_NEAR(elongation(sim) / expected, 1.0, 0.01) << GetParam() << " t = " << sim.time();
-    fmt::print("creep {} t = {:.3f}: {:.6e} expected {:.6e} ({:+.3f}%)\n", GetParam(), sim.time(), elongation(sim), expected,
-               100 * (elongation(sim) / expected - 1));
+    fmt::print("creep {} t = {:.3f}: {:.6e} expected {:.6e} ({:+.3f}%)\n", GetParam(), sim.time(), elongation(sim),
+               expected, 100 * (elongation(sim) / expected - 1));
   }
   EXPECT_TRUE(sim.summary().converged);
 }

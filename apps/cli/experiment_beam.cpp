@@ -32,13 +32,15 @@ int run_beam_experiment(const BeamOptions& options) {
   fs::create_directories(options.out);
   const fs::path out = options.out;
   Scene scene = read_scene_file(options.scene);
-  if (scene.object.shape != ShapeKind::BOX) throw Error(fmt::format("{}: the beam experiment needs a box", options.scene));
+  if (scene.object.shape != ShapeKind::BOX)
+    throw Error(fmt::format("{}: the beam experiment needs a box", options.scene));
   const double x_max = scene.object.origin.x() + scene.object.size.x();
   fem::find_ccx();
   auto csv = fmt::output_file((out / "beam.csv").string());
   csv.print("method,threads,points_or_elements,tip_sag_m,error_pct,compute_s,simulated_s,compute_s_per_simulated_s\n");
-  std::string md = fmt::format("# {}: settled tip sag and cost\n\n| method | threads | tip sag (m) | vs CalculiX | compute s per simulated s |\n|---|---|---|---|---|\n",
-                               options.scene);
+  std::string md = fmt::format(
+      "# {}: settled tip sag and cost\n\n| method | threads | tip sag (m) | vs CalculiX | compute s per simulated s |\n|---|---|---|---|---|\n",
+      options.scene);
 
   // CalculiX NLGEOM on two meshes of 20-node hexahedra
   double reference = 0;
@@ -54,7 +56,8 @@ int run_beam_experiment(const BeamOptions& options) {
     p.density = scene.material.density;
     p.nlgeom = true;
     for (const FixedSpec& f : scene.fixed) {
-      if (f.sphere || f.cylinder) throw Error(fmt::format("beam-4x1x1: {}: the CalculiX model takes [[fixed]] boxes only", scene.path));
+      if (f.sphere || f.cylinder)
+        throw Error(fmt::format("beam-4x1x1: {}: the CalculiX model takes [[fixed]] boxes only", scene.path));
       p.clamps.push_back({f.box.min, f.box.max});
     }
     for (const LoadSpec& l : scene.loads) {
@@ -65,7 +68,8 @@ int run_beam_experiment(const BeamOptions& options) {
     reference = tip_sag(sol.nodes, sol.displacement, x_max);
     fmt::print("CalculiX NLGEOM {}x{}x{}: tip sag {:.5f} m ({:.1f} s)\n", p.nx, p.ny, p.nz, reference, sol.wall_s);
     csv.print("calculix_nlgeom,2,{},{:.6e},,{:.3f},,\n", p.nx * p.ny * p.nz, reference, sol.wall_s);
-    md += fmt::format("| CalculiX NLGEOM {}x{}x{} C3D20R | 2 | {:.5f} | | ({:.1f} s static) |\n", p.nx, p.ny, p.nz, reference, sol.wall_s);
+    md += fmt::format("| CalculiX NLGEOM {}x{}x{} C3D20R | 2 | {:.5f} | | ({:.1f} s static) |\n", p.nx, p.ny, p.nz,
+                      reference, sol.wall_s);
   }
   auto error = [&](double d) { return 100 * (d / reference - 1); };
 
@@ -93,12 +97,14 @@ int run_beam_experiment(const BeamOptions& options) {
       sim.run(options.duration);
       const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       const double sag = tip_sag(sim.model().X, sim.state().u, x_max);
-      fmt::print("point model {} ({} threads, dt = {} s): tip sag after {} s {:.5f} m ({:+.2f}%), {:.2f} s compute per simulated s\n",
-                 to_string(kind), threads, dyn.solver.dt, options.duration, sag, error(sag), s / options.duration);
+      fmt::print(
+          "point model {} ({} threads, dt = {} s): tip sag after {} s {:.5f} m ({:+.2f}%), {:.2f} s compute per simulated s\n",
+          to_string(kind), threads, dyn.solver.dt, options.duration, sag, error(sag), s / options.duration);
       csv.print("point_{},{},{},{:.6e},{:.3f},{:.3f},{},{:.4f}\n", to_string(kind), threads, sim.model().n_points, sag,
                 error(sag), s, options.duration, s / options.duration);
-      md += fmt::format("| point model, {} dt = {} s, after {} s | {} | {:.5f} | {:+.2f}% | {:.2f} |\n", to_string(kind),
-                        dyn.solver.dt, options.duration, threads, sag, error(sag), s / options.duration);
+      md +=
+          fmt::format("| point model, {} dt = {} s, after {} s | {} | {:.5f} | {:+.2f}% | {:.2f} |\n", to_string(kind),
+                      dyn.solver.dt, options.duration, threads, sag, error(sag), s / options.duration);
     }
   csv.close();
   auto summary = fmt::output_file((out / "summary.md").string());

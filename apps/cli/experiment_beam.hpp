@@ -7,9 +7,9 @@ namespace pointhaptics::experiments {
 
 struct BeamOptions {
   std::string out = "beam-out";
-  std::string scene;     ///< scenes/beam-4x1x1.toml
-  double duration = 2.0; ///< simulated seconds for the dynamic runs
-  bool implicit = true;  ///< also time the implicit solver (slow)
+  std::string scene;      ///< scenes/beam-4x1x1.toml
+  double duration = 2.0;  ///< simulated seconds for the dynamic runs
+  bool implicit = true;   ///< also time the implicit solver (slow)
 };
 
 /// Writes beam.csv and summary.md into options.out; returns the process exit code.

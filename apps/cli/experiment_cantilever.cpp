@@ -18,7 +18,6 @@
 #include <optional>
 #include <thread>
 
-
 namespace pointhaptics::experiments {
 namespace {
 
@@ -57,10 +56,14 @@ Deflection deflection_of(const Points& X, const Points& u) {
     // a mesh with an odd number of elements across (16x3x3) has no node at the face centre, the centre of
     // one element's face: the 20-node brick's face interpolates it there as -1/4 of each of the face's
     // corners and 1/2 of each of its mid-edge nodes
-    const std::array<std::pair<Vec3, double>, 8> face{{{{L, H / 2 - dy, W / 2 - dz}, -0.25}, {{L, H / 2 + dy, W / 2 - dz}, -0.25},
-                                                       {{L, H / 2 - dy, W / 2 + dz}, -0.25}, {{L, H / 2 + dy, W / 2 + dz}, -0.25},
-                                                       {{L, H / 2 - dy, W / 2}, 0.5},       {{L, H / 2 + dy, W / 2}, 0.5},
-                                                       {{L, H / 2, W / 2 - dz}, 0.5},       {{L, H / 2, W / 2 + dz}, 0.5}}};
+    const std::array<std::pair<Vec3, double>, 8> face{{{{L, H / 2 - dy, W / 2 - dz}, -0.25},
+                                                       {{L, H / 2 + dy, W / 2 - dz}, -0.25},
+                                                       {{L, H / 2 - dy, W / 2 + dz}, -0.25},
+                                                       {{L, H / 2 + dy, W / 2 + dz}, -0.25},
+                                                       {{L, H / 2 - dy, W / 2}, 0.5},
+                                                       {{L, H / 2 + dy, W / 2}, 0.5},
+                                                       {{L, H / 2, W / 2 - dz}, 0.5},
+                                                       {{L, H / 2, W / 2 + dz}, 0.5}}};
     int found = 0;
     double centre = 0;
     for (const auto& [q, weight] : face)
@@ -131,7 +134,8 @@ PointRun solve_point_model(const Scene& scene, int threads) {
   sim.run(0.0);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const RunSummary s = sim.summary();  // (a report: not timed)
-  if (!s.converged) throw Error(fmt::format("point model at spacing {} did not converge: {}", scene.object.spacing, s.failure));
+  if (!s.converged)
+    throw Error(fmt::format("point model at spacing {} did not converge: {}", scene.object.spacing, s.failure));
   PointRun r;
   r.seconds = seconds;
   r.points = sim.model().n_points;
@@ -172,21 +176,22 @@ double extrapolate(double d1, double d2, double d3) {
   return d3 + b * b / (a - b);
 }
 
-
 }  // namespace
 
 int run_cantilever_experiment(const CantileverOptions& options) {
   namespace fs = std::filesystem;
   fs::create_directories(options.out);
   const fs::path out = options.out;
-  const int threads = options.threads > 0 ? options.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const int threads =
+      options.threads > 0 ? options.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   fem::find_ccx();  // fail early, with the installation hint
 
   std::vector<LoadCase> cases;
   for (double f : options.quick ? std::vector<double>{0.01, 0.3} : std::vector<double>{0.003, 0.01, 0.03, 0.1, 0.3})
     cases.push_back({fmt::format("F = {} N", f), f, false});
   if (!options.quick) cases.push_back({"gravity", 0.0, true});
-  const std::vector<double> spacings = options.quick ? std::vector<double>{0.015, 0.0075} : std::vector<double>{0.015, 0.0075, 0.005, 0.00375};
+  const std::vector<double> spacings =
+      options.quick ? std::vector<double>{0.015, 0.0075} : std::vector<double>{0.015, 0.0075, 0.005, 0.00375};
   const std::vector<double> factors = options.quick ? std::vector<double>{2.0} : std::vector<double>{2.0, 2.5};
   // FEM meshes (x, y, z elements), each refined by 2; the finest two plus extrapolation give "converged"
   const std::vector<std::array<int, 3>> meshes =
@@ -194,8 +199,9 @@ int run_cantilever_experiment(const CantileverOptions& options) {
                     : std::vector<std::array<int, 3>>{{10, 2, 2}, {20, 4, 4}, {40, 8, 8}};
 
   auto csv = fmt::output_file((out / "cantilever.csv").string());
-  csv.print("case,force_n,method,spacing_m,support_factor,h_m,points_or_elements,d_centre_m,d_mean_m,d_corner_m,"
-            "error_centre_pct,seconds,iterations\n");
+  csv.print(
+      "case,force_n,method,spacing_m,support_factor,h_m,points_or_elements,d_centre_m,d_mean_m,d_corner_m,"
+      "error_centre_pct,seconds,iterations\n");
   struct Row {
     std::string method;
     double spacing, factor, h, d, error, seconds;
@@ -232,8 +238,8 @@ int run_cantilever_experiment(const CantileverOptions& options) {
     reference[ci] = nm >= 3 ? extrapolate(fem_d[nm - 3], fem_d[nm - 2], fem_d[nm - 1]) : fem_d.back();
     if (c.force == 0.01) {
       for (size_t k = 0; k < meshes.size(); ++k)
-        timed_fem.push_back({fmt::format("CalculiX NLGEOM {}x{}x{}", meshes[k][0], meshes[k][1], meshes[k][2]), fem_s[k],
-                             100 * (fem_d[k] / reference[ci] - 1)});
+        timed_fem.push_back({fmt::format("CalculiX NLGEOM {}x{}x{}", meshes[k][0], meshes[k][1], meshes[k][2]),
+                             fem_s[k], 100 * (fem_d[k] / reference[ci] - 1)});
       // a mesh between the refinement steps, for the cheapest one within 1% (not in the extrapolation)
       if (!options.quick) {
         const fem::Solution sol = fem::solve(fem_problem(c, 16, 3, 3, true), threads);
@@ -262,26 +268,29 @@ int run_cantilever_experiment(const CantileverOptions& options) {
       for (double s : spacings) settings.push_back({s, f, 0.0});
     settings.push_back({0.015, 0.0, 0.1});
     for (const Setting& st : settings) {
-      const PointRun r = solve_point_model(beam_scene(c, st.spacing, st.support > 0 ? 2.0 : st.factor, st.support), threads);
+      const PointRun r =
+          solve_point_model(beam_scene(c, st.spacing, st.support > 0 ? 2.0 : st.factor, st.support), threads);
       const std::string method = st.support > 0 ? "point_seed_h" : "point";
-      fmt::print("  point model s = {} m, h = {:.4g} m ({} points): d = {:.5e} m ({:+.2f}%), {:.3f} s\n", st.spacing, r.h,
-                 r.points, r.d.centre, error(r.d.centre), r.seconds);
+      fmt::print("  point model s = {} m, h = {:.4g} m ({} points): d = {:.5e} m ({:+.2f}%), {:.3f} s\n", st.spacing,
+                 r.h, r.points, r.d.centre, error(r.d.centre), r.seconds);
       csv.print("{},{},{},{},{},{},{},{:.6e},{:.6e},{:.6e},{:.4f},{:.4f},{}\n", c.name, c.force, method, st.spacing,
                 st.support > 0 ? r.h / st.spacing : st.factor, r.h, r.points, r.d.centre, r.d.mean, r.d.corner,
                 error(r.d.centre), r.seconds, r.iterations);
-      table[ci].push_back({st.support > 0 ? "point, seed's h = 0.1 m" : fmt::format("point, h = {}s", st.factor), st.spacing,
-                           st.factor, r.h, r.d.centre, error(r.d.centre), r.seconds});
+      table[ci].push_back({st.support > 0 ? "point, seed's h = 0.1 m" : fmt::format("point, h = {}s", st.factor),
+                           st.spacing, st.factor, r.h, r.d.centre, error(r.d.centre), r.seconds});
       if (!c.gravity && c.force == cases.back().force && st.spacing == 0.0075 && st.factor == 2.0 && st.support == 0)
         deformed_point = r;
       if (c.force == 0.01 && st.factor == 2.0 && st.support == 0)
-        timed_point.push_back({fmt::format("point model, s = {} m ({} points)", st.spacing, r.points), r.seconds, error(r.d.centre)});
+        timed_point.push_back(
+            {fmt::format("point model, s = {} m ({} points)", st.spacing, r.points), r.seconds, error(r.d.centre)});
       if (c.force == 0.01 && st.factor == 2.0 && st.support == 0) {
-        cost_lines += fmt::format("- F = 0.01 N, point model at s = {} m ({} points): {:.3f} s static solve, error {:+.2f}%\n",
-                                  st.spacing, r.points, r.seconds, error(r.d.centre));
+        cost_lines +=
+            fmt::format("- F = 0.01 N, point model at s = {} m ({} points): {:.3f} s static solve, error {:+.2f}%\n",
+                        st.spacing, r.points, r.seconds, error(r.d.centre));
         if (st.spacing == spacings.back())
           for (size_t k = 0; k < meshes.size(); ++k)
-            cost_lines += fmt::format("- F = 0.01 N, CalculiX NLGEOM {}x{}x{}: {:.2f} s, error {:+.2f}%\n", meshes[k][0],
-                                      meshes[k][1], meshes[k][2], fem_s[k], error(fem_d[k]));
+            cost_lines += fmt::format("- F = 0.01 N, CalculiX NLGEOM {}x{}x{}: {:.2f} s, error {:+.2f}%\n",
+                                      meshes[k][0], meshes[k][1], meshes[k][2], fem_s[k], error(fem_d[k]));
       }
     }
   }
@@ -294,7 +303,8 @@ int run_cantilever_experiment(const CantileverOptions& options) {
   const PointCloud cloud = sample_object(pl);
   index_t loaded = 0;
   for (index_t i = 0; i < cloud.size(); ++i)
-    if ((cloud.X.col(i) - Vec3(L / 2, H, W / 2)).norm() < (cloud.X.col(loaded) - Vec3(L / 2, H, W / 2)).norm()) loaded = i;
+    if ((cloud.X.col(i) - Vec3(L / 2, H, W / 2)).norm() < (cloud.X.col(loaded) - Vec3(L / 2, H, W / 2)).norm())
+      loaded = i;
   LoadSpec point_load;
   point_load.kind = LoadKind::POINT;
   point_load.point = loaded;
@@ -304,8 +314,8 @@ int run_cantilever_experiment(const CantileverOptions& options) {
   // linear FEM: the deflection (~0.2 mm) is far inside the small-strain range, and linear ccx takes seconds
   fem::BoxProblem pf = fem_problem({"point", 0, false}, 40, 8, 8, false);
   pf.tractions.clear();
-  pf.tractions.push_back({{Vec3(L / 2 - s_pl / 2, H, W / 2 - s_pl / 2), Vec3(L / 2 + s_pl / 2, H, W / 2 + s_pl / 2)},
-                          Vec3(0, -f_pl, 0)});
+  pf.tractions.push_back(
+      {{Vec3(L / 2 - s_pl / 2, H, W / 2 - s_pl / 2), Vec3(L / 2 + s_pl / 2, H, W / 2 + s_pl / 2)}, Vec3(0, -f_pl, 0)});
   const fem::Solution fs_pl = fem::solve(pf, threads);
   auto pl_csv = fmt::output_file((out / "point-load.csv").string());
   pl_csv.print("y_m,point_uy_m,calculix_uy_m\n");
@@ -326,8 +336,8 @@ int run_cantilever_experiment(const CantileverOptions& options) {
   }
   pl_csv.close();
   const double pl_error = 100 * (bottom_point / bottom_fem - 1);
-  fmt::print("point load: bottom deflection {:.5e} m vs CalculiX {:.5e} m ({:+.2f}%), profile {}\n", bottom_point, bottom_fem,
-             pl_error, monotone ? "monotone" : "NOT monotone");
+  fmt::print("point load: bottom deflection {:.5e} m vs CalculiX {:.5e} m ({:+.2f}%), profile {}\n", bottom_point,
+             bottom_fem, pl_error, monotone ? "monotone" : "NOT monotone");
 
   // deformed shapes of the largest tip load, for the side-by-side figure
   auto def_csv = fmt::output_file((out / "deformed.csv").string());
@@ -336,8 +346,9 @@ int run_cantilever_experiment(const CantileverOptions& options) {
     def_csv.print("point,{},{},{},{},{},{}\n", deformed_point.X(0, i), deformed_point.X(1, i), deformed_point.X(2, i),
                   deformed_point.u(0, i), deformed_point.u(1, i), deformed_point.u(2, i));
   for (Eigen::Index k = 0; k < deformed_fem.nodes.cols(); ++k)
-    def_csv.print("calculix,{},{},{},{},{},{}\n", deformed_fem.nodes(0, k), deformed_fem.nodes(1, k), deformed_fem.nodes(2, k),
-                  deformed_fem.displacement(0, k), deformed_fem.displacement(1, k), deformed_fem.displacement(2, k));
+    def_csv.print("calculix,{},{},{},{},{},{}\n", deformed_fem.nodes(0, k), deformed_fem.nodes(1, k),
+                  deformed_fem.nodes(2, k), deformed_fem.displacement(0, k), deformed_fem.displacement(1, k),
+                  deformed_fem.displacement(2, k));
   def_csv.close();
 
   // summary
@@ -345,26 +356,30 @@ int run_cantilever_experiment(const CantileverOptions& options) {
   md.print("# Cantilever: point model vs CalculiX (seed Fig. 3-4)\n\n");
   std::string mesh_list;
   for (const auto& m : meshes) mesh_list += fmt::format("{}{}x{}x{}", mesh_list.empty() ? "" : ", ", m[0], m[1], m[2]);
-  md.print("Beam [0, 0.15] x [0, 0.03] x [0, 0.03] m, E = 1e5 Pa, nu = 0.4, rho = 1000 kg/m^3, face x = 0 clamped, "
-           "uniform traction in -y on face x = 0.15 (or gravity). Deflection d = -u_y at the tip-face centre. Errors "
-           "are against CalculiX NLGEOM (St. Venant-Kirchhoff, C3D20R) on {} elements ({}). Point model: static "
-           "Newton solve, cell volumes, poly6 kernel, hourglass alpha = {} (the defaults).\n\n",
-           mesh_list, meshes.size() >= 3 ? "Richardson-extrapolated from the finest three" : "the finest",
-           MaterialParams{}.hourglass);
+  md.print(
+      "Beam [0, 0.15] x [0, 0.03] x [0, 0.03] m, E = 1e5 Pa, nu = 0.4, rho = 1000 kg/m^3, face x = 0 clamped, "
+      "uniform traction in -y on face x = 0.15 (or gravity). Deflection d = -u_y at the tip-face centre. Errors "
+      "are against CalculiX NLGEOM (St. Venant-Kirchhoff, C3D20R) on {} elements ({}). Point model: static "
+      "Newton solve, cell volumes, poly6 kernel, hourglass alpha = {} (the defaults).\n\n",
+      mesh_list, meshes.size() >= 3 ? "Richardson-extrapolated from the finest three" : "the finest",
+      MaterialParams{}.hourglass);
   for (size_t ci = 0; ci < cases.size(); ++ci) {
-    md.print("## {}\n\n| method | spacing (m) | h (m) | d (m) | error | time (s) |\n|---|---|---|---|---|---|\n", cases[ci].name);
+    md.print("## {}\n\n| method | spacing (m) | h (m) | d (m) | error | time (s) |\n|---|---|---|---|---|---|\n",
+             cases[ci].name);
     for (const Row& r : table[ci])
       md.print("| {} | {} | {} | {:.5e} | {} | {} |\n", r.method, r.spacing > 0 ? fmt::format("{}", r.spacing) : "",
-               r.h > 0 ? fmt::format("{:.4g}", r.h) : "", r.d, r.method.rfind("CalculiX NLGEOM", 0) == 0 ? "" : fmt::format("{:+.2f}%", r.error),
+               r.h > 0 ? fmt::format("{:.4g}", r.h) : "", r.d,
+               r.method.rfind("CalculiX NLGEOM", 0) == 0 ? "" : fmt::format("{:+.2f}%", r.error),
                r.seconds > 0 ? fmt::format("{:.3f}", r.seconds) : "");
     md.print("\n");
   }
-  md.print("## Point load (the haptic case)\n\n{} N on point {} at ({}, {}, {}) m, spacing {} m; CalculiX: the same force as a "
-           "uniform traction on one sampling cell around it (40x8x8 elements, linear).\n\n"
-           "- displacement down the depth below the load: {}\n- bottom-face deflection below the load: point model {:.5e} m, "
-           "CalculiX {:.5e} m ({:+.2f}%)\n\n",
-           f_pl, loaded, L / 2, H, W / 2, s_pl, monotone ? "monotone (no zig-zag)" : "NOT monotone", bottom_point, bottom_fem,
-           pl_error);
+  md.print(
+      "## Point load (the haptic case)\n\n{} N on point {} at ({}, {}, {}) m, spacing {} m; CalculiX: the same force as a "
+      "uniform traction on one sampling cell around it (40x8x8 elements, linear).\n\n"
+      "- displacement down the depth below the load: {}\n- bottom-face deflection below the load: point model {:.5e} m, "
+      "CalculiX {:.5e} m ({:+.2f}%)\n\n",
+      f_pl, loaded, L / 2, H, W / 2, s_pl, monotone ? "monotone (no zig-zag)" : "NOT monotone", bottom_point,
+      bottom_fem, pl_error);
   md.print("## Cost\n\n{}\n", cost_lines);
   // the cheapest run of each within 1% of the reference
   auto cheapest = [](const std::vector<Timed>& runs) -> const Timed* {
@@ -375,15 +390,19 @@ int run_cantilever_experiment(const CantileverOptions& options) {
   };
   const Timed *best_point = cheapest(timed_point), *best_fem = cheapest(timed_fem);
   md.print("## Speed at equal accuracy (F = 0.01 N, within 1% of the reference)\n\n{}",
-           options.quick ? "(--quick: the reference is the finest mesh run, not the extrapolated one; the full run decides)\n\n" : "");
+           options.quick
+               ? "(--quick: the reference is the finest mesh run, not the extrapolated one; the full run decides)\n\n"
+               : "");
   if (best_point && best_fem) {
-    const std::string line = fmt::format("the cheapest point model within 1%: {} ({:.3f} s, {:+.2f}%); the cheapest CalculiX: {} "
-                                         "({:.2f} s, {:+.2f}%); the point model is {:.0f}x faster",
-                                         best_point->label, best_point->seconds, best_point->error, best_fem->label,
-                                         best_fem->seconds, best_fem->error, best_fem->seconds / best_point->seconds);
-    md.print("{} (each timed from its input: the point model's sampling, neighbour search and static solve; ccx's run "
-             "with reading the deck and writing results).\n",
-             line);
+    const std::string line = fmt::format(
+        "the cheapest point model within 1%: {} ({:.3f} s, {:+.2f}%); the cheapest CalculiX: {} "
+        "({:.2f} s, {:+.2f}%); the point model is {:.0f}x faster",
+        best_point->label, best_point->seconds, best_point->error, best_fem->label, best_fem->seconds, best_fem->error,
+        best_fem->seconds / best_point->seconds);
+    md.print(
+        "{} (each timed from its input: the point model's sampling, neighbour search and static solve; ccx's run "
+        "with reading the deck and writing results).\n",
+        line);
     fmt::print("speed at equal accuracy: {}\n", line);
   } else {
     md.print("no run of {} reached 1% in this set\n", best_point ? "CalculiX" : "the point model");

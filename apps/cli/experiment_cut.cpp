@@ -56,7 +56,11 @@ nlohmann::json surface_frame(const std::string& title, CutSurface& surface, cons
   nlohmann::json vertices = nlohmann::json::array(), faces = nlohmann::json::array();
   for (Eigen::Index v = 0; v < y.cols(); ++v) vertices.push_back({y(0, v), y(1, v), y(2, v)});
   for (const auto& f : cut.mesh.F) faces.push_back({f[0], f[1], f[2]});
-  return {{"title", title}, {"time_s", sim.time()}, {"vertices", std::move(vertices)}, {"faces", std::move(faces)}, {"cut_faces", cut.cut_faces}};
+  return {{"title", title},
+          {"time_s", sim.time()},
+          {"vertices", std::move(vertices)},
+          {"faces", std::move(faces)},
+          {"cut_faces", cut.cut_faces}};
 }
 
 long long non_finite_entries(const Points& p) { return static_cast<long long>((!p.array().isFinite()).count()); }
@@ -67,7 +71,10 @@ CutRun blade_through_cantilever(const CutOptions& options, double resistance) {
   const Scene scene = cantilever();
   Simulation sim(build_scene_model(scene), scene.solver, options.threads);
   const Vec3 above(0.03375, 0.05, 0.015), below(0.03375, -0.02, 0.015);
-  VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), true}, {0.05, Vec3::Zero(), true}, {0.25, below - above, true}, {0.5, below - above, true}}),
+  VirtualDevice device(Trajectory({{0.0, Vec3::Zero(), true},
+                                   {0.05, Vec3::Zero(), true},
+                                   {0.25, below - above, true},
+                                   {0.5, below - above, true}}),
                        known_device_specs("touch"));
   InteractiveOptions o;
   o.probe.radius = 0.001;
@@ -86,7 +93,8 @@ CutRun blade_through_cantilever(const CutOptions& options, double resistance) {
   std::size_t next_frame = 0;
   o.after_step = [&](long long) {
     if (next_frame < frame_times.size() && sim.time() >= frame_times[next_frame] - 1e-9) {
-      run.frames.push_back(surface_frame(fmt::format("blade through the cantilever, t = {:.2f} s", sim.time()), surface, sim, 1.0));
+      run.frames.push_back(
+          surface_frame(fmt::format("blade through the cantilever, t = {:.2f} s", sim.time()), surface, sim, 1.0));
       ++next_frame;
     }
     const ProbeTool* tool = sim.probe();
@@ -171,7 +179,8 @@ CutRun slit_opens_under_load(const CutOptions& options) {
     for (index_t i = 0; i < m.n_points; ++i)
       if (std::abs(m.X(1, i) - top) < 1e-9 && std::abs(m.X(0, i) - (x_slit + 0.0015)) < 1e-6) {
         for (index_t j = 0; j < m.n_points; ++j)
-          if (std::abs(m.X(1, j) - top) < 1e-9 && std::abs(m.X(0, j) - (x_slit - 0.0015)) < 1e-6 && std::abs(m.X(2, j) - m.X(2, i)) < 1e-9) {
+          if (std::abs(m.X(1, j) - top) < 1e-9 && std::abs(m.X(0, j) - (x_slit - 0.0015)) < 1e-6 &&
+              std::abs(m.X(2, j) - m.X(2, i)) < 1e-9) {
             sum += sim.state().u(0, i) - sim.state().u(0, j);
             ++n;
           }
@@ -187,7 +196,8 @@ CutRun slit_opens_under_load(const CutOptions& options) {
   cut.add_scripted_cut(slit);
   cut.run(0);
   for (const Simulation* s : {&whole, &cut})
-    if (s->diagnostics().failed) throw Error(fmt::format("experiment cut: the slit's static solve failed: {}", s->diagnostics().failure));
+    if (s->diagnostics().failed)
+      throw Error(fmt::format("experiment cut: the slit's static solve failed: {}", s->diagnostics().failure));
   const RunSummary s = cut.summary();
   CutRun run;
   CutSurface surface(build_object_surface(scene, cut.model()));
@@ -237,45 +247,49 @@ int run_cut_experiment(const CutOptions& options) {
   const nlohmann::json& t = through.json;
   const nlohmann::json& s = slit.json;
   auto md = fmt::output_file((out / "summary.md").string());
-  md.print("# Cutting (issue 18)\n\n"
-           "## A device's blade through the seed's cantilever\n\n"
-           "The cantilever (0.15 x 0.03 x 0.03 m, {} points, E = 1e6 Pa, under its weight). A virtual hand draws a 5 cm blade "
-           "down through x = 3.375 cm at 0.35 m/s, button held, cut resistance {} J/m^2 (deterministic, simulated time).\n\n"
-           "| | |\n|---|---|\n"
-           "| pieces | {} ({} points) |\n| pairs cut | {} |\n| their area | {:.3g} m^2 (the section: 9e-4 m^2) |\n"
-           "| the hand's work against the resistance | {:.4g} J (resistance x area: {:.4g} J) |\n"
-           "| largest resistance | {:.3g} N |\n| largest change of the commanded force per tick | {:.3g} N (bound {:.3g} N) |\n"
-           "| steps that cut, update mean / max | {}, {:.2f} / {:.2f} ms |\n| the free piece's fall | {:.3f} m/s (terminal {:.3f} m/s) |\n"
-           "| non-finite values | {} |\n\n"
-           "## A slit that opens under load\n\n"
-           "A block 6 x 3 x 3 cm ({} points, neo-Hookean, E = 1e5 Pa), bottom held, its end faces pulled apart by 0.5 N each, "
-           "solved statically. A scripted blade cuts a slit {} cm deep from the top between two planes of points.\n\n"
-           "| | |\n|---|---|\n| pieces | {} |\n| pairs cut | {} |\n| the top's opening across the slit, whole | {:.4g} m |\n"
-           "| ... with the slit | {:.4g} m |\n| converged | {} |\n| non-finite values | {} |\n\n"
-           "## The surface\n\n"
-           "The object's surface split along the cuts' sheets (the faces of the cuts darker), as the blade goes through "
-           "and the free piece falls, then the slit pulled open (displacements x 10): `surface-1.png` ... `surface-{}.png`, "
-           "all in `surface-series.png`; the frames' vertices and triangles in `surface-frames.json`.\n",
-           t["points"].get<long long>(), resistance, t["pieces"].get<long long>(), t["piece_points"].dump(), t["cut_pairs"].get<long long>(),
-           t["cut_area_m2"].get<double>(), t["work_j"].get<double>(), t["resistance_times_area_j"].get<double>(),
-           t["largest_force_n"].get<double>(), t["max_force_step_n"].get<double>(), t["per_tick_bound_n"].get<double>(),
-           t["sweeps"].get<long long>(), t["mean_update_ms"].get<double>(), t["max_update_ms"].get<double>(),
-           t["free_piece_speed_m_per_s"].get<double>(), t["terminal_speed_m_per_s"].get<double>(), t["non_finite"].get<long long>(),
-           s["points"].get<long long>(), 100 * s["slit_depth_m"].get<double>(), s["pieces"].get<long long>(), s["cut_pairs"].get<long long>(),
-           s["opening_whole_m"].get<double>(), s["opening_slit_m"].get<double>(), s["converged"].get<bool>(), s["non_finite"].get<long long>(),
-           frames.size());
+  md.print(
+      "# Cutting (issue 18)\n\n"
+      "## A device's blade through the seed's cantilever\n\n"
+      "The cantilever (0.15 x 0.03 x 0.03 m, {} points, E = 1e6 Pa, under its weight). A virtual hand draws a 5 cm blade "
+      "down through x = 3.375 cm at 0.35 m/s, button held, cut resistance {} J/m^2 (deterministic, simulated time).\n\n"
+      "| | |\n|---|---|\n"
+      "| pieces | {} ({} points) |\n| pairs cut | {} |\n| their area | {:.3g} m^2 (the section: 9e-4 m^2) |\n"
+      "| the hand's work against the resistance | {:.4g} J (resistance x area: {:.4g} J) |\n"
+      "| largest resistance | {:.3g} N |\n| largest change of the commanded force per tick | {:.3g} N (bound {:.3g} N) |\n"
+      "| steps that cut, update mean / max | {}, {:.2f} / {:.2f} ms |\n| the free piece's fall | {:.3f} m/s (terminal {:.3f} m/s) |\n"
+      "| non-finite values | {} |\n\n"
+      "## A slit that opens under load\n\n"
+      "A block 6 x 3 x 3 cm ({} points, neo-Hookean, E = 1e5 Pa), bottom held, its end faces pulled apart by 0.5 N each, "
+      "solved statically. A scripted blade cuts a slit {} cm deep from the top between two planes of points.\n\n"
+      "| | |\n|---|---|\n| pieces | {} |\n| pairs cut | {} |\n| the top's opening across the slit, whole | {:.4g} m |\n"
+      "| ... with the slit | {:.4g} m |\n| converged | {} |\n| non-finite values | {} |\n\n"
+      "## The surface\n\n"
+      "The object's surface split along the cuts' sheets (the faces of the cuts darker), as the blade goes through "
+      "and the free piece falls, then the slit pulled open (displacements x 10): `surface-1.png` ... `surface-{}.png`, "
+      "all in `surface-series.png`; the frames' vertices and triangles in `surface-frames.json`.\n",
+      t["points"].get<long long>(), resistance, t["pieces"].get<long long>(), t["piece_points"].dump(),
+      t["cut_pairs"].get<long long>(), t["cut_area_m2"].get<double>(), t["work_j"].get<double>(),
+      t["resistance_times_area_j"].get<double>(), t["largest_force_n"].get<double>(),
+      t["max_force_step_n"].get<double>(), t["per_tick_bound_n"].get<double>(), t["sweeps"].get<long long>(),
+      t["mean_update_ms"].get<double>(), t["max_update_ms"].get<double>(), t["free_piece_speed_m_per_s"].get<double>(),
+      t["terminal_speed_m_per_s"].get<double>(), t["non_finite"].get<long long>(), s["points"].get<long long>(),
+      100 * s["slit_depth_m"].get<double>(), s["pieces"].get<long long>(), s["cut_pairs"].get<long long>(),
+      s["opening_whole_m"].get<double>(), s["opening_slit_m"].get<double>(), s["converged"].get<bool>(),
+      s["non_finite"].get<long long>(), frames.size());
   md.close();
-  fmt::print("cut: blade through the cantilever: {} pieces, {} pairs, work {:.4g} J against {:.4g} J, force step per tick {:.3g} N; "
-             "slit: opening {:.3g} m against {:.3g} m whole; non-finite {}\n",
-             t["pieces"].get<long long>(), t["cut_pairs"].get<long long>(), t["work_j"].get<double>(),
-             t["resistance_times_area_j"].get<double>(), t["max_force_step_n"].get<double>(), s["opening_slit_m"].get<double>(),
-             s["opening_whole_m"].get<double>(), doc["non_finite"].get<long long>());
+  fmt::print(
+      "cut: blade through the cantilever: {} pieces, {} pairs, work {:.4g} J against {:.4g} J, force step per tick {:.3g} N; "
+      "slit: opening {:.3g} m against {:.3g} m whole; non-finite {}\n",
+      t["pieces"].get<long long>(), t["cut_pairs"].get<long long>(), t["work_j"].get<double>(),
+      t["resistance_times_area_j"].get<double>(), t["max_force_step_n"].get<double>(),
+      s["opening_slit_m"].get<double>(), s["opening_whole_m"].get<double>(), doc["non_finite"].get<long long>());
   fmt::print("wrote {}\n", out.string());
   // what must hold: nothing non-finite, the cantilever in two, the slit open wider than the whole block's top,
   // both surfaces split (faces of cuts), the pictures drawn
   const bool held = doc["non_finite"].get<long long>() == 0 && through.pieces == 2 && slit.pieces == 1 &&
                     s["opening_slit_m"].get<double>() > 2 * s["opening_whole_m"].get<double>() && plots == 0 &&
-                    through.frames.back()["cut_faces"].get<long long>() > 0 && slit.frames.back()["cut_faces"].get<long long>() > 0;
+                    through.frames.back()["cut_faces"].get<long long>() > 0 &&
+                    slit.frames.back()["cut_faces"].get<long long>() > 0;
   if (!held) fmt::print(stderr, "experiment cut: a check failed (see {})\n", (out / "cut.json").string());
   return held ? 0 : 1;
 }

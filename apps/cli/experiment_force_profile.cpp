@@ -68,14 +68,15 @@ int run_force_profile_experiment(const ForceProfileOptions& options) {
   }
   csv.close();
   auto md = fmt::output_file((out / "summary.md").string());
-  md.print("# Force profile (seed Fig. 2c)\n\n"
-           "The seed's beam (90 points, 0.135 x 0.03 x 0.03 m, E = 1e5 Pa, nu = 0.4, both ends held). A virtual hand "
-           "(Touch specs, coupling at half its stable stiffness) grabs point {} at ({:.3f}, {:.3f}, {:.3f}) m at 0.2 s, "
-           "pulls it {} mm up by 1.2 s, holds, and lets go at 2 s. {} run: {} haptic ticks, {} simulation steps.\n\n"
-           "- peak force {:.3f} N at {:.3f} s\n- force while holding (1.95 s) {:.3f} N\n- largest force after 3.5 s "
-           "(released, ringing down) {:.4f} N\n- passivity observer minimum {:.2e} J\n",
-           dragged, at.x(), at.y(), at.z(), 1e3 * lift, options.real_time ? "Real-time" : "Deterministic (simulated time)",
-           r.haptic.ticks, r.simulation_steps, peak, peak_t, held, after, r.haptic.min_observed_energy);
+  md.print(
+      "# Force profile (seed Fig. 2c)\n\n"
+      "The seed's beam (90 points, 0.135 x 0.03 x 0.03 m, E = 1e5 Pa, nu = 0.4, both ends held). A virtual hand "
+      "(Touch specs, coupling at half its stable stiffness) grabs point {} at ({:.3f}, {:.3f}, {:.3f}) m at 0.2 s, "
+      "pulls it {} mm up by 1.2 s, holds, and lets go at 2 s. {} run: {} haptic ticks, {} simulation steps.\n\n"
+      "- peak force {:.3f} N at {:.3f} s\n- force while holding (1.95 s) {:.3f} N\n- largest force after 3.5 s "
+      "(released, ringing down) {:.4f} N\n- passivity observer minimum {:.2e} J\n",
+      dragged, at.x(), at.y(), at.z(), 1e3 * lift, options.real_time ? "Real-time" : "Deterministic (simulated time)",
+      r.haptic.ticks, r.simulation_steps, peak, peak_t, held, after, r.haptic.min_observed_energy);
   md.close();
   fmt::print("force profile: peak {:.3f} N at {:.3f} s, {:.3f} N while holding, {:.4f} N after release\n", peak, peak_t,
              held, after);

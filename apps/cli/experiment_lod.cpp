@@ -131,11 +131,13 @@ Errors errors(const Model& m, const Points& u, const Points& reference, const Ve
 int run_lod_table_experiment(const LodExperimentOptions& options) {
   fs::create_directories(options.out);
   const fs::path out = options.out;
-  const std::vector<int> targets = options.quick ? std::vector<int>{224, 500, 1200} : std::vector<int>{224, 500, 1200, 10000, 100000};
+  const std::vector<int> targets =
+      options.quick ? std::vector<int>{224, 500, 1200} : std::vector<int>{224, 500, 1200, 10000, 100000};
   const double tr[3][2] = {{1.0, 1.5}, {1.5, 2.0}, {2.0, 2.5}};
   const double seed_fps[3][3] = {{83, 56, 46}, {50, 39, 24}, {40, 33, 20}};  // seed Table 1, rows 224, 500, 1200
   auto csv = fmt::output_file((out / "lod-table.csv").string());
-  csv.print("points,tr1,tr2,mode,selected,steps_per_s,seed_fps,active,realtime_factor,stable_dt_s,selection_ms,build_ms,threads\n");
+  csv.print(
+      "points,tr1,tr2,mode,selected,steps_per_s,seed_fps,active,realtime_factor,stable_dt_s,selection_ms,build_ms,threads\n");
   std::string md =
       "# Seed Table 1: simulation steps per second with levels of detail\n\n"
       "The seed's half-sphere (radius 5 cm, flat face held), the contact at its pole, one explicit step = one force "
@@ -148,8 +150,8 @@ int run_lod_table_experiment(const LodExperimentOptions& options) {
   std::size_t done = 0;
   const auto progress = [&](index_t n, const std::string& config, double steps_per_s) {
     ++done;
-    fmt::print("lod-table: [{}/{}] {} points, {}: {:.0f} steps/s ({:.0f} s so far)\n", done, n_configs, n, config, steps_per_s,
-               std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+    fmt::print("lod-table: [{}/{}] {} points, {}: {:.0f} steps/s ({:.0f} s so far)\n", done, n_configs, n, config,
+               steps_per_s, std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
     std::fflush(stdout);
   };
   for (std::size_t o = 0; o < targets.size(); ++o) {
@@ -162,10 +164,10 @@ int run_lod_table_experiment(const LodExperimentOptions& options) {
     Simulation full(model, solver, options.threads);
     const Timing tf = time_steps(full, options.seconds);
     progress(model.n_points, "full model", tf.steps_per_s);
-    csv.print("{},,,full,{},{:.6g},,{},{:.6g},{:.6g},,,{}\n", model.n_points, model.n_points, tf.steps_per_s, model.n_points,
-              tf.realtime, tf.stable_dt, options.threads);
-    md += fmt::format("| {} | full model | {} | {} | {:.0f} | 1 | | {:.3f} |\n", model.n_points, model.n_points, model.n_points,
-                      tf.steps_per_s, tf.realtime);
+    csv.print("{},,,full,{},{:.6g},,{},{:.6g},{:.6g},,,{}\n", model.n_points, model.n_points, tf.steps_per_s,
+              model.n_points, tf.realtime, tf.stable_dt, options.threads);
+    md += fmt::format("| {} | full model | {} | {} | {:.0f} | 1 | | {:.3f} |\n", model.n_points, model.n_points,
+                      model.n_points, tf.steps_per_s, tf.realtime);
     for (int b = 0; b < 3; ++b) {
       Simulation sim(model, solver, options.threads);
       sim.enable_lod(bands(tr[b][0], tr[b][1]), model.X.col(pole));
@@ -173,12 +175,12 @@ int run_lod_table_experiment(const LodExperimentOptions& options) {
       progress(model.n_points, fmt::format("T_r1 = {}h, T_r2 = {}h", tr[b][0], tr[b][1]), t.steps_per_s);
       const RunSummary s = sim.summary();
       const std::optional<double> fps = o < 3 ? std::optional<double>(seed_fps[o][b]) : std::nullopt;
-      csv.print("{},{},{},lod,{},{:.6g},{},{},{:.6g},{:.6g},{:.4g},{:.4g},{}\n", model.n_points, tr[b][0], tr[b][1], s.lod.selected,
-                t.steps_per_s, csv_or_empty(fps), s.lod.selected + s.lod.frozen, t.realtime, t.stable_dt, s.lod.selection_ms,
-                s.lod.build_ms, options.threads);
-      md += fmt::format("| {} | {}h, {}h | {} | {} | {:.0f} | {:.1f} | {} | {:.3f} |\n", model.n_points, tr[b][0], tr[b][1],
-                        s.lod.selected, s.lod.selected + s.lod.frozen, t.steps_per_s, t.steps_per_s / tf.steps_per_s,
-                        fps ? fmt::format("{:.0f}", *fps) : "", t.realtime);
+      csv.print("{},{},{},lod,{},{:.6g},{},{},{:.6g},{:.6g},{:.4g},{:.4g},{}\n", model.n_points, tr[b][0], tr[b][1],
+                s.lod.selected, t.steps_per_s, csv_or_empty(fps), s.lod.selected + s.lod.frozen, t.realtime,
+                t.stable_dt, s.lod.selection_ms, s.lod.build_ms, options.threads);
+      md += fmt::format("| {} | {}h, {}h | {} | {} | {:.0f} | {:.1f} | {} | {:.3f} |\n", model.n_points, tr[b][0],
+                        tr[b][1], s.lod.selected, s.lod.selected + s.lod.frozen, t.steps_per_s,
+                        t.steps_per_s / tf.steps_per_s, fps ? fmt::format("{:.0f}", *fps) : "", t.realtime);
     }
   }
   csv.close();
@@ -215,7 +217,12 @@ int run_propagation_experiment(const LodExperimentOptions& options) {
   runs.push_back({"full", std::nullopt, {}, {}, {}, 0});
   for (LodScheme scheme : {LodScheme::RANDOM, LodScheme::DITHER})
     for (int K : {6, 8})
-      runs.push_back({fmt::format("{} {:.1f}", to_string(scheme), (10 - K) / 10.0), bands(1.0, 1.5, {{whole, K}}, scheme), {}, {}, {}, 0});
+      runs.push_back({fmt::format("{} {:.1f}", to_string(scheme), (10 - K) / 10.0),
+                      bands(1.0, 1.5, {{whole, K}}, scheme),
+                      {},
+                      {},
+                      {},
+                      0});
   for (Run& r : runs) {
     Simulation sim(model, half_sphere(spacing).solver, options.threads);
     if (r.lod) sim.enable_lod(*r.lod, at);
@@ -261,10 +268,11 @@ int run_propagation_experiment(const LodExperimentOptions& options) {
   const Points& reference = runs.front().u;
   for (const Run& r : runs) {
     const Errors e = errors(model, r.u, reference, at, model.h);
-    runs_csv.print("{},{},{:.6g},{:.6g},{:.6g},{:.4g},{:.4g}\n", r.name, r.n_selected, r.timing.steps_per_s, r.timing.realtime,
-                   r.u.colwise().norm().maxCoeff(), 100 * e.near, 100 * e.whole);
-    md += fmt::format("| {} | {} | {:.0f} | {:.2f} | {:.3f} | {:.1f}% | {:.1f}% |\n", r.name, r.n_selected, r.timing.steps_per_s,
-                      r.timing.realtime, 1e3 * r.u.colwise().norm().maxCoeff(), 100 * e.near, 100 * e.whole);
+    runs_csv.print("{},{},{:.6g},{:.6g},{:.6g},{:.4g},{:.4g}\n", r.name, r.n_selected, r.timing.steps_per_s,
+                   r.timing.realtime, r.u.colwise().norm().maxCoeff(), 100 * e.near, 100 * e.whole);
+    md += fmt::format("| {} | {} | {:.0f} | {:.2f} | {:.3f} | {:.1f}% | {:.1f}% |\n", r.name, r.n_selected,
+                      r.timing.steps_per_s, r.timing.realtime, 1e3 * r.u.colwise().norm().maxCoeff(), 100 * e.near,
+                      100 * e.whole);
   }
   runs_csv.close();
   auto summary = fmt::output_file((out / "summary.md").string());
@@ -301,7 +309,8 @@ std::string describe(const LodParams& p, double whole) {
   std::string s = fmt::format("T_r1 = {}h, T_r2 = {}h", p.k1, p.k2);
   if (p.min_neighbours != LodParams{}.min_neighbours) s += fmt::format(", {} neighbours", p.min_neighbours);
   for (const LodLevel& l : p.levels)
-    s += l.distance >= whole ? fmt::format("; whole object at K = {}", l.K) : fmt::format("; to {}h at K = {}", l.distance, l.K);
+    s += l.distance >= whole ? fmt::format("; whole object at K = {}", l.K)
+                             : fmt::format("; to {}h at K = {}", l.distance, l.K);
   return s;
 }
 
@@ -357,8 +366,9 @@ int run_lod_error_experiment(const LodExperimentOptions& options) {
   }
   const double whole = 2.0 * radius / model.h + 1.0;
   auto csv = fmt::output_file((out / "lod-error.csv").string());
-  csv.print("points,scheme,seed,level_distance_h,K,weight,selected,active,steps_per_s,speedup,realtime_speedup,error_near_pct,"
-            "error_whole_pct,error_near_rms_pct,force_error_pct,config\n");
+  csv.print(
+      "points,scheme,seed,level_distance_h,K,weight,selected,active,steps_per_s,speedup,realtime_speedup,error_near_pct,"
+      "error_whole_pct,error_near_rms_pct,force_error_pct,config\n");
   csv.print("{},full,,,,1,{},{},{:.6g},1,1,0,0,0,0,full\n", model.n_points, model.n_points, model.n_points, full_steps);
   struct Row {
     std::string scheme, config;
@@ -405,9 +415,10 @@ int run_lod_error_experiment(const LodExperimentOptions& options) {
       dyn.enable_lod(p, c);
       const Timing t = time_steps(dyn, options.seconds / 2);
       const double force = indent ? (s.reactions.back() - full_force).norm() / full_force.norm() : 0.0;
-      csv.print("{},{},{},{:.4g},{},{:.1f},{},{},{:.6g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},\"{}\"\n", model.n_points, row.scheme,
-                seed, P, K, (10 - K) / 10.0, s.lod.selected, s.lod.selected + s.lod.frozen, t.steps_per_s, t.steps_per_s / full_steps,
-                t.realtime / full_realtime, 100 * e.near, 100 * e.whole, 100 * e.near_rms, 100 * force, row.config);
+      csv.print("{},{},{},{:.4g},{},{:.1f},{},{},{:.6g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},\"{}\"\n",
+                model.n_points, row.scheme, seed, P, K, (10 - K) / 10.0, s.lod.selected, s.lod.selected + s.lod.frozen,
+                t.steps_per_s, t.steps_per_s / full_steps, t.realtime / full_realtime, 100 * e.near, 100 * e.whole,
+                100 * e.near_rms, 100 * force, row.config);
       row.near_rms += e.near_rms / seeds;
       row.force += force / seeds;
       row.steps += t.steps_per_s / seeds;
@@ -415,12 +426,16 @@ int run_lod_error_experiment(const LodExperimentOptions& options) {
       row.near += e.near / seeds;
       row.whole += e.whole / seeds;
       row.n += s.lod.selected;
-      if (!s.converged) fmt::print(stderr, "lod-error: a static solve did not converge ({}, {}, seed {})\n", row.config, row.scheme, seed);
+      if (!s.converged)
+        fmt::print(stderr, "lod-error: a static solve did not converge ({}, {}, seed {})\n", row.config, row.scheme,
+                   seed);
     }
     row.n /= seeds;
-    fmt::print("lod-error: {} {}: {} points, {:.0f} steps/s (x{:.1f}), error inside T_r1 max {:.2f}% rms {:.2f}%, whole {:.2f}%, "
-               "force {:.2f}%\n", row.config, row.scheme, row.n, row.steps, row.speedup, 100 * row.near, 100 * row.near_rms,
-               100 * row.whole, 100 * row.force);
+    fmt::print(
+        "lod-error: {} {}: {} points, {:.0f} steps/s (x{:.1f}), error inside T_r1 max {:.2f}% rms {:.2f}%, whole {:.2f}%, "
+        "force {:.2f}%\n",
+        row.config, row.scheme, row.n, row.steps, row.speedup, 100 * row.near, 100 * row.near_rms, 100 * row.whole,
+        100 * row.force);
     rows.push_back(row);
   }
   csv.close();
@@ -433,10 +448,12 @@ int run_lod_error_experiment(const LodExperimentOptions& options) {
       "whole object the RMS; with an imprint, the error of the force the probe feels.\n\n"
       "| configuration | scheme | points simulated | steps/s | speed-up | inside T_r1, max | inside T_r1, RMS | whole object | force |\n"
       "|---|---|---|---|---|---|---|---|---|\n",
-      model.n_points, load_text, options.threads == 0 ? std::string("all") : std::to_string(options.threads), full_steps);
+      model.n_points, load_text, options.threads == 0 ? std::string("all") : std::to_string(options.threads),
+      full_steps);
   for (const Row& r : rows)
-    md += fmt::format("| {} | {} | {} | {:.0f} | {:.1f} | {:.1f}% | {:.1f}% | {:.1f}% | {} |\n", r.config, r.scheme, r.n, r.steps,
-                      r.speedup, 100 * r.near, 100 * r.near_rms, 100 * r.whole, indent ? fmt::format("{:.1f}%", 100 * r.force) : "");
+    md += fmt::format("| {} | {} | {} | {:.0f} | {:.1f} | {:.1f}% | {:.1f}% | {:.1f}% | {} |\n", r.config, r.scheme,
+                      r.n, r.steps, r.speedup, 100 * r.near, 100 * r.near_rms, 100 * r.whole,
+                      indent ? fmt::format("{:.1f}%", 100 * r.force) : "");
   auto summary = fmt::output_file((out / "lod-error.md").string());
   summary.print("{}", md);
   summary.close();

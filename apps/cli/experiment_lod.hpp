@@ -7,13 +7,13 @@ namespace pointhaptics::experiments {
 
 struct LodExperimentOptions {
   std::string out;
-  bool quick = false;   ///< small objects only (CI)
-  int threads = 0;      ///< 0: all hardware threads
-  double seconds = 0.5; ///< wall time per timed configuration
+  bool quick = false;    ///< small objects only (CI)
+  int threads = 0;       ///< 0: all hardware threads
+  double seconds = 0.5;  ///< wall time per timed configuration
   // lod-error only
-  int points = 0;            ///< object size (0: 10000, --quick 1200)
-  std::string load = "pull"; ///< pull: 0.01 N at the pole | indent: the pole pushed 1 mm in (prescribed)
-  std::string levels;        ///< one configuration instead of the sweep: "k1,k2[;P:K]..." (units of h)
+  int points = 0;             ///< object size (0: 10000, --quick 1200)
+  std::string load = "pull";  ///< pull: 0.01 N at the pole | indent: the pole pushed 1 mm in (prescribed)
+  std::string levels;         ///< one configuration instead of the sweep: "k1,k2[;P:K]..." (units of h)
 };
 
 /// Writes lod-table.csv, lod-table.md and lod-table.png; returns the exit code.

@@ -92,8 +92,9 @@ Outcome solve_point_model(const Scene& scene, int threads, Value&& value) {
 }
 
 Outcome point_beam(const MaterialParams& m, const BeamCase& c, double spacing, int threads) {
-  return solve_point_model(beam_scene(m, c, spacing), threads,
-                           [](const Simulation& sim, const RunSummary&) { return tip_deflection(sim.model().X, sim.state().u); });
+  return solve_point_model(beam_scene(m, c, spacing), threads, [](const Simulation& sim, const RunSummary&) {
+    return tip_deflection(sim.model().X, sim.state().u);
+  });
 }
 
 Outcome fem_beam(const MaterialParams& m, const BeamCase& c, int nx, int threads) {
@@ -141,7 +142,8 @@ Scene punch_scene(const MaterialParams& m, double depth, double spacing) {
 
 Outcome point_punch(const MaterialParams& m, double depth, double spacing, int threads) {
   // the punch pushes down
-  return solve_point_model(punch_scene(m, depth, spacing), threads, [](const Simulation&, const RunSummary& s) { return -s.reactions[1].y(); });
+  return solve_point_model(punch_scene(m, depth, spacing), threads,
+                           [](const Simulation&, const RunSummary& s) { return -s.reactions[1].y(); });
 }
 
 // Richardson's extrapolation of three solutions on meshes refined by `ratio` each time (coarse to fine), with
@@ -199,7 +201,8 @@ int run_materials_experiment(const MaterialsOptions& options) {
   namespace fs = std::filesystem;
   fs::create_directories(options.out);
   const fs::path out = options.out;
-  const int threads = options.threads > 0 ? options.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const int threads =
+      options.threads > 0 ? options.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   fem::find_ccx();
   std::vector<MaterialModel> models = {MaterialModel::SVK, MaterialModel::NEO_HOOKEAN, MaterialModel::MOONEY_RIVLIN};
   if (!options.models.empty()) {
@@ -207,17 +210,21 @@ int run_materials_experiment(const MaterialsOptions& options) {
     for (const std::string& name : options.models) {
       const std::optional<MaterialModel> model = parse_enum<MaterialModel>(name);
       if (!model || *model == MaterialModel::COROTATED) {
-        fmt::print(stderr, "pointhaptics: experiment materials: --models: \"{}\" is not one CalculiX has (svk | neo_hookean | mooney_rivlin)\n", name);
+        fmt::print(
+            stderr,
+            "pointhaptics: experiment materials: --models: \"{}\" is not one CalculiX has (svk | neo_hookean | mooney_rivlin)\n",
+            name);
         return 1;
       }
       models.push_back(*model);
     }
   }
   auto md = fmt::output_file((out / "summary.md").string());
-  md.print("# Materials: the point model against CalculiX's own models\n\n"
-           "Each model with the same small-strain moduli: svk as CalculiX's *ELASTIC with NLGEOM, neo_hookean as "
-           "*HYPERELASTIC, NEO HOOKE (C10 = mu / 2, D1 = 2 / K), mooney_rivlin as MOONEY-RIVLIN (C10 : C01 = 70 : 30, "
-           "D1 = 2 / K). CalculiX: C3D20R, NLGEOM; the reference is its finest mesh.\n\n");
+  md.print(
+      "# Materials: the point model against CalculiX's own models\n\n"
+      "Each model with the same small-strain moduli: svk as CalculiX's *ELASTIC with NLGEOM, neo_hookean as "
+      "*HYPERELASTIC, NEO HOOKE (C10 = mu / 2, D1 = 2 / K), mooney_rivlin as MOONEY-RIVLIN (C10 : C01 = 70 : 30, "
+      "D1 = 2 / K). CalculiX: C3D20R, NLGEOM; the reference is its finest mesh.\n\n");
 
   // the cantilever
   const std::vector<BeamCase> beam_cases = {{"F = 0.3 N", 0.3}, {"gravity", 0.0}};
@@ -225,16 +232,17 @@ int run_materials_experiment(const MaterialsOptions& options) {
   const std::vector<double> spacings = {0.0075, 0.005};
   auto csv = fmt::output_file((out / "materials.csv").string());
   csv.print("model,case,method,spacing_or_elements,deflection_m,error_pct,seconds,converged\n");
-  md.print("## The seed's cantilever (E = 1e5 Pa, nu = 0.4): tip-face centre deflection\n\n"
-           "| model | case | CalculiX (m) | point 7.5 mm | point 5 mm |\n|---|---|---|---|---|\n");
+  md.print(
+      "## The seed's cantilever (E = 1e5 Pa, nu = 0.4): tip-face centre deflection\n\n"
+      "| model | case | CalculiX (m) | point 7.5 mm | point 5 mm |\n|---|---|---|---|---|\n");
   for (const MaterialModel model : models) {
     const MaterialParams m = material_of(model, 1e5, 0.4);
     for (const BeamCase& c : beam_cases) {
       Outcome reference;
       for (const int nx : beam_meshes) {
         reference = fem_beam(m, c, nx, threads);
-        csv.print("{},{},calculix,{}x{}x{},{:.6e},,{:.2f},{}\n", to_string(model), c.name, nx, nx / 5, nx / 5, reference.value,
-                  reference.seconds, reference.ok);
+        csv.print("{},{},calculix,{}x{}x{},{:.6e},,{:.2f},{}\n", to_string(model), c.name, nx, nx / 5, nx / 5,
+                  reference.value, reference.seconds, reference.ok);
         fmt::print("{} {}: CalculiX {}x{}x{}: {:.5e} m ({:.1f} s){}\n", to_string(model), c.name, nx, nx / 5, nx / 5,
                    reference.value, reference.seconds, reference.ok ? "" : " FAILED: " + first_line(reference.note));
       }
@@ -242,9 +250,10 @@ int run_materials_experiment(const MaterialsOptions& options) {
       for (const double s : spacings) {
         const Outcome o = point_beam(m, c, s, threads);
         const double error = 100 * (o.value / reference.value - 1);
-        csv.print("{},{},point,{},{:.6e},{:.3f},{:.3f},{}\n", to_string(model), c.name, s, o.value, error, o.seconds, o.ok);
-        fmt::print("{} {}: point model s = {} m: {:.5e} m ({:+.2f}%), {:.2f} s\n", to_string(model), c.name, s, o.value, error,
-                   o.seconds);
+        csv.print("{},{},point,{},{:.6e},{:.3f},{:.3f},{}\n", to_string(model), c.name, s, o.value, error, o.seconds,
+                  o.ok);
+        fmt::print("{} {}: point model s = {} m: {:.5e} m ({:+.2f}%), {:.2f} s\n", to_string(model), c.name, s, o.value,
+                   error, o.seconds);
         cells += o.ok ? fmt::format(" {:+.2f}% |", error) : fmt::format(" not converged ({}) |", first_line(o.note));
       }
       md.print("| {} | {} | {:.5e} |{}\n", to_string(model), c.name, reference.value, cells);
@@ -265,19 +274,22 @@ int run_materials_experiment(const MaterialsOptions& options) {
   const size_t n_meshes = punch_meshes.size();
   const bool extrapolate = n_meshes >= 3 && punch_meshes[n_meshes - 1] == 2 * punch_meshes[n_meshes - 2] &&
                            punch_meshes[n_meshes - 2] == 2 * punch_meshes[n_meshes - 3];
-  const std::vector<double> punch_spacings = options.quick ? std::vector<double>{0.005} : std::vector<double>{0.005, 0.0025};
+  const std::vector<double> punch_spacings =
+      options.quick ? std::vector<double>{0.005} : std::vector<double>{0.005, 0.0025};
   auto punch_csv = fmt::output_file((out / "punch.csv").string());
-  punch_csv.print("model,spacing_m,depth_m,calculix_n,point_n,error_pct,point_converged,point_inverted,calculix_extrapolated_n,"
-                  "error_extrapolated_pct,calculix_elements\n");
+  punch_csv.print(
+      "model,spacing_m,depth_m,calculix_n,point_n,error_pct,point_converged,point_inverted,calculix_extrapolated_n,"
+      "error_extrapolated_pct,calculix_elements\n");
   auto fem_csv = fmt::output_file((out / "punch-calculix.csv").string());
   fem_csv.print("model,elements,depth_m,force_n,seconds,converged\n");
   std::string fem_md;
-  md.print("\n## Flat punch (block 0.1 x 0.05 x 0.1 m, E = 1e4 Pa, nu = 0.45, 10 mm radius): force against depth\n\n"
-           "CalculiX {}x{}x{} elements (a quarter of them, with two mirror planes; its punch: the nodes within 10 mm of "
-           "the centre), the depth in 5 fixed increments; the point model's punch: its points within 10 mm.\n\n"
-           "| model | spacing (mm) | depth (mm) | CalculiX (N) | point (N) | error | against CalculiX extrapolated |\n"
-           "|---|---|---|---|---|---|---|\n",
-           punch_mesh, punch_mesh / 2, punch_mesh);
+  md.print(
+      "\n## Flat punch (block 0.1 x 0.05 x 0.1 m, E = 1e4 Pa, nu = 0.45, 10 mm radius): force against depth\n\n"
+      "CalculiX {}x{}x{} elements (a quarter of them, with two mirror planes; its punch: the nodes within 10 mm of "
+      "the centre), the depth in 5 fixed increments; the point model's punch: its points within 10 mm.\n\n"
+      "| model | spacing (mm) | depth (mm) | CalculiX (N) | point (N) | error | against CalculiX extrapolated |\n"
+      "|---|---|---|---|---|---|---|\n",
+      punch_mesh, punch_mesh / 2, punch_mesh);
   for (const MaterialModel model : models) {
     const MaterialParams m = material_of(model, 1e4, 0.45);
     std::vector<Outcome> fem;
@@ -287,11 +299,12 @@ int run_materials_experiment(const MaterialsOptions& options) {
       by_mesh.push_back(fem);
       std::string cells;
       for (size_t k = 0; k < depths.size(); ++k) {
-        fem_csv.print("{},{},{},{:.6e},{:.2f},{}\n", to_string(model), n, depths[k], fem[k].value, fem[k].seconds, fem[k].ok);
+        fem_csv.print("{},{},{},{:.6e},{:.2f},{}\n", to_string(model), n, depths[k], fem[k].value, fem[k].seconds,
+                      fem[k].ok);
         cells += fem[k].ok ? fmt::format(" {:.4f} |", fem[k].value) : " did not converge |";
       }
-      fmt::print("{} punch CalculiX {}x{}x{}: {:.4f} N at 5 mm ({:.0f} s)\n", to_string(model), n, n / 2, n, fem.back().value,
-                 fem.back().seconds);
+      fmt::print("{} punch CalculiX {}x{}x{}: {:.4f} N at 5 mm ({:.0f} s)\n", to_string(model), n, n / 2, n,
+                 fem.back().value, fem.back().seconds);
       fem_md += fmt::format("| {} | {}x{}x{} |{} {:.0f} |\n", to_string(model), n, n / 2, n, cells, fem.back().seconds);
     }
     // at each depth the finest mesh that reached it (ccx may stop part way on the finest)
@@ -314,14 +327,15 @@ int run_materials_experiment(const MaterialsOptions& options) {
         const Outcome o = point_punch(m, depths[k], spacing, threads);
         const double error = fem[k].ok ? 100 * (o.value / fem[k].value - 1) : NAN;
         const double error_extrapolated = 100 * (o.value / extrapolated[k] - 1);
-        punch_csv.print("{},{},{},{:.6e},{:.6e},{:.3f},{},{},{:.6e},{:.3f},{}\n", to_string(model), spacing, depths[k], fem[k].value,
-                        o.value, error, o.ok, o.note.find("inverted") != std::string::npos, extrapolated[k], error_extrapolated,
-                        fem_mesh[k]);
-        fmt::print("{} punch s = {} m, {} mm: CalculiX {} N, point {:.4f} N{} ({:+.2f}%, {:.1f} s)\n", to_string(model), spacing,
-                   1e3 * depths[k], fem[k].ok ? fmt::format("{:.4f}", fem[k].value) : "no result", o.value,
+        punch_csv.print("{},{},{},{:.6e},{:.6e},{:.3f},{},{},{:.6e},{:.3f},{}\n", to_string(model), spacing, depths[k],
+                        fem[k].value, o.value, error, o.ok, o.note.find("inverted") != std::string::npos,
+                        extrapolated[k], error_extrapolated, fem_mesh[k]);
+        fmt::print("{} punch s = {} m, {} mm: CalculiX {} N, point {:.4f} N{} ({:+.2f}%, {:.1f} s)\n", to_string(model),
+                   spacing, 1e3 * depths[k], fem[k].ok ? fmt::format("{:.4f}", fem[k].value) : "no result", o.value,
                    o.ok ? "" : " NOT converged", error, o.seconds);
         md.print("| {} | {} | {} | {} | {} | {} | {} |\n", to_string(model), 1e3 * spacing, 1e3 * depths[k],
-                 fem[k].ok ? fmt::format("{:.4f}{}", fem[k].value, fem_mesh[k] == punch_mesh ? "" : fmt::format(" ({} across)", fem_mesh[k]))
+                 fem[k].ok ? fmt::format("{:.4f}{}", fem[k].value,
+                                         fem_mesh[k] == punch_mesh ? "" : fmt::format(" ({} across)", fem_mesh[k]))
                            : "did not converge",
                  o.ok ? fmt::format("{:.4f}", o.value) : fmt::format("{:.4f} ({})", o.value, first_line(o.note)),
                  fem[k].ok && o.ok ? fmt::format("{:+.2f}%", error) : "",
@@ -330,8 +344,10 @@ int run_materials_experiment(const MaterialsOptions& options) {
   }
   punch_csv.close();
   fem_csv.close();
-  md.print("\nCalculiX's punch force against its mesh (N; `punch-calculix.csv`; extrapolated: Richardson's extrapolation of the last three meshes with the order they show, the converged force's estimate):\n\n| model | elements | 1 mm | 2 mm | 3 mm | "
-           "4 mm | 5 mm | ccx (s) |\n|---|---|---|---|---|---|---|---|\n{}", fem_md);
+  md.print(
+      "\nCalculiX's punch force against its mesh (N; `punch-calculix.csv`; extrapolated: Richardson's extrapolation of the last three meshes with the order they show, the converged force's estimate):\n\n| model | elements | 1 mm | 2 mm | 3 mm | "
+      "4 mm | 5 mm | ccx (s) |\n|---|---|---|---|---|---|---|---|\n{}",
+      fem_md);
   md.close();
   if (run_plot_script("plot_materials.py", out.string(), options.plot_script) != 0) return 1;
   fmt::print("wrote {}\n", out.string());

@@ -44,7 +44,7 @@ struct RunOptions {
   bool deterministic = false;
   bool quiet = false;
   int threads = 0;
-  std::uint64_t max_memory = 0;  ///< bytes; 0: the memory available
+  std::uint64_t max_memory = 0;       ///< bytes; 0: the memory available
   std::vector<std::string> settings;  ///< --set key=value
 };
 
@@ -53,11 +53,12 @@ void print_summary(ph::Simulation& sim, const ph::RunSummary& s, double setup_s)
   const ph::State& st = sim.state();
   Eigen::Index worst = 0;
   const double max_u = m.n_points ? st.u.colwise().norm().maxCoeff(&worst) : 0.0;
-  fmt::print("points          {} ({} held), h = {:.4g} m, {:.1f} neighbours per point (min {}), kernel {}\n", m.n_points,
-             std::count(m.fixed.begin(), m.fixed.end(), 1), m.h, m.diagnostics.mean_neighbours,
+  fmt::print("points          {} ({} held), h = {:.4g} m, {:.1f} neighbours per point (min {}), kernel {}\n",
+             m.n_points, std::count(m.fixed.begin(), m.fixed.end(), 1), m.h, m.diagnostics.mean_neighbours,
              m.diagnostics.min_neighbours, ph::to_string(m.kernel.type));
   if (m.diagnostics.regularised_neighbourhoods)
-    fmt::print("warning         {} neighbourhoods were ill-conditioned and regularised\n", m.diagnostics.regularised_neighbourhoods);
+    fmt::print("warning         {} neighbourhoods were ill-conditioned and regularised\n",
+               m.diagnostics.regularised_neighbourhoods);
   fmt::print("material        {}: E = {:.4g} Pa, nu = {:.3g}, rho = {:.4g} kg/m^3, total mass {:.4g} kg{}\n",
              ph::to_string(m.material.model), m.material.young, m.material.poisson, m.material.density, m.mass.sum(),
              m.point_materials.size() > 1 ? fmt::format("; {} region materials", m.point_materials.size() - 1) : "");
@@ -68,8 +69,8 @@ void print_summary(ph::Simulation& sim, const ph::RunSummary& s, double setup_s)
     fmt::print("solver          static: {} in {} load increments, {} Newton and {} CG iterations, residual {:.3g}\n",
                s.converged ? "converged" : "NOT converged", s.substeps, s.iterations, s.cg_iterations, s.residual);
   else if (s.solver_kind == "implicit")
-    fmt::print("solver          implicit: {} steps of {:.3g} s, {} Newton and {} CG iterations, t = {:.4g} s{}\n", s.steps,
-               sim.solver().dt, s.iterations, s.cg_iterations, st.time,
+    fmt::print("solver          implicit: {} steps of {:.3g} s, {} Newton and {} CG iterations, t = {:.4g} s{}\n",
+               s.steps, sim.solver().dt, s.iterations, s.cg_iterations, st.time,
                s.budget_steps > 0 ? fmt::format("; {} steps ended at the iteration budget, last residual {:.3g}",
                                                 s.budget_steps, s.residual)
                                   : std::string());
@@ -77,15 +78,17 @@ void print_summary(ph::Simulation& sim, const ph::RunSummary& s, double setup_s)
     fmt::print("solver          {}: {} steps of {:.3g} s, {} sub-steps (stable sub-step {:.3g} s), t = {:.4g} s\n",
                s.solver_kind, s.steps, sim.solver().dt, s.substeps, s.stable_dt, st.time);
   if (s.preconditioner == "cholesky")
-    fmt::print("preconditioner  cholesky: {} factorisation{} of the tangent{}, factor {:.1f} MB\n", s.factorisations,
-               s.factorisations == 1 ? "" : "s",
-               s.background_factorisations > 0 ? fmt::format(" ({} in the background)", s.background_factorisations) : "",
-               s.factor_bytes / 1e6);
+    fmt::print(
+        "preconditioner  cholesky: {} factorisation{} of the tangent{}, factor {:.1f} MB\n", s.factorisations,
+        s.factorisations == 1 ? "" : "s",
+        s.background_factorisations > 0 ? fmt::format(" ({} in the background)", s.background_factorisations) : "",
+        s.factor_bytes / 1e6);
   if (s.preconditioner == "two_level")
     fmt::print("preconditioner  two_level: a coarse level of {} points, its factor {:.2f} MB{}\n", s.coarse_points,
-               s.factor_bytes / 1e6, s.coarse_points == 0 ? " (none: the object is too small; block-Jacobi alone)" : "");
-  fmt::print("displacement    max {:.4g} m at point {} ({:.4g}, {:.4g}, {:.4g})\n", max_u, worst, m.X(0, worst), m.X(1, worst),
-             m.X(2, worst));
+               s.factor_bytes / 1e6,
+               s.coarse_points == 0 ? " (none: the object is too small; block-Jacobi alone)" : "");
+  fmt::print("displacement    max {:.4g} m at point {} ({:.4g}, {:.4g}, {:.4g})\n", max_u, worst, m.X(0, worst),
+             m.X(1, worst), m.X(2, worst));
   // the out-of-balance force: |f_int + f_ext| over the free points relative to the load; in dynamics it is
   // the inertia (and a probe's push), not an error
   fmt::print("energy          strain {:.4g} J, kinetic {:.4g} J\n", s.strain_energy, s.kinetic_energy);
@@ -93,36 +96,42 @@ void print_summary(ph::Simulation& sim, const ph::RunSummary& s, double setup_s)
              s.solver_kind == "static" ? std::string(" (the equilibrium's residual)")
                                        : std::string(" (in dynamics the inertia and any probe force, not an error)"));
   for (size_t g = 0; g < s.reactions.size(); ++g)
-    fmt::print("reaction        {}: ({:.4g}, {:.4g}, {:.4g}) N on {} points\n", m.fixed_groups[g].name, s.reactions[g][0],
-               s.reactions[g][1], s.reactions[g][2], m.fixed_groups[g].points.size());
+    fmt::print("reaction        {}: ({:.4g}, {:.4g}, {:.4g}) N on {} points\n", m.fixed_groups[g].name,
+               s.reactions[g][0], s.reactions[g][1], s.reactions[g][2], m.fixed_groups[g].points.size());
   if (s.tool.present)
-    fmt::print("tool            {} at ({:.4g}, {:.4g}, {:.4g}) m: the object pushes it with ({:.4g}, {:.4g}, {:.4g}) N, torque "
-               "({:.3g}, {:.3g}, {:.3g}) N m; {} contacts, deepest {:.3g} m inside\n",
-               s.tool.kind, s.tool.position.x(), s.tool.position.y(), s.tool.position.z(), s.tool.force.x(), s.tool.force.y(),
-               s.tool.force.z(), s.tool.torque.x(), s.tool.torque.y(), s.tool.torque.z(), s.tool.contacts, s.tool.penetration);
+    fmt::print(
+        "tool            {} at ({:.4g}, {:.4g}, {:.4g}) m: the object pushes it with ({:.4g}, {:.4g}, {:.4g}) N, torque "
+        "({:.3g}, {:.3g}, {:.3g}) N m; {} contacts, deepest {:.3g} m inside\n",
+        s.tool.kind, s.tool.position.x(), s.tool.position.y(), s.tool.position.z(), s.tool.force.x(), s.tool.force.y(),
+        s.tool.force.z(), s.tool.torque.x(), s.tool.torque.y(), s.tool.torque.z(), s.tool.contacts, s.tool.penetration);
   if (s.cut.present) {
     std::string sizes;
-    for (size_t p = 0; p < s.cut.piece_points.size(); ++p) sizes += fmt::format("{}{}", p ? ", " : "", s.cut.piece_points[p]);
-    fmt::print("cut             {} steps cut, severing {} neighbour pairs; {} piece(s) of {} points; an update took {:.2f} ms "
-               "on average, {:.2f} ms at most; {} sheet triangles{}\n",
-               s.cut.sweeps, s.cut.cut_pairs, s.cut.piece_points.size(), sizes, s.cut.mean_update_ms, s.cut.max_update_ms,
-               s.cut.sheet_triangles,
-               s.cut.surface_splits ? fmt::format(", the probe's surface split {} times (at most {:.1f} ms)", s.cut.surface_splits, s.cut.max_split_ms) : "");
+    for (size_t p = 0; p < s.cut.piece_points.size(); ++p)
+      sizes += fmt::format("{}{}", p ? ", " : "", s.cut.piece_points[p]);
+    fmt::print(
+        "cut             {} steps cut, severing {} neighbour pairs; {} piece(s) of {} points; an update took {:.2f} ms "
+        "on average, {:.2f} ms at most; {} sheet triangles{}\n",
+        s.cut.sweeps, s.cut.cut_pairs, s.cut.piece_points.size(), sizes, s.cut.mean_update_ms, s.cut.max_update_ms,
+        s.cut.sheet_triangles,
+        s.cut.surface_splits ? fmt::format(", the probe's surface split {} times (at most {:.1f} ms)",
+                                           s.cut.surface_splits, s.cut.max_split_ms)
+                             : "");
   }
   if (s.lod.enabled) {
     std::string bands;
     for (size_t b = 0; b < s.lod.band_count.size(); ++b)
       bands += fmt::format("{}{}/{}", b ? ", " : "", s.lod.band_selected[b], s.lod.band_count[b]);
-    fmt::print("levels of detail {} of {} points simulated ({} held around them, {} with wider supports); selected per "
-               "band {}; {} selections, the last {:.2f} ms + {:.2f} ms to build; a re-selection held the simulation for {:.2f} ms at most\n",
-               s.lod.selected, m.n_points, s.lod.frozen, s.lod.widened, bands, s.lod.selections, s.lod.selection_ms,
-               s.lod.build_ms, s.lod.max_reselect_ms);
+    fmt::print(
+        "levels of detail {} of {} points simulated ({} held around them, {} with wider supports); selected per "
+        "band {}; {} selections, the last {:.2f} ms + {:.2f} ms to build; a re-selection held the simulation for {:.2f} ms at most\n",
+        s.lod.selected, m.n_points, s.lod.frozen, s.lod.widened, bands, s.lod.selections, s.lod.selection_ms,
+        s.lod.build_ms, s.lod.max_reselect_ms);
   }
-  if (s.solver_kind == "static")
-    fmt::print("timing          set-up {:.3f} s, solve {:.3f} s\n", setup_s, s.wall_s);
+  if (s.solver_kind == "static") fmt::print("timing          set-up {:.3f} s, solve {:.3f} s\n", setup_s, s.wall_s);
   else
-    fmt::print("timing          set-up {:.3f} s, stepping {:.3f} s, {:.3f} ms per step (longest {:.3f} ms), {:.0f} steps/s\n",
-               setup_s, s.wall_s, s.step_ms_mean, s.step_ms_max, s.steps_per_s);
+    fmt::print(
+        "timing          set-up {:.3f} s, stepping {:.3f} s, {:.3f} ms per step (longest {:.3f} ms), {:.0f} steps/s\n",
+        setup_s, s.wall_s, s.step_ms_mean, s.step_ms_max, s.steps_per_s);
 }
 
 // SIGINT or SIGTERM during a run: stop at the next step and write what was reached (issue 21)
@@ -164,7 +173,9 @@ int run_command(const RunOptions& opt) {
   // (after cuts, split along them: cut_surface.hpp)
   std::optional<ph::CutSurface> surface;
   if (!opt.surface.empty() || vtk) surface.emplace(ph::build_object_surface(scene, sim.model()));
-  auto vtk_surface = [&]() -> const ph::ObjectSurface* { return surface ? &surface->at(sim.model(), sim.cut_sheets()) : nullptr; };
+  auto vtk_surface = [&]() -> const ph::ObjectSurface* {
+    return surface ? &surface->at(sim.model(), sim.cut_sheets()) : nullptr;
+  };
   if (vtk) ph::add_vtk_frame(*vtk, sim, vtk_surface());  // the initial state
   const double start_time = sim.time();
   const bool options_real_time = !opt.deterministic;
@@ -197,8 +208,9 @@ int run_command(const RunOptions& opt) {
     interactive = ph::run_interactive(sim, *session.device, options);
     if (force_log) errors.attempt([&] { force_log->commit(); });
     if (interactive.log_dropped > 0)
-      errors.messages.push_back(fmt::format("--force-log {}: {} haptic ticks were not logged (the simulation thread fell behind)",
-                                            opt.force_log, interactive.log_dropped));
+      errors.messages.push_back(
+          fmt::format("--force-log {}: {} haptic ticks were not logged (the simulation thread fell behind)",
+                      opt.force_log, interactive.log_dropped));
   } else {
     ph::cli::ProgressBar bar(!opt.quiet);
     const auto stepping = std::chrono::steady_clock::now();
@@ -213,21 +225,24 @@ int run_command(const RunOptions& opt) {
         if (total > 60) {
           const ph::RunSummary so_far = sim.summary();
           const bool stiff = scene.solver.kind == ph::SolverKind::EXPLICIT && so_far.substeps > 4 * so_far.steps;
-          fmt::print(stderr,
-                     "pointhaptics: {}: this run will take about {} ({} steps of {:.3g} s at {:.3g} ms each{}){}; Ctrl-C "
-                     "stops it and writes the state reached\n",
-                     opt.scene, total < 7200 ? fmt::format("{:.0f} min", total / 60) : fmt::format("{:.1f} h", total / 3600),
-                     n_steps, scene.solver.dt, 1e3 * elapsed / static_cast<double>(step),
-                     scene.solver.kind == ph::SolverKind::EXPLICIT
-                         ? fmt::format(", {:.0f} sub-steps each below the stable step {:.3g} s",
-                                       static_cast<double>(so_far.substeps) / static_cast<double>(so_far.steps), so_far.stable_dt)
-                         : std::string(),
-                     stiff ? "; a stiff object: solver.kind = \"implicit\" takes steps of any size" : "");
+          fmt::print(
+              stderr,
+              "pointhaptics: {}: this run will take about {} ({} steps of {:.3g} s at {:.3g} ms each{}){}; Ctrl-C "
+              "stops it and writes the state reached\n",
+              opt.scene, total < 7200 ? fmt::format("{:.0f} min", total / 60) : fmt::format("{:.1f} h", total / 3600),
+              n_steps, scene.solver.dt, 1e3 * elapsed / static_cast<double>(step),
+              scene.solver.kind == ph::SolverKind::EXPLICIT
+                  ? fmt::format(", {:.0f} sub-steps each below the stable step {:.3g} s",
+                                static_cast<double>(so_far.substeps) / static_cast<double>(so_far.steps),
+                                so_far.stable_dt)
+                  : std::string(),
+              stiff ? "; a stiff object: solver.kind = \"implicit\" takes steps of any size" : "");
         }
       }
       // frames: every vtk_every steps (default: about 50 over the run), and the last state below
       const long long every = opt.vtk_every > 0 ? opt.vtk_every : std::max<long long>(1, n_steps / 50);
-      if (vtk && step % every == 0 && step < n_steps) errors.attempt([&] { ph::add_vtk_frame(*vtk, sim, vtk_surface()); });
+      if (vtk && step % every == 0 && step < n_steps)
+        errors.attempt([&] { ph::add_vtk_frame(*vtk, sim, vtk_surface()); });
       return !interrupted.load();
     });
   }
@@ -249,26 +264,30 @@ int run_command(const RunOptions& opt) {
     print_summary(sim, summary, setup_s);
     if (haptic) {
       const ph::HapticStats& h = interactive.haptic;
-      fmt::print("haptics         {} ticks at {:.0f} Hz, period error p50 {:.0f} us, p99 {:.0f} us, max {:.0f} us; "
-                 "longest tick {:.1f} us, spin-wait {:.0f} us on average; max force {:.3g} N; up to {} points in contact; "
-                 "{} simulation steps\n",
-                 h.ticks, h.rate_hz, h.period_p50_us, h.period_p99_us, h.period_max_us, h.tick_max_us, h.spin_mean_us, h.max_force_n,
-                 interactive.max_contacts, interactive.simulation_steps);
-      fmt::print("passivity       observed energy at its least {:.3g} J (below 0: the object gave back more than the hand put in); the "
-                 "controller dissipated {:.3g} J on {} ticks\n",
-                 h.min_observed_energy, h.passivity_dissipated, h.passivity_ticks);
+      fmt::print(
+          "haptics         {} ticks at {:.0f} Hz, period error p50 {:.0f} us, p99 {:.0f} us, max {:.0f} us; "
+          "longest tick {:.1f} us, spin-wait {:.0f} us on average; max force {:.3g} N; up to {} points in contact; "
+          "{} simulation steps\n",
+          h.ticks, h.rate_hz, h.period_p50_us, h.period_p99_us, h.period_max_us, h.tick_max_us, h.spin_mean_us,
+          h.max_force_n, interactive.max_contacts, interactive.simulation_steps);
+      fmt::print(
+          "passivity       observed energy at its least {:.3g} J (below 0: the object gave back more than the hand put in); the "
+          "controller dissipated {:.3g} J on {} ticks\n",
+          h.min_observed_energy, h.passivity_dissipated, h.passivity_ticks);
       const ph::LocalModelSummary& m = interactive.local_model;
       if (m.updates > 0)
-        fmt::print("local model     over {} updates in contact (mean force {:.3g} N) it strayed from the next by {:.3g} N on "
-                   "average, {:.3g} N at most (held force: {:.3g} N; the contact's own stiffness: {:.3g} N)\n",
-                   m.updates, m.force_mean_n, m.rendered_mean_n, m.rendered_max_n, m.hold_mean_n, m.held_object_mean_n);
+        fmt::print(
+            "local model     over {} updates in contact (mean force {:.3g} N) it strayed from the next by {:.3g} N on "
+            "average, {:.3g} N at most (held force: {:.3g} N; the contact's own stiffness: {:.3g} N)\n",
+            m.updates, m.force_mean_n, m.rendered_mean_n, m.rendered_max_n, m.hold_mean_n, m.held_object_mean_n);
       if (options_real_time && interactive.simulation_wall_s > 0) {
         // a real-time run whose simulation could not keep up with the wall clock says by how much
         const double simulated = sim.time() - start_time;
         if (simulated < 0.95 * interactive.simulation_wall_s)
-          fmt::print("warning         the simulation fell behind the wall clock: {:.3g} s simulated in {:.3g} s ({:.0f}% of real "
-                     "time); the hand felt a slower object (fewer points, levels of detail, or the implicit solver)\n",
-                     simulated, interactive.simulation_wall_s, 100 * simulated / interactive.simulation_wall_s);
+          fmt::print(
+              "warning         the simulation fell behind the wall clock: {:.3g} s simulated in {:.3g} s ({:.0f}% of real "
+              "time); the hand felt a slower object (fewer points, levels of detail, or the implicit solver)\n",
+              simulated, interactive.simulation_wall_s, 100 * simulated / interactive.simulation_wall_s);
       }
       if (h.period_max_us > 1000)
         fmt::print("warning         a haptic period was {:.0f} us off its 1 ms (p99 {:.0f} us): the machine was busy\n",
@@ -306,63 +325,91 @@ int main(int argc, char** argv) {
   CLI::App* run_cmd = app.add_subcommand("run", "Simulate a scene file as it says (headless)");
   run_cmd->add_option("scene", run.scene, "Scene file (TOML)")->required();
   run_cmd->add_option("--json", run.json, "Write the result JSON to FILE");
-  run_cmd->add_option("--max-memory", run.max_memory,
-                      "Refuse an object whose model would need more memory than this (e.g. 4GB; default: the memory available)")
+  run_cmd
+      ->add_option(
+          "--max-memory", run.max_memory,
+          "Refuse an object whose model would need more memory than this (e.g. 4GB; default: the memory available)")
       ->transform(CLI::AsSizeValue(false));
   run_cmd->add_flag("--quiet,-q", run.quiet, "Print nothing but errors");
-  run_cmd->add_option("--force-log", run.force_log, "With a [probe]: write the haptic log (CSV, one row per tick) to FILE");
+  run_cmd->add_option("--force-log", run.force_log,
+                      "With a [probe]: write the haptic log (CSV, one row per tick) to FILE");
   run_cmd->add_option("--vtk", run.vtk, "Write a ParaView time series (DIR/frame.pvd and DIR/frame_*.vtp)");
-  run_cmd->add_option("--csv", run.csv, "Write the final state as CSV, one row per point (x, y, z, u, stress, energy, flags)");
+  run_cmd->add_option("--csv", run.csv,
+                      "Write the final state as CSV, one row per point (x, y, z, u, stress, energy, flags)");
   run_cmd->add_option("--surface", run.surface,
                       "Write the object's deformed surface at the end (FILE.stl, .ply or .obj)");
   run_cmd->add_option("--vtk-every", run.vtk_every, "Steps between VTK frames (default: about 50 frames per run)")
       ->check(CLI::PositiveNumber);
   run_cmd->add_flag("--deterministic", run.deterministic,
                     "With a [probe]: interleave haptic ticks and simulation steps on one thread in simulated time");
-  run_cmd->add_option("--threads", run.threads, "Threads for the force evaluation (0: all)")->check(CLI::NonNegativeNumber);
-  run_cmd->add_option("--set", run.settings,
-                      "Change a key of the scene: KEY=VALUE, a dotted path and a TOML value (material.young=2e5, "
-                      "load.0.total=[0,-0.02,0]); repeatable")
+  run_cmd->add_option("--threads", run.threads, "Threads for the force evaluation (0: all)")
+      ->check(CLI::NonNegativeNumber);
+  run_cmd
+      ->add_option("--set", run.settings,
+                   "Change a key of the scene: KEY=VALUE, a dotted path and a TOML value (material.young=2e5, "
+                   "load.0.total=[0,-0.02,0]); repeatable")
       ->allow_extra_args(false);
 
 #ifdef PH_HAVE_VIEWER
   ph::viewer::ViewerOptions view;
-  CLI::App* view_cmd = app.add_subcommand("view", "Open the interactive viewer (mouse or device probe); --screenshot renders headless");
-  view_cmd->add_option("scene", view.scene, "Scene file (TOML); default: the seed's beam held at both ends, with a probe");
-  view_cmd->add_option("--screenshot", view.screenshot,
-                       "Write a PNG and exit: without --run-for, one frame rendered without a window (EGL); with it, the "
-                       "window's last frame");
-  view_cmd->add_option("--time", view.time, "Headless: simulated seconds before the frame (deterministic; the scene's "
-                                            "scripted probe moves if it has one)")->check(CLI::NonNegativeNumber);
-  view_cmd->add_option("--run-for", view.run_for, "Close the window after this many seconds")->check(CLI::PositiveNumber);
+  CLI::App* view_cmd =
+      app.add_subcommand("view", "Open the interactive viewer (mouse or device probe); --screenshot renders headless");
+  view_cmd->add_option("scene", view.scene,
+                       "Scene file (TOML); default: the seed's beam held at both ends, with a probe");
+  view_cmd->add_option(
+      "--screenshot", view.screenshot,
+      "Write a PNG and exit: without --run-for, one frame rendered without a window (EGL); with it, the "
+      "window's last frame");
+  view_cmd
+      ->add_option("--time", view.time,
+                   "Headless: simulated seconds before the frame (deterministic; the scene's "
+                   "scripted probe moves if it has one)")
+      ->check(CLI::NonNegativeNumber);
+  view_cmd->add_option("--run-for", view.run_for, "Close the window after this many seconds")
+      ->check(CLI::PositiveNumber);
   view_cmd->add_option("--info", view.info, "With --screenshot: write the frame's camera, viewport and probe as JSON");
-  view_cmd->add_option("--width", view.width, "Window or image width in pixels (default 1280)")->check(CLI::Range(16, 8192));
-  view_cmd->add_option("--height", view.height, "Window or image height in pixels (default 800)")->check(CLI::Range(16, 8192));
-  view_cmd->add_option("--probe", view.probe, "What drives the probe: auto (a device if present, else the mouse), mouse, "
-                                              "script (the scene's trajectory), device")
+  view_cmd->add_option("--width", view.width, "Window or image width in pixels (default 1280)")
+      ->check(CLI::Range(16, 8192));
+  view_cmd->add_option("--height", view.height, "Window or image height in pixels (default 800)")
+      ->check(CLI::Range(16, 8192));
+  view_cmd
+      ->add_option("--probe", view.probe,
+                   "What drives the probe: auto (a device if present, else the mouse), mouse, "
+                   "script (the scene's trajectory), device")
       ->check(CLI::IsMember({"auto", "mouse", "script", "device"}));
-  view_cmd->add_option("--colour", view.colour, "Colour the object by displacement, von Mises stress or level-of-detail band (seed Fig. 6)")
+  view_cmd
+      ->add_option("--colour", view.colour,
+                   "Colour the object by displacement, von Mises stress or level-of-detail band (seed Fig. 6)")
       ->check(CLI::IsMember({"displacement", "von_mises", "band"}));
-  view_cmd->add_option("--draw", view.draw, "Draw the object's surface (boxes, spheres, half-spheres, meshes) or its points")
+  view_cmd
+      ->add_option("--draw", view.draw,
+                   "Draw the object's surface (boxes, spheres, half-spheres, meshes) or its points")
       ->check(CLI::IsMember({"surface", "points"}));
-  view_cmd->add_flag("--no-panels", [&view](std::int64_t) { view.panels = false; }, "Only the 3-D view");
+  view_cmd->add_flag(
+      "--no-panels", [&view](std::int64_t) { view.panels = false; }, "Only the 3-D view");
   view_cmd->add_option("--frames", view.frames, "Headless: draw this many frames and report the time per frame")
       ->check(CLI::Range(1, 100000));
-  view_cmd->add_option("--threads", view.threads, "Threads for the force evaluation (0: all)")->check(CLI::NonNegativeNumber);
+  view_cmd->add_option("--threads", view.threads, "Threads for the force evaluation (0: all)")
+      ->check(CLI::NonNegativeNumber);
 #endif
 
   ph::bench::BenchOptions bench;
-  CLI::App* bench_cmd = app.add_subcommand("bench", "Run the performance suite (forces and explicit steps) and print a table");
+  CLI::App* bench_cmd =
+      app.add_subcommand("bench", "Run the performance suite (forces and explicit steps) and print a table");
   bench_cmd->add_option("--json", bench.json_path, "Write the results as JSON to FILE");
-  bench_cmd->add_option("--filter", bench.filter, "Only benchmarks whose name matches this regex, e.g. 'forces/points:10000'");
+  bench_cmd->add_option("--filter", bench.filter,
+                        "Only benchmarks whose name matches this regex, e.g. 'forces/points:10000'");
   bench_cmd->add_option("--min-time", bench.min_time, "Seconds per benchmark")->check(CLI::PositiveNumber);
   bench_cmd->add_option("--sizes", bench.sizes, "Approximate point counts")->check(CLI::PositiveNumber);
   bench_cmd->add_option("--threads", bench.threads, "Thread counts")->check(CLI::PositiveNumber);
-  bench_cmd->add_option("--repetitions", bench.repetitions, "Run each benchmark N times in random order and report medians (steadier on a shared machine)")
+  bench_cmd
+      ->add_option("--repetitions", bench.repetitions,
+                   "Run each benchmark N times in random order and report medians (steadier on a shared machine)")
       ->check(CLI::PositiveNumber);
 
   ph::experiments::CantileverOptions cantilever;
-  CLI::App* experiment_cmd = app.add_subcommand("experiment", "Reproduce a seed experiment: CSV, markdown summary, PNG plots");
+  CLI::App* experiment_cmd =
+      app.add_subcommand("experiment", "Reproduce a seed experiment: CSV, markdown summary, PNG plots");
   experiment_cmd->require_subcommand(1);
   CLI::App* cantilever_cmd = experiment_cmd->add_subcommand(
       "cantilever", "Seed Fig. 3-4: the cantilever against CalculiX (ccx) and Timoshenko beam theory");
@@ -380,47 +427,64 @@ int main(int argc, char** argv) {
   materials_cmd->add_option("--threads", materials.threads, "Threads for the point model and ccx (0: all)")
       ->check(CLI::NonNegativeNumber);
   materials_cmd->add_option("--plot-script", materials.plot_script, "plot_materials.py to use");
-  materials_cmd->add_option("--models", materials.models, "Only these models (svk, neo_hookean, mooney_rivlin)")->delimiter(',');
-  materials_cmd->add_option("--punch-meshes", materials.punch_meshes,
-                            "CalculiX's punch meshes, elements across the block (even), coarse to fine; the point model is "
-                            "compared with the finest (default 10,20,40; --quick: 10)")
-      ->delimiter(',')->check(CLI::Range(2, 200));
+  materials_cmd->add_option("--models", materials.models, "Only these models (svk, neo_hookean, mooney_rivlin)")
+      ->delimiter(',');
+  materials_cmd
+      ->add_option("--punch-meshes", materials.punch_meshes,
+                   "CalculiX's punch meshes, elements across the block (even), coarse to fine; the point model is "
+                   "compared with the finest (default 10,20,40; --quick: 10)")
+      ->delimiter(',')
+      ->check(CLI::Range(2, 200));
 
   ph::experiments::BeamOptions beam;
   CLI::App* beam_cmd = experiment_cmd->add_subcommand(
       "beam-4x1x1", "The 4 x 1 x 1 m benchmark beam: settled sag vs CalculiX, compute s per simulated s");
   beam_cmd->add_option("--out", beam.out, "Output folder")->required();
   beam_cmd->add_option("--scene", beam.scene, "Scene file")->required()->check(CLI::ExistingFile);
-  beam_cmd->add_option("--duration", beam.duration, "Simulated seconds of the dynamic runs")->check(CLI::PositiveNumber);
+  beam_cmd->add_option("--duration", beam.duration, "Simulated seconds of the dynamic runs")
+      ->check(CLI::PositiveNumber);
   beam_cmd->add_flag("!--no-implicit", beam.implicit, "Skip the (slow) implicit runs");
 
   ph::experiments::ContactOptions contact;
   CLI::App* contact_cmd = experiment_cmd->add_subcommand(
-      "contact", "A rigid sphere pressed into a block through the object's surface: force against depth beside Hertz, first "
-                 "contact, sliding");
+      "contact",
+      "A rigid sphere pressed into a block through the object's surface: force against depth beside Hertz, first "
+      "contact, sliding");
   contact_cmd->add_option("--out", contact.out, "Output folder")->required();
   contact_cmd->add_flag("--quick", contact.quick, "The first spacing only, three depths (seconds)");
-  contact_cmd->add_option("--spacings", contact.per_radius, "Spacings as R / n: the n (default 4,8)")->delimiter(',')->check(CLI::Range(2, 64));
+  contact_cmd->add_option("--spacings", contact.per_radius, "Spacings as R / n: the n (default 4,8)")
+      ->delimiter(',')
+      ->check(CLI::Range(2, 64));
   contact_cmd->add_option("--threads", contact.threads, "Threads (0: all)")->check(CLI::NonNegativeNumber);
-  contact_cmd->add_option("--refine", contact.refine,
-                          "The first spacing once more with points at R / n near the contact ([[refine]]; default 8, 0: none)")->check(CLI::Range(0, 64));
-  contact_cmd->add_option("--surface-map", contact.surface_map, "The contact's surface map: exact (default) | non_negative ([probe] surface_map)")
+  contact_cmd
+      ->add_option("--refine", contact.refine,
+                   "The first spacing once more with points at R / n near the contact ([[refine]]; default 8, 0: none)")
+      ->check(CLI::Range(0, 64));
+  contact_cmd
+      ->add_option("--surface-map", contact.surface_map,
+                   "The contact's surface map: exact (default) | non_negative ([probe] surface_map)")
       ->check(CLI::IsMember({"exact", "non_negative"}));
   contact_cmd->add_option("--friction", contact.friction, "Coulomb's coefficient of the friction run (default 0.3)")
       ->check(CLI::Range(0.01, 2.0));
-  contact_cmd->add_option("--drag-steps", contact.drag_steps,
-                          "Quasi-static steps per spacing of the friction runs' drag, one run each (default 8,16,32; --quick: the last)")
-      ->delimiter(',')->check(CLI::Range(1, 256));
-  contact_cmd->add_option("--material", contact.material, "The block's material: neo_hookean (default), svk or mooney_rivlin");
-  contact_cmd->add_option("--fem-meshes", contact.fem_per_radius,
-                          "CalculiX's element sizes at the contact as R / n, the last the reference (default 10,20,40)")
+  contact_cmd
+      ->add_option(
+          "--drag-steps", contact.drag_steps,
+          "Quasi-static steps per spacing of the friction runs' drag, one run each (default 8,16,32; --quick: the last)")
+      ->delimiter(',')
+      ->check(CLI::Range(1, 256));
+  contact_cmd->add_option("--material", contact.material,
+                          "The block's material: neo_hookean (default), svk or mooney_rivlin");
+  contact_cmd
+      ->add_option("--fem-meshes", contact.fem_per_radius,
+                   "CalculiX's element sizes at the contact as R / n, the last the reference (default 10,20,40)")
       ->delimiter(',')
       ->check(CLI::Range(2, 200));
   contact_cmd->add_option("--plot-script", contact.plot_script, "plot_contact.py to use");
 
   ph::experiments::CutOptions cut_experiment;
   CLI::App* cut_cmd = experiment_cmd->add_subcommand(
-      "cut", "Cutting: a device's blade cuts the cantilever through near its root, a scripted one cuts a slit that opens under load");
+      "cut",
+      "Cutting: a device's blade cuts the cantilever through near its root, a scripted one cuts a slit that opens under load");
   cut_cmd->add_option("--out", cut_experiment.out, "Output folder")->required();
   cut_cmd->add_option("--threads", cut_experiment.threads, "Threads (0: all)")->check(CLI::NonNegativeNumber);
 
@@ -428,7 +492,8 @@ int main(int argc, char** argv) {
   CLI::App* profile_cmd = experiment_cmd->add_subcommand(
       "force-profile", "Seed Fig. 2c: the force felt while dragging a point of the beam and letting it go");
   profile_cmd->add_option("--out", profile.out, "Output folder")->required();
-  profile_cmd->add_flag("--real-time", profile.real_time, "Run the haptic thread on the wall clock (default: simulated time)");
+  profile_cmd->add_flag("--real-time", profile.real_time,
+                        "Run the haptic thread on the wall clock (default: simulated time)");
 
   ph::experiments::LodExperimentOptions lod_table, propagation, lod_error;
   auto lod_options = [](CLI::App* cmd, ph::experiments::LodExperimentOptions& o) {
@@ -450,15 +515,18 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(100, 2000000));
   lod_error_cmd->add_option("--load", lod_error.load, "pull: 0.01 N at the pole | indent: the pole pushed 1 mm in")
       ->check(CLI::IsMember({"pull", "indent"}));
-  lod_error_cmd->add_option("--config", lod_error.levels,
-                            "One configuration instead of the sweep, both schemes: \"k1,k2[,min_neighbours];P1:K1;P2:K2\" "
-                            "(units of h; P = 0: the whole object)");
+  lod_error_cmd->add_option(
+      "--config", lod_error.levels,
+      "One configuration instead of the sweep, both schemes: \"k1,k2[,min_neighbours];P1:K1;P2:K2\" "
+      "(units of h; P = 0: the whole object)");
 
   // studies and fits: Python's argparse reads their options (`pointhaptics study --help`)
   CLI::App* study_cmd = app.add_subcommand(
-      "study", "Run a parameter study on Dask: study.toml --out DIR [--scheduler tcp://HOST:PORT] [--workers N] (docs/studies.md)");
+      "study",
+      "Run a parameter study on Dask: study.toml --out DIR [--scheduler tcp://HOST:PORT] [--workers N] (docs/studies.md)");
   CLI::App* fit_cmd = app.add_subcommand(
-      "fit", "Fit material parameters to a measured indentation curve: measured.csv --scene S --params K1,K2 --out DIR (docs/studies.md)");
+      "fit",
+      "Fit material parameters to a measured indentation curve: measured.csv --scene S --params K1,K2 --out DIR (docs/studies.md)");
   for (CLI::App* cmd : {study_cmd, fit_cmd}) {
     cmd->set_help_flag();
     cmd->prefix_command();
@@ -472,7 +540,8 @@ int main(int argc, char** argv) {
 #ifdef PH_HAVE_VIEWER
     if (*view_cmd) {
       if (!view.info.empty() && view.screenshot.empty()) throw ph::Error("view: --info needs --screenshot");
-      return view.screenshot.empty() || view.run_for > 0 ? ph::viewer::run_window(view) : ph::viewer::render_screenshot(view);
+      return view.screenshot.empty() || view.run_for > 0 ? ph::viewer::run_window(view)
+                                                         : ph::viewer::render_screenshot(view);
     }
 #endif
     if (*bench_cmd) return ph::bench::run_bench_suite(bench);
@@ -489,8 +558,10 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "pointhaptics: error: %s\n", e.what());
     return 1;
   } catch (const std::bad_alloc&) {
-    std::fprintf(stderr, "pointhaptics: error: out of memory: this run needs more memory than the machine could give (a coarser "
-                         "spacing, fewer points or --max-memory to refuse such runs before they start)\n");
+    std::fprintf(
+        stderr,
+        "pointhaptics: error: out of memory: this run needs more memory than the machine could give (a coarser "
+        "spacing, fewer points or --max-memory to refuse such runs before they start)\n");
     return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "pointhaptics: internal error: %s\n", e.what());

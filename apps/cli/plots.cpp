@@ -18,7 +18,8 @@ int run_plot_script(const std::string& script_name, const std::string& out_dir, 
   namespace fs = std::filesystem;
   std::string script = given;
   for (const char* dir : {PH_SCRIPTS_SOURCE_DIR, PH_SCRIPTS_INSTALLED_DIR})
-    if (script.empty() && *dir && fs::exists(fs::path(dir) / script_name)) script = (fs::path(dir) / script_name).string();
+    if (script.empty() && *dir && fs::exists(fs::path(dir) / script_name))
+      script = (fs::path(dir) / script_name).string();
   if (script.empty()) {
     fmt::print(stderr, "pointhaptics: {} not found; CSV and summary written, no plots\n", script_name);
     return 1;

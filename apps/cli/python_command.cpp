@@ -21,7 +21,8 @@ int run_python_module(const std::string& module, const std::vector<std::string>&
   const fs::path build_package = fs::path(PH_PYTHON_BUILD_DIR) / "pointhaptics" / "__init__.py";
   if (*PH_PYTHON_BUILD_DIR && fs::exists(build_package)) {
     const char* old = std::getenv("PYTHONPATH");
-    const std::string path = old && *old ? fmt::format("{}:{}", PH_PYTHON_BUILD_DIR, old) : std::string(PH_PYTHON_BUILD_DIR);
+    const std::string path =
+        old && *old ? fmt::format("{}:{}", PH_PYTHON_BUILD_DIR, old) : std::string(PH_PYTHON_BUILD_DIR);
     setenv("PYTHONPATH", path.c_str(), 1);
   }
   // Debian's interpreter: python3-distributed, -pandas, -scipy and -matplotlib are installed for it
@@ -32,8 +33,10 @@ int run_python_module(const std::string& module, const std::vector<std::string>&
   for (std::string& w : words) argv.push_back(w.data());
   argv.push_back(nullptr);
   execvp(argv[0], argv.data());
-  fmt::print(stderr, "pointhaptics: error: cannot run {} ({}); the studies need python3 with python3-distributed, "
-             "python3-pandas and python3-scipy\n", python, std::strerror(errno));
+  fmt::print(stderr,
+             "pointhaptics: error: cannot run {} ({}); the studies need python3 with python3-distributed, "
+             "python3-pandas and python3-scipy\n",
+             python, std::strerror(errno));
   return 1;
 }
 

@@ -23,10 +23,10 @@ struct Ray {
 class OrbitCamera {
  public:
   Vec3 target = Vec3::Zero();
-  double distance = 1.0;        ///< eye to target, m
-  double yaw = 0.35;            ///< about y, rad (0: looking along -z)
-  double pitch = 0.55;          ///< above the horizontal, rad
-  double fov_y = 0.6;           ///< vertical field of view, rad
+  double distance = 1.0;  ///< eye to target, m
+  double yaw = 0.35;      ///< about y, rad (0: looking along -z)
+  double pitch = 0.55;    ///< above the horizontal, rad
+  double fov_y = 0.6;     ///< vertical field of view, rad
 
   /// Look at the box [lo, hi] from the current angles, from far enough to see all of it.
   void frame(const Vec3& lo, const Vec3& hi);

@@ -22,8 +22,11 @@ std::string glfw_error() {
 }  // namespace
 
 Window::Window(int width, int height, const std::string& title, bool visible) {
-  if (!glfwInit()) throw Error(fmt::format("viewer: cannot open a window ({}); is there a display (DISPLAY or WAYLAND_DISPLAY)? "
-                                           "--screenshot renders without one", glfw_error()));
+  if (!glfwInit())
+    throw Error(
+        fmt::format("viewer: cannot open a window ({}); is there a display (DISPLAY or WAYLAND_DISPLAY)? "
+                    "--screenshot renders without one",
+                    glfw_error()));
   glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
   glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
@@ -71,7 +74,8 @@ struct HeadlessContext::Egl {
   EGLContext context = EGL_NO_CONTEXT;
 };
 
-HeadlessContext::HeadlessContext(int width, int height) : egl_(std::make_unique<Egl>()), width_(width), height_(height) {
+HeadlessContext::HeadlessContext(int width, int height)
+    : egl_(std::make_unique<Egl>()), width_(width), height_(height) {
   if (width < 16 || height < 16 || width > 8192 || height > 8192)
     throw Error(fmt::format("viewer: a {} x {} image; the size must be 16 to 8192 pixels a side", width, height));
   // Mesa's surfaceless platform needs neither a display server nor a GPU (llvmpipe renders in software)
@@ -82,12 +86,15 @@ HeadlessContext::HeadlessContext(int width, int height) : egl_(std::make_unique<
   if (egl_->display == EGL_NO_DISPLAY || !eglInitialize(egl_->display, &major, &minor))
     throw Error(fmt::format("viewer: cannot initialise a headless EGL display (EGL error 0x{:x})", eglGetError()));
   if (!eglBindAPI(EGL_OPENGL_API)) throw Error("viewer: this EGL has no desktop OpenGL");
-  const EGLint attributes[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 3, EGL_CONTEXT_OPENGL_PROFILE_MASK,
-                               EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+  const EGLint attributes[] = {
+      EGL_CONTEXT_MAJOR_VERSION,           3,       EGL_CONTEXT_MINOR_VERSION, 3, EGL_CONTEXT_OPENGL_PROFILE_MASK,
+      EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
   egl_->context = eglCreateContext(egl_->display, EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, attributes);
-  if (egl_->context == EGL_NO_CONTEXT || !eglMakeCurrent(egl_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, egl_->context)) {
+  if (egl_->context == EGL_NO_CONTEXT ||
+      !eglMakeCurrent(egl_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, egl_->context)) {
     eglTerminate(egl_->display);
-    throw Error(fmt::format("viewer: cannot make a headless OpenGL 3.3 core context (EGL error 0x{:x})", eglGetError()));
+    throw Error(
+        fmt::format("viewer: cannot make a headless OpenGL 3.3 core context (EGL error 0x{:x})", eglGetError()));
   }
   glGenFramebuffers(1, &framebuffer_);
   glBindFramebuffer(GL_FRAMEBUFFER, framebuffer_);
@@ -99,7 +106,8 @@ HeadlessContext::HeadlessContext(int width, int height) : egl_(std::make_unique<
   glBindRenderbuffer(GL_RENDERBUFFER, depth_);
   glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width, height);
   glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_);
-  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) throw Error("viewer: the offscreen framebuffer is incomplete");
+  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+    throw Error("viewer: the offscreen framebuffer is incomplete");
 }
 
 HeadlessContext::~HeadlessContext() {

@@ -43,7 +43,8 @@ unsigned link_program(const char* vertex_source, const char* fragment_source) {
 }
 
 Viewport use_viewport(const Viewport& viewport, int fb_height, double pixel_ratio) {
-  const Viewport vp{viewport.x * pixel_ratio, viewport.y * pixel_ratio, viewport.width * pixel_ratio, viewport.height * pixel_ratio};
+  const Viewport vp{viewport.x * pixel_ratio, viewport.y * pixel_ratio, viewport.width * pixel_ratio,
+                    viewport.height * pixel_ratio};
   glViewport(static_cast<GLint>(vp.x), static_cast<GLint>(fb_height - vp.y - vp.height), static_cast<GLsizei>(vp.width),
              static_cast<GLsizei>(vp.height));
   return vp;

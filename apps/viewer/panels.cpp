@@ -33,20 +33,23 @@ bool combo(const char* label, Enum& value, const std::array<const char*, N>& nam
 void plot(const char* label, const RollingSeries& series, std::vector<float>& scratch, const char* unit) {
   series.values(scratch);
   // round-off (a force of 1e-15 N when nothing touches) shows as the 0 it is
-  const double latest = std::abs(series.latest()) < 1e-9 * std::max(1.0, static_cast<double>(series.max())) ? 0.0 : series.latest();
+  const double latest =
+      std::abs(series.latest()) < 1e-9 * std::max(1.0, static_cast<double>(series.max())) ? 0.0 : series.latest();
   const std::string overlay = fmt::format("{:.3g} {}", latest, unit);
   const float top = std::max(series.max() * 1.1f, 1e-6f);
-  ImGui::PlotLines(label, scratch.data(), static_cast<int>(scratch.size()), 0, overlay.c_str(), 0.0f, top, ImVec2(0, 60));
+  ImGui::PlotLines(label, scratch.data(), static_cast<int>(scratch.size()), 0, overlay.c_str(), 0.0f, top,
+                   ImVec2(0, 60));
 }
 
 void scene_panel(const ViewerSession* session, const Prepared& p, const DisplayFrame& f) {
   ImGui::TextWrapped("%s", p.scene.path.c_str());
-  ImGui::Text("%ld points, %ld simulated, %d in contact", static_cast<long>(p.reference.cols()), static_cast<long>(f.simulated),
-              f.contacts);
+  ImGui::Text("%ld points, %ld simulated, %d in contact", static_cast<long>(p.reference.cols()),
+              static_cast<long>(f.simulated), f.contacts);
   ImGui::Text("probe: %s", p.device_name.c_str());
   if (!p.note.empty()) ImGui::TextWrapped("%s", p.note.c_str());
   if (session && session->rebuilding()) ImGui::TextColored(ImVec4(1, 0.8f, 0.3f, 1), "rebuilding the model ...");
-  if (session && !session->error().empty()) ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "%s", session->error().c_str());
+  if (session && !session->error().empty())
+    ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "%s", session->error().c_str());
 }
 
 bool parameter_panels(Scene& s) {
@@ -58,7 +61,8 @@ bool parameter_panels(Scene& s) {
     changed |= slider("damping (1/s)", s.material.damping, 0.0, 200.0, "%.3g");
   }
   if (ImGui::CollapsingHeader("Kernel and solver")) {
-    changed |= combo("kernel", s.kernel.type, std::array{"poly6 (Eq. 3)", "spiky (Eq. 4)", "viscosity (Eq. 5)", "quadratic (Eq. 6)"});
+    changed |= combo("kernel", s.kernel.type,
+                     std::array{"poly6 (Eq. 3)", "spiky (Eq. 4)", "viscosity (Eq. 5)", "quadratic (Eq. 6)"});
     changed |= slider("support (x spacing)", s.kernel.support_factor, 1.2, 4.0, "%.2f");
     int kind = s.solver.kind == SolverKind::IMPLICIT ? 1 : 0;
     if (ImGui::Combo("solver", &kind, "explicit\0implicit (backward Euler)\0")) {
@@ -137,10 +141,12 @@ void display_panel(const Prepared& p, SceneView& view) {
   ImGui::Checkbox("auto scale", &view.auto_scale);
   if (!view.auto_scale && view.colour_by == ColourBy::VON_MISES) {
     float kpa = view.stress_max * 1e-3f;
-    if (ImGui::SliderFloat("scale (kPa)", &kpa, 1e-3f, 1e4f, "%.3g", ImGuiSliderFlags_Logarithmic)) view.stress_max = kpa * 1e3f;
+    if (ImGui::SliderFloat("scale (kPa)", &kpa, 1e-3f, 1e4f, "%.3g", ImGuiSliderFlags_Logarithmic))
+      view.stress_max = kpa * 1e3f;
   } else if (!view.auto_scale) {
     float mm = view.scale_max * 1e3f;
-    if (ImGui::SliderFloat("scale (mm)", &mm, 1e-3f, 100.0f, "%.3g", ImGuiSliderFlags_Logarithmic)) view.scale_max = mm * 1e-3f;
+    if (ImGui::SliderFloat("scale (mm)", &mm, 1e-3f, 100.0f, "%.3g", ImGuiSliderFlags_Logarithmic))
+      view.scale_max = mm * 1e-3f;
   }
   ImGui::SliderFloat("point size", &view.point_scale, 0.2f, 1.5f, "%.2f");
   if (p.surface) {
@@ -174,11 +180,12 @@ void controls_panel() {
 
 }  // namespace
 
-void draw_panels(const ViewerSession* session, const Prepared& p, const DisplayFrame& f, SceneView& view, PanelState& state,
-                 LiveStats& live, double /*width*/, double height) {
+void draw_panels(const ViewerSession* session, const Prepared& p, const DisplayFrame& f, SceneView& view,
+                 PanelState& state, LiveStats& live, double /*width*/, double height) {
   ImGui::SetNextWindowPos(ImVec2(0, 0));
   ImGui::SetNextWindowSize(ImVec2(static_cast<float>(panel_width), static_cast<float>(height)));
-  ImGui::Begin("PointHaptics", nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
+  ImGui::Begin("PointHaptics", nullptr,
+               ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
   ImGui::PushItemWidth(150);
   scene_panel(session, p, f);
   ImGui::Separator();
@@ -194,8 +201,8 @@ void draw_panels(const ViewerSession* session, const Prepared& p, const DisplayF
   if (session) {
     live_panel(f, live);
   } else if (ImGui::CollapsingHeader("Live", ImGuiTreeNodeFlags_DefaultOpen)) {
-    ImGui::TextWrapped("t = %.2f s, %lld steps, |F| = %.3g N (a headless frame: the live plots run in the window)", f.time,
-                       f.step, f.force.norm());
+    ImGui::TextWrapped("t = %.2f s, %lld steps, |F| = %.3g N (a headless frame: the live plots run in the window)",
+                       f.time, f.step, f.force.norm());
   }
   controls_panel();
   if (!state.screenshot_message.empty()) ImGui::TextWrapped("%s", state.screenshot_message.c_str());

@@ -26,19 +26,26 @@ Sphere sphere(const Vec3& p, const Rgb& c, double radius) {
           static_cast<float>(radius)};
 }
 
-Rgb probe_colour_of(const SceneView& view) { return view.colour_by == ColourBy::LOD_BAND ? probe_colour_on_bands : probe_colour; }
+Rgb probe_colour_of(const SceneView& view) {
+  return view.colour_by == ColourBy::LOD_BAND ? probe_colour_on_bands : probe_colour;
+}
 
-Rgb paler(const Rgb& c) { return {0.35f * c[0] + 0.65f * 0.55f, 0.35f * c[1] + 0.65f * 0.57f, 0.35f * c[2] + 0.65f * 0.6f}; }
+Rgb paler(const Rgb& c) {
+  return {0.35f * c[0] + 0.65f * 0.55f, 0.35f * c[1] + 0.65f * 0.57f, 0.35f * c[2] + 0.65f * 0.6f};
+}
 
 // rise at once, fall slowly, so the colours do not flicker
-void follow_scale(float& top, double largest, float floor) { top = std::max({static_cast<float>(largest), 0.97f * top, floor}); }
+void follow_scale(float& top, double largest, float floor) {
+  top = std::max({static_cast<float>(largest), 0.97f * top, floor});
+}
 
 bool surface_drawn(const Prepared& p, const SceneView& view) { return p.drawn_surface() && view.draw_surface; }
 
 /// The colour of point i (its flags first, then the chosen field: `magnitude` is its displacement's norm,
 /// m, or its von Mises stress, Pa, as view.colour_by says); with `pale_unsimulated`, paler where levels of
 /// detail do not simulate it (points; on a surface the dithered selection's scattered points made blotches).
-Rgb point_colour(const Prepared& p, const DisplayFrame& f, const SceneView& view, std::size_t i, double magnitude, bool pale_unsimulated) {
+Rgb point_colour(const Prepared& p, const DisplayFrame& f, const SceneView& view, std::size_t i, double magnitude,
+                 bool pale_unsimulated) {
   const bool bands = f.lod_band.size() == p.fixed.size();
   if (p.fixed[i]) return held_colour;
   if (view.grabbed[i]) return grabbed_colour;
@@ -68,12 +75,15 @@ void build_spheres(const Prepared& p, const DisplayFrame& f, SceneView& view) {
   // the surface shell only, unless asked (a point scaled below full size leaves gaps to see inside by); none
   // under a drawn surface unless asked
   const bool all = view.interior || view.point_scale < 0.9f;
-  const Eigen::Index count = surface_drawn(p, view) && !view.points_too ? 0 : all ? n : static_cast<Eigen::Index>(p.shell.size());
+  const Eigen::Index count = surface_drawn(p, view) && !view.points_too ? 0
+                             : all                                      ? n
+                                                                        : static_cast<Eigen::Index>(p.shell.size());
   for (Eigen::Index m = 0; m < count; ++m) {
     const Eigen::Index i = all ? m : p.shell[static_cast<std::size_t>(m)];
     const Vec3 u = displacement_ok ? Vec3(f.u.col(i)) : Vec3::Zero();
     const double magnitude = stress ? view.von_mises[i] : u.norm();
-    view.spheres.push_back(sphere(p.reference.col(i) + u, point_colour(p, f, view, static_cast<std::size_t>(i), magnitude, true), radius));
+    view.spheres.push_back(
+        sphere(p.reference.col(i) + u, point_colour(p, f, view, static_cast<std::size_t>(i), magnitude, true), radius));
   }
   const double probe_radius = p.options.probe.radius;
   if (f.probe.allFinite()) view.spheres.push_back(sphere(f.probe, probe_colour_of(view), probe_radius));
@@ -98,7 +108,8 @@ void build_surface(const Prepared& p, const DisplayFrame& f, SceneView& view) {
   // smooth normals: each vertex the sum of its triangles' area vectors
   view.surface_normals.setZero(3, m);
   for (const auto& t : surface.mesh.F) {
-    const Vec3 a = view.surface_positions.col(t[0]), b = view.surface_positions.col(t[1]), c = view.surface_positions.col(t[2]);
+    const Vec3 a = view.surface_positions.col(t[0]), b = view.surface_positions.col(t[1]),
+               c = view.surface_positions.col(t[2]);
     const Vec3 area = (b - a).cross(c - a);
     for (const index_t v : t) view.surface_normals.col(v) += area;
   }
@@ -109,10 +120,11 @@ void build_surface(const Prepared& p, const DisplayFrame& f, SceneView& view) {
     const Vec3 y = view.surface_positions.col(v);
     const Vec3 normal = view.surface_normals.col(v).normalized();
     const double magnitude = stress ? view.surface_stress(0, v) : (y - surface.mesh.V.col(v)).norm();
-    const Rgb c = point_colour(p, f, view, static_cast<std::size_t>(p.drawn_surface_point()[static_cast<std::size_t>(v)]), magnitude, false);
+    const Rgb c = point_colour(
+        p, f, view, static_cast<std::size_t>(p.drawn_surface_point()[static_cast<std::size_t>(v)]), magnitude, false);
     view.surface_vertices.push_back({static_cast<float>(y.x()), static_cast<float>(y.y()), static_cast<float>(y.z()),
-                                     static_cast<float>(normal.x()), static_cast<float>(normal.y()), static_cast<float>(normal.z()), c[0],
-                                     c[1], c[2]});
+                                     static_cast<float>(normal.x()), static_cast<float>(normal.y()),
+                                     static_cast<float>(normal.z()), c[0], c[1], c[2]});
   }
 }
 
@@ -136,11 +148,13 @@ void draw_overlay(const Prepared& p, const DisplayFrame& f, const SceneView& vie
     const bool stress = view.colour_by == ColourBy::VON_MISES;
     constexpr int steps = 32;
     for (int s = 0; s < steps; ++s) {
-      const float a = y1 - (y1 - y0) * static_cast<float>(s) / steps, b = y1 - (y1 - y0) * static_cast<float>(s + 1) / steps;
+      const float a = y1 - (y1 - y0) * static_cast<float>(s) / steps,
+                  b = y1 - (y1 - y0) * static_cast<float>(s + 1) / steps;
       draw->AddRectFilled(ImVec2(x0, b), ImVec2(x1, a), pack_rgba(viridis((s + 0.5) / steps)));
     }
     draw->AddRect(ImVec2(x0, y0), ImVec2(x1, y1), IM_COL32(200, 200, 205, 255));
-    const std::string top = stress ? fmt::format("{:.3g} kPa", 1e-3 * view.stress_max) : fmt::format("{:.3g} mm", 1e3 * view.scale_max);
+    const std::string top =
+        stress ? fmt::format("{:.3g} kPa", 1e-3 * view.stress_max) : fmt::format("{:.3g} mm", 1e3 * view.scale_max);
     const float w = ImGui::CalcTextSize(top.c_str()).x;
     draw->AddText(ImVec2(x1 - w, y0 - 20), text, top.c_str());
     draw->AddText(ImVec2(x1 - ImGui::CalcTextSize("0").x, y1 + 4), text, "0");
@@ -166,8 +180,8 @@ void draw_overlay(const Prepared& p, const DisplayFrame& f, const SceneView& vie
       draw->AddCircle(ImVec2(static_cast<float>(foot.x()), static_cast<float>(foot.y())), 4.0f, line);
     }
   }
-  const std::string caption = fmt::format("t = {:.2f} s   |F| = {:.2f} N   {} contacts   {} of {} points simulated", f.time,
-                                          f.force.norm(), f.contacts, f.simulated, p.reference.cols());
+  const std::string caption = fmt::format("t = {:.2f} s   |F| = {:.2f} N   {} contacts   {} of {} points simulated",
+                                          f.time, f.force.norm(), f.contacts, f.simulated, p.reference.cols());
   draw->AddText(ImVec2(static_cast<float>(vp.x) + 12, static_cast<float>(vp.y) + 10), text, caption.c_str());
 }
 
@@ -179,9 +193,10 @@ void write_frame_info(const std::string& path, const Prepared& p, const DisplayF
   json j;
   j["image"] = {{"width", fb_width}, {"height", fb_height}};
   j["viewport"] = {vp.x, vp.y, vp.width, vp.height};
-  j["camera"] = {{"eye", vec(c.eye())}, {"target", vec(c.target)}, {"up", vec(c.up())}, {"fov_y", c.fov_y},
-                 {"near", c.near_plane()}, {"far", c.far_plane()}};
-  j["probe"] = {{"position", f.probe.allFinite() ? vec(f.probe) : json(nullptr)}, {"radius", p.options.probe.radius},
+  j["camera"] = {{"eye", vec(c.eye())}, {"target", vec(c.target)}, {"up", vec(c.up())},
+                 {"fov_y", c.fov_y},    {"near", c.near_plane()},  {"far", c.far_plane()}};
+  j["probe"] = {{"position", f.probe.allFinite() ? vec(f.probe) : json(nullptr)},
+                {"radius", p.options.probe.radius},
                 {"colour", probe_colour_of(view)}};
   j["points"] = p.reference.cols();
   j["point_radius"] = p.point_radius * view.point_scale;

@@ -18,21 +18,21 @@ enum class ColourBy { DISPLACEMENT, LOD_BAND, VON_MISES };
 struct SceneView {
   OrbitCamera camera;
   ColourBy colour_by = ColourBy::DISPLACEMENT;
-  bool auto_scale = true;       ///< the colour bar's top follows the largest displacement
-  float scale_max = 1e-3f;      ///< m, the colour bar's top (displacement)
-  float stress_max = 1e3f;      ///< Pa, the colour bar's top (von Mises stress)
-  bool draw_surface = true;     ///< the object's surface when it has one (else its points)
-  bool points_too = false;      ///< the points as well as the surface
-  float point_scale = 1.0f;     ///< drawn radius / half the spacing
-  bool interior = false;        ///< draw the points hidden inside the object too (Prepared::shell)
-  std::vector<Sphere> spheres;  ///< reused every frame
-  std::vector<char> grabbed;    ///< per point, reused
-  Eigen::VectorXd von_mises;    ///< per point, Pa, when coloured by it (reused)
+  bool auto_scale = true;                       ///< the colour bar's top follows the largest displacement
+  float scale_max = 1e-3f;                      ///< m, the colour bar's top (displacement)
+  float stress_max = 1e3f;                      ///< Pa, the colour bar's top (von Mises stress)
+  bool draw_surface = true;                     ///< the object's surface when it has one (else its points)
+  bool points_too = false;                      ///< the points as well as the surface
+  float point_scale = 1.0f;                     ///< drawn radius / half the spacing
+  bool interior = false;                        ///< draw the points hidden inside the object too (Prepared::shell)
+  std::vector<Sphere> spheres;                  ///< reused every frame
+  std::vector<char> grabbed;                    ///< per point, reused
+  Eigen::VectorXd von_mises;                    ///< per point, Pa, when coloured by it (reused)
   std::vector<SurfaceVertex> surface_vertices;  ///< the drawn surface, reused every frame (empty: none drawn)
   std::vector<unsigned> surface_indices;
   const ObjectSurface* indexed_surface = nullptr;  ///< whose triangles surface_indices holds
-  Points surface_positions, surface_normals;    ///< reused
-  Eigen::MatrixXd surface_stress;               ///< von Mises stress at the vertices (1 x m), reused
+  Points surface_positions, surface_normals;       ///< reused
+  Eigen::MatrixXd surface_stress;                  ///< von Mises stress at the vertices (1 x m), reused
 };
 
 /// The 3-D view's rectangle of a window of width x height (window coordinates): right of the panels.
@@ -63,7 +63,8 @@ struct Renderers {
 void draw_overlay(const Prepared& prepared, const DisplayFrame& frame, const SceneView& view, const Viewport& viewport);
 
 /// The frame as JSON (camera, viewport in framebuffer pixels, probe, displacement), for tests and figures.
-void write_frame_info(const std::string& path, const Prepared& prepared, const DisplayFrame& frame, const SceneView& view,
-                      const Viewport& viewport_fb, int fb_width, int fb_height, double haptic_rate_hz);
+void write_frame_info(const std::string& path, const Prepared& prepared, const DisplayFrame& frame,
+                      const SceneView& view, const Viewport& viewport_fb, int fb_width, int fb_height,
+                      double haptic_rate_hz);
 
 }  // namespace pointhaptics::viewer

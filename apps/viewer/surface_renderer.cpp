@@ -58,11 +58,14 @@ SurfaceRenderer::SurfaceRenderer() {
   glBindBuffer(GL_ARRAY_BUFFER, vbo_);
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, ebo_);  // recorded in the vertex array
   glEnableVertexAttribArray(0);
-  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(SurfaceVertex), reinterpret_cast<void*>(offsetof(SurfaceVertex, x)));
+  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(SurfaceVertex),
+                        reinterpret_cast<void*>(offsetof(SurfaceVertex, x)));
   glEnableVertexAttribArray(1);
-  glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, sizeof(SurfaceVertex), reinterpret_cast<void*>(offsetof(SurfaceVertex, nx)));
+  glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, sizeof(SurfaceVertex),
+                        reinterpret_cast<void*>(offsetof(SurfaceVertex, nx)));
   glEnableVertexAttribArray(2);
-  glVertexAttribPointer(2, 3, GL_FLOAT, GL_FALSE, sizeof(SurfaceVertex), reinterpret_cast<void*>(offsetof(SurfaceVertex, r)));
+  glVertexAttribPointer(2, 3, GL_FLOAT, GL_FALSE, sizeof(SurfaceVertex),
+                        reinterpret_cast<void*>(offsetof(SurfaceVertex, r)));
   glBindVertexArray(0);
 }
 
@@ -73,8 +76,9 @@ SurfaceRenderer::~SurfaceRenderer() {
   glDeleteProgram(program_);
 }
 
-void SurfaceRenderer::draw(const std::vector<SurfaceVertex>& vertices, const std::vector<unsigned>& indices, const OrbitCamera& camera,
-                           const Viewport& viewport, int fb_width, int fb_height, double pixel_ratio) {
+void SurfaceRenderer::draw(const std::vector<SurfaceVertex>& vertices, const std::vector<unsigned>& indices,
+                           const OrbitCamera& camera, const Viewport& viewport, int fb_width, int fb_height,
+                           double pixel_ratio) {
   if (vertices.empty() || indices.empty()) return;
   const Viewport vp = use_viewport(viewport, fb_height, pixel_ratio);
   glEnable(GL_DEPTH_TEST);
@@ -96,7 +100,8 @@ void SurfaceRenderer::draw(const std::vector<SurfaceVertex>& vertices, const std
     glBufferSubData(GL_ARRAY_BUFFER, 0, bytes, vertices.data());
   }
   if (indices != uploaded_indices_) {  // a new object (compared once a frame: cheap beside the upload)
-    glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(indices.size() * sizeof(unsigned)), indices.data(), GL_STATIC_DRAW);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(indices.size() * sizeof(unsigned)), indices.data(),
+                 GL_STATIC_DRAW);
     uploaded_indices_ = indices;
   }
   glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(indices.size()), GL_UNSIGNED_INT, nullptr);

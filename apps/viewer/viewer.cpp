@@ -67,17 +67,19 @@ struct ImGuiContextGuard {
 // depth, the left button grabs.
 struct MouseProbe {
   Vec3 target = Vec3::Constant(NAN);  ///< scene position the hand aims at
-  CursorAnchor anchor;                 ///< moves it with the cursor's motion (from the first motion on)
+  CursorAnchor anchor;                ///< moves it with the cursor's motion (from the first motion on)
   bool follow = true;
-  double scroll = 0;                   ///< wheel clicks since the last frame (from the GLFW callback)
-  std::vector<int> keys;               ///< keys pressed since the last frame (from the callback: a tap
-                                       ///< shorter than a frame is not lost)
+  double scroll = 0;      ///< wheel clicks since the last frame (from the GLFW callback)
+  std::vector<int> keys;  ///< keys pressed since the last frame (from the callback: a tap
+                          ///< shorter than a frame is not lost)
 };
 
 // The view a window or a screenshot starts with: the colours asked for, the object framed.
 SceneView initial_view(const ViewerOptions& o, const Prepared& prepared) {
   SceneView view;
-  view.colour_by = o.colour == "band" ? ColourBy::LOD_BAND : o.colour == "von_mises" ? ColourBy::VON_MISES : ColourBy::DISPLACEMENT;
+  view.colour_by = o.colour == "band"        ? ColourBy::LOD_BAND
+                   : o.colour == "von_mises" ? ColourBy::VON_MISES
+                                             : ColourBy::DISPLACEMENT;
   view.draw_surface = o.draw == "surface";
   view.camera.frame(prepared.lo, prepared.hi);
   return view;
@@ -89,8 +91,10 @@ MouseProbe* mouse_probe_of(GLFWwindow* w) { return static_cast<MouseProbe*>(glfw
 
 int render_screenshot(const ViewerOptions& o) {
   const Scene scene = read_viewer_scene(o);
-  const bool scripted = !scene.probe.keyframes.empty() || !scene.probe.trajectory.empty() || scene.device.kind == "replay";
-  const ProbeSource source = o.probe == "auto" ? (scripted ? ProbeSource::SCRIPT : ProbeSource::MOUSE) : probe_source_of(o.probe);
+  const bool scripted =
+      !scene.probe.keyframes.empty() || !scene.probe.trajectory.empty() || scene.device.kind == "replay";
+  const ProbeSource source =
+      o.probe == "auto" ? (scripted ? ProbeSource::SCRIPT : ProbeSource::MOUSE) : probe_source_of(o.probe);
   auto prepared = prepare(scene, source, o.threads);
   const DisplayFrame frame = simulate_frame(*prepared, o.time);
 
@@ -163,7 +167,9 @@ int run_window(const ViewerOptions& o) {
   mouse.target = session.current().options.mapping.origin;
 
   const auto start = std::chrono::steady_clock::now();
-  const auto wall = [&start] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+  const auto wall = [&start] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
   double last_x = 0, last_y = 0;
   int frames = 0;
   double fps_t0 = 0;
@@ -210,7 +216,8 @@ int run_window(const ViewerOptions& o) {
     }
     if (over_view && mouse.scroll != 0) {
       if (shift || ctrl) view.camera.zoom(std::pow(0.9, mouse.scroll));
-      else if (mouse.target.allFinite()) mouse.target += view.camera.forward() * (-0.5 * p.options.probe.radius * mouse.scroll);
+      else if (mouse.target.allFinite())
+        mouse.target += view.camera.forward() * (-0.5 * p.options.probe.radius * mouse.scroll);
       mouse.anchor.reset();
     }
     mouse.scroll = 0;

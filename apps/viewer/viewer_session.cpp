@@ -26,7 +26,8 @@ std::unique_ptr<Device> make_device(const Scene& scene, ProbeSource source, cons
                                     MouseDevice*& mouse, std::string& name) {
   if (source == ProbeSource::SCRIPT) {
     if (scene.probe.keyframes.empty() && scene.probe.trajectory.empty() && scene.device.kind != "replay")
-      throw Error(fmt::format("{}: --probe script needs [probe] keyframes or a trajectory, or a replay device", scene.path));
+      throw Error(
+          fmt::format("{}: --probe script needs [probe] keyframes or a trajectory, or a replay device", scene.path));
     name = scene.device.kind == "replay" ? "replay of " + scene.device.log : "scripted hand";
     return make_scene_device(scene);
   }
@@ -194,7 +195,8 @@ void ViewerSession::stop() {
 
 void ViewerSession::rebuild(const Scene& scene) {
   if (pending_.valid()) return;  // one at a time; the panel shows that one is in flight
-  pending_ = std::async(std::launch::async, [scene, source = source_, threads = threads_] { return prepare(scene, source, threads); });
+  pending_ = std::async(std::launch::async,
+                        [scene, source = source_, threads = threads_] { return prepare(scene, source, threads); });
 }
 
 bool ViewerSession::poll() {
@@ -237,7 +239,9 @@ void ViewerSession::poll_cut_surface() {
   // positions, kernel and supports, all the split reads of it, do not change while it runs
   split_ = std::async(std::launch::async, [&p, sheets = frame.cut_sheets, revision = frame.cut_revision] {
     tbb::task_arena one_thread(1);
-    return one_thread.execute([&] { return Split{split_surface(*p.surface, p.simulation->model(), sheets), &p, revision}; });
+    return one_thread.execute([&] {
+      return Split{split_surface(*p.surface, p.simulation->model(), sheets), &p, revision};
+    });
   });
 }
 

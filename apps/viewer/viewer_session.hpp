@@ -30,9 +30,9 @@ struct Prepared {
   MouseDevice* mouse = nullptr;  ///< the device, when the mouse drives it
   std::string device_name;       ///< what drives the probe, for the panel
   InteractiveOptions options;
-  Points reference;              ///< the object's points, m
+  Points reference;  ///< the object's points, m
   std::vector<unsigned char> fixed;
-  double point_radius = 0;       ///< spheres drawn for points, m
+  double point_radius = 0;  ///< spheres drawn for points, m
   /// The points that can be seen from outside: those with fewer neighbours than the fullest neighbourhood,
   /// and their neighbours (the two outer layers of a lattice sampling; every point of an irregular cloud).
   /// An opaque object hides the rest, and not drawing them is 2-4x less to draw at 100k points.
@@ -50,8 +50,8 @@ struct Prepared {
   /// The surface drawn (the cut one after cuts), or null; and its vertices' points of largest weight.
   const ObjectSurface* drawn_surface() const { return cut_surface ? &*cut_surface : surface ? &*surface : nullptr; }
   const std::vector<index_t>& drawn_surface_point() const { return cut_surface ? cut_surface_point : surface_point; }
-  Vec3 lo, hi;                   ///< bounding box of the reference configuration
-  std::string note;              ///< what was changed to run the scene here (a static solver), else empty
+  Vec3 lo, hi;       ///< bounding box of the reference configuration
+  std::string note;  ///< what was changed to run the scene here (a static solver), else empty
   std::unique_ptr<TripleBuffer<DisplayFrame>> display;
 };
 

@@ -23,11 +23,13 @@ void write_points_csv(const std::string& path, Simulation& sim) {
   const Model& m = sim.model();
   const State& s = sim.state();
   write_text_file(path, "--csv", [&](TextOutput& out) {
-    out.print("index,x_ref,y_ref,z_ref,ux,uy,uz,von_mises,strain_energy_density,active,fixed\n");  // reference positions; current = ref + u
+    out.print(
+        "index,x_ref,y_ref,z_ref,ux,uy,uz,von_mises,strain_energy_density,active,fixed\n");  // reference positions; current = ref + u
     for (index_t i = 0; i < m.n_points; ++i) {
       const std::size_t k = static_cast<std::size_t>(i);
-      out.print("{},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{},{}\n", i, m.X(0, i), m.X(1, i), m.X(2, i), s.u(0, i),
-                s.u(1, i), s.u(2, i), vm[k], w[k], static_cast<int>(active[k]), static_cast<int>(fixed[k]));
+      out.print("{},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{},{}\n", i, m.X(0, i), m.X(1, i),
+                m.X(2, i), s.u(0, i), s.u(1, i), s.u(2, i), vm[k], w[k], static_cast<int>(active[k]),
+                static_cast<int>(fixed[k]));
     }
   });
 }

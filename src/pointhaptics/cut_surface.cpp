@@ -34,7 +34,8 @@ Box box_of(const SheetTriangle& t) {
 }
 
 std::uint64_t edge_key(index_t a, index_t b) {
-  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(std::min(a, b))) << 32) | static_cast<std::uint32_t>(std::max(a, b));
+  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(std::min(a, b))) << 32) |
+         static_cast<std::uint32_t>(std::max(a, b));
 }
 
 /// The mesh being built: vertices, where each looks from for the points it sees, triangles.
@@ -102,7 +103,8 @@ class SheetGrid {
         const std::uint32_t t = sheet_[static_cast<std::size_t>(k)];
         if (asked[t] == question) continue;
         asked[t] = question;
-        crossed = segment.overlaps(boxes_[t]) && segment_crossing(p, q, sheets_[t][0], sheets_[t][1], sheets_[t][2]).has_value();
+        crossed = segment.overlaps(boxes_[t]) &&
+                  segment_crossing(p, q, sheets_[t][0], sheets_[t][1], sheets_[t][2]).has_value();
       }
     });
     return crossed;
@@ -113,8 +115,10 @@ class SheetGrid {
   void for_cells(const Box& b, Fn&& fn) const {
     index_t first[3], last[3];
     for (int a = 0; a < 3; ++a) {
-      first[a] = std::clamp<index_t>(static_cast<index_t>(std::floor((b.lo[a] - bounds_.lo[a]) / cell_)), 0, cells_[a] - 1);
-      last[a] = std::clamp<index_t>(static_cast<index_t>(std::floor((b.hi[a] - bounds_.lo[a]) / cell_)), 0, cells_[a] - 1);
+      first[a] =
+          std::clamp<index_t>(static_cast<index_t>(std::floor((b.lo[a] - bounds_.lo[a]) / cell_)), 0, cells_[a] - 1);
+      last[a] =
+          std::clamp<index_t>(static_cast<index_t>(std::floor((b.hi[a] - bounds_.lo[a]) / cell_)), 0, cells_[a] - 1);
     }
     for (index_t k = first[2]; k <= last[2]; ++k)
       for (index_t j = first[1]; j <= last[1]; ++j)
@@ -146,7 +150,8 @@ void split_triangles(const TriangleMesh& mesh, std::span<const SheetTriangle> sh
   }
   auto crossing_of = [&](index_t a, index_t b) -> const Crossing* {
     const std::uint64_t key = edge_key(a, b);
-    if (const auto found = crossing.find(key); found != crossing.end()) return found->second.copy[0] < 0 ? nullptr : &found->second;
+    if (const auto found = crossing.find(key); found != crossing.end())
+      return found->second.copy[0] < 0 ? nullptr : &found->second;
     const index_t lo = std::min(a, b), hi = std::max(a, b);
     const Vec3 p = mesh.V.col(lo), q = mesh.V.col(hi);
     Box segment;
@@ -166,12 +171,16 @@ void split_triangles(const TriangleMesh& mesh, std::span<const SheetTriangle> sh
     }
     if (!std::isfinite(nearest)) return nullptr;
     // each copy looks from just off the crossing toward its own end (from the end itself if it is that close)
-    auto toward = [&](const Vec3& end) { return (end - at).norm() > offset ? Vec3(at + offset * (end - at).normalized()) : end; };
+    auto toward = [&](const Vec3& end) {
+      return (end - at).norm() > offset ? Vec3(at + offset * (end - at).normalized()) : end;
+    };
     c.copy = {out.add(at, toward(p)), out.add(at, toward(q))};
     return &c;
   };
   // the copy of edge (a, b)'s crossing on vertex v's side
-  auto copy_near = [](const Crossing* c, index_t a, index_t b, index_t v) { return c->copy[v == std::min(a, b) ? 0 : 1]; };
+  auto copy_near = [](const Crossing* c, index_t a, index_t b, index_t v) {
+    return c->copy[v == std::min(a, b) ? 0 : 1];
+  };
   for (const auto& f : mesh.F) {
     const Crossing* edge[3];
     int crossed = 0;
@@ -228,7 +237,8 @@ void add_sheet_faces(const TriangleMesh& mesh, std::span<const SheetTriangle> sh
   Box object;
   for (Eigen::Index v = 0; v < mesh.V.cols(); ++v) object.add(mesh.V.col(v));
   std::vector<double> d;
-  std::vector<std::array<index_t, 2>> grid_vertex;  // a grid vertex's two copies (material on the normal's side, on the other)
+  std::vector<std::array<index_t, 2>>
+      grid_vertex;  // a grid vertex's two copies (material on the normal's side, on the other)
   std::unordered_map<std::uint64_t, std::array<index_t, 2>> edge_vertex;  // a grid edge's crossing of the surface
   for (std::size_t s = 0; s < sheets.size(); ++s) {
     const SheetTriangle& t = sheets[s];
@@ -241,15 +251,19 @@ void add_sheet_faces(const TriangleMesh& mesh, std::span<const SheetTriangle> sh
     const index_t row = k + 1;
     auto id = [row](index_t i, index_t j) { return i * row + j; };
     auto position = [&](index_t i, index_t j) -> Vec3 {
-      return t[0] + (static_cast<double>(i) / static_cast<double>(k)) * (t[1] - t[0]) + (static_cast<double>(j) / static_cast<double>(k)) * (t[2] - t[0]);
+      return t[0] + (static_cast<double>(i) / static_cast<double>(k)) * (t[1] - t[0]) +
+             (static_cast<double>(j) / static_cast<double>(k)) * (t[2] - t[0]);
     };
     d.assign(static_cast<std::size_t>(row * row), 0.0);
     tbb::parallel_for(index_t{0}, row, [&](index_t i) {
-      for (index_t j = 0; i + j <= k; ++j) d[static_cast<std::size_t>(id(i, j))] = distance.signed_distance(position(i, j));
+      for (index_t j = 0; i + j <= k; ++j)
+        d[static_cast<std::size_t>(id(i, j))] = distance.signed_distance(position(i, j));
     });
     grid_vertex.assign(static_cast<std::size_t>(row * row), {-1, -1});
     edge_vertex.clear();
-    auto pair_at = [&](const Vec3& p) -> std::array<index_t, 2> { return {out.add(p, p + offset * n), out.add(p, p - offset * n)}; };
+    auto pair_at = [&](const Vec3& p) -> std::array<index_t, 2> {
+      return {out.add(p, p + offset * n), out.add(p, p - offset * n)};
+    };
     auto vertex_of = [&](index_t g) -> std::array<index_t, 2> {
       auto& v = grid_vertex[static_cast<std::size_t>(g)];
       if (v[0] < 0) v = pair_at(position(g / row, g % row));
@@ -289,15 +303,17 @@ void add_sheet_faces(const TriangleMesh& mesh, std::span<const SheetTriangle> sh
 
 }  // namespace
 
-void CutSheets::add_strip(const Vec3& A0, const Vec3& B0, const Vec3& A1, const Vec3& B1, bool continues, double tolerance) {
+void CutSheets::add_strip(const Vec3& A0, const Vec3& B0, const Vec3& A1, const Vec3& B1, bool continues,
+                          double tolerance) {
   ++revision;
   const std::size_t n = triangles.size();
   if (continues && n >= 2) {
     // the last strip: (P0, Q0, Q1), (P0, Q1, P1), ending on P1-Q1, where this one starts
     const Vec3 P0 = triangles[n - 2][0], Q0 = triangles[n - 2][1], P1 = triangles[n - 1][2], Q1 = triangles[n - 2][2];
     const Vec3 normal = (Q0 - P0).cross(B1 - P0);
-    const bool straight = distance_to_segment(P1, P0, A1) <= tolerance && distance_to_segment(Q1, Q0, B1) <= tolerance &&
-                          normal.norm() > 0 && std::abs(normal.normalized().dot(A1 - P0)) <= tolerance;
+    const bool straight = distance_to_segment(P1, P0, A1) <= tolerance &&
+                          distance_to_segment(Q1, Q0, B1) <= tolerance && normal.norm() > 0 &&
+                          std::abs(normal.normalized().dot(A1 - P0)) <= tolerance;
     if (straight) {
       triangles[n - 2] = {P0, Q0, B1};
       triangles[n - 1] = {P0, B1, A1};
@@ -354,17 +370,20 @@ ObjectSurface split_surface(const ObjectSurface& whole, const Model& model, std:
   for (const Vec3& v : out.vertex) region.add(v);
   const SheetGrid grid(sheets, sheet_box, region.inflated(reach), 0.5 * h);
   Points Y(3, static_cast<Eigen::Index>(remap.size()));
-  for (std::size_t r = 0; r < remap.size(); ++r) Y.col(static_cast<Eigen::Index>(r)) = out.vertex[static_cast<std::size_t>(remap[r])];
+  for (std::size_t r = 0; r < remap.size(); ++r)
+    Y.col(static_cast<Eigen::Index>(r)) = out.vertex[static_cast<std::size_t>(remap[r])];
   const VertexSees sees = [&](index_t r, index_t j) {
     const std::size_t v = static_cast<std::size_t>(remap[static_cast<std::size_t>(r)]);
-    return (model.X.col(j) - out.vertex[v]).squaredNorm() <= reach * reach && !grid.crosses(out.from[v], model.X.col(j));
+    return (model.X.col(j) - out.vertex[v]).squaredNorm() <= reach * reach &&
+           !grid.crosses(out.from[v], model.X.col(j));
   };
   std::vector<char> uncarried;
   const SurfaceMap fresh = build_surface_map(model, Y, &uncarried, sees);
 
   // the rows, in the new vertices' order: the whole map's, or the fresh ones
   std::vector<index_t> fresh_row(n_vertices, -1);
-  for (std::size_t r = 0; r < remap.size(); ++r) fresh_row[static_cast<std::size_t>(remap[r])] = static_cast<index_t>(r);
+  for (std::size_t r = 0; r < remap.size(); ++r)
+    fresh_row[static_cast<std::size_t>(remap[r])] = static_cast<index_t>(r);
   std::vector<char> dropped(n_vertices, 0);
   ObjectSurface split;
   SurfaceMap& map = split.map;
@@ -387,16 +406,18 @@ ObjectSurface split_surface(const ObjectSurface& whole, const Model& model, std:
   index_t dropped_faces = 0;
   for (std::size_t t = 0; t < out.faces.size(); ++t) {
     const auto& f = out.faces[t];
-    if (dropped[static_cast<std::size_t>(f[0])] || dropped[static_cast<std::size_t>(f[1])] || dropped[static_cast<std::size_t>(f[2])]) {
+    if (dropped[static_cast<std::size_t>(f[0])] || dropped[static_cast<std::size_t>(f[1])] ||
+        dropped[static_cast<std::size_t>(f[2])]) {
       ++dropped_faces;
       continue;
     }
     split.mesh.F.push_back(f);
     if (t >= n_split) ++split.cut_faces;
   }
-  split.source = fmt::format("{}; split by {} cut sheet triangle{} ({} faces of cuts{})", whole.source, sheets.size(),
-                             sheets.size() == 1 ? "" : "s", split.cut_faces,
-                             dropped_faces ? fmt::format(", {} triangles dropped: too few points to carry them", dropped_faces) : "");
+  split.source = fmt::format(
+      "{}; split by {} cut sheet triangle{} ({} faces of cuts{})", whole.source, sheets.size(),
+      sheets.size() == 1 ? "" : "s", split.cut_faces,
+      dropped_faces ? fmt::format(", {} triangles dropped: too few points to carry them", dropped_faces) : "");
   return split;
 }
 

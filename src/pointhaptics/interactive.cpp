@@ -61,8 +61,10 @@ int simulation_step(Simulation& sim, HapticLoop& loop, LocalModelStray& stray) {
 }  // namespace
 
 InteractiveResult run_interactive(Simulation& sim, Device& device, const InteractiveOptions& options) {
-  if (!(options.duration >= 0) || !(options.haptic_rate > 0)) throw Error("interactive run: bad duration or haptic rate");
-  if (sim.solver().kind == SolverKind::STATIC) throw Error("interactive run: needs a dynamic solver (explicit or implicit)");
+  if (!(options.duration >= 0) || !(options.haptic_rate > 0))
+    throw Error("interactive run: bad duration or haptic rate");
+  if (sim.solver().kind == SolverKind::STATIC)
+    throw Error("interactive run: needs a dynamic solver (explicit or implicit)");
   if (options.display && options.display->back().u.cols() != sim.model().n_points)
     throw Error("interactive run: the display frames must be sized for the model's points (3 x n)");
   const CouplingGains gains = coupling_budget(device.specs(), options.mapping.scale, options.coupling_safety);

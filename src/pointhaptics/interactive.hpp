@@ -14,7 +14,7 @@ namespace pointhaptics {
 struct DisplayFrame {
   double time = 0;
   long long step = 0;
-  Points u;             ///< displacements, m (3 x n)
+  Points u;  ///< displacements, m (3 x n)
   Vec3 probe = Vec3::Constant(NAN);
   Vec3 device = Vec3::Constant(NAN);  ///< scene position of the device point, m
   Vec3 force = Vec3::Zero();          ///< force the haptic loop rendered last, N
@@ -25,7 +25,7 @@ struct DisplayFrame {
   /// others; empty without levels of detail. Rewritten only when lod_selections changes.
   std::vector<std::int8_t> lod_band;
   long long lod_selections = 0;
-  index_t simulated = 0;              ///< points simulated (the active set with levels of detail)
+  index_t simulated = 0;  ///< points simulated (the active set with levels of detail)
   /// The cuts' sheets (reference configuration; cut_surface.hpp), rewritten only when cut_revision changes:
   /// a viewer splits the object's surface along them.
   std::vector<SheetTriangle> cut_sheets;
@@ -42,8 +42,8 @@ struct InteractiveOptions {
   double haptic_rate = 1000.0;   ///< Hz
   double coupling_safety = 0.5;  ///< fraction of the device's stable stiffness the coupling may use
   ForceRules rules;
-  bool real_time = true;         ///< threads on the wall clock; false: one thread, deterministic, simulated time
-  bool log = true;               ///< keep the force log (one row per haptic tick) in the result
+  bool real_time = true;  ///< threads on the wall clock; false: one thread, deterministic, simulated time
+  bool log = true;        ///< keep the force log (one row per haptic tick) in the result
   /// If set, the force log is streamed here instead (on the simulation's thread, as the run goes), so that
   /// a run of any length logs in bounded memory (a --force-log file).
   std::function<void(const HapticLogRow&)> log_sink;

@@ -23,7 +23,8 @@ LodBuild build_lod(const Model& full, const LodParams& params, const Vec3& centr
   std::mt19937_64 rng(params.seed);  // a fresh generator: every point keeps its draw across selections
   b.selection = select_points(full, centre, params, rng);
   b.active = build_active_set(full, b.selection, params);
-  cut_as_object(b.active, full, sheets, solver != SolverKind::EXPLICIT);  // before its stable step: a cut stencil can be stiffer
+  cut_as_object(b.active, full, sheets,
+                solver != SolverKind::EXPLICIT);  // before its stable step: a cut stencil can be stiffer
   b.object_cuts = object_cuts;
   b.centre = centre;
   if (solver == SolverKind::EXPLICIT) b.stable_dt = stable_time_step(b.active.model, 0.8, 20);
@@ -59,7 +60,8 @@ LevelsOfDetail::LevelsOfDetail(ModelSimulation&& object, const LodParams& params
   // the object's own cuts so far are in its model (and its sheets): the active sets are built with them
   sheets_carried_ = active_->cut_sheets_.triangles.size();
   sheet_revision_carried_ = active_->cut_sheets_.revision;
-  take_over(build_lod(full_, params_, snap(contact), solver_.kind, active_->cut_sheets_.triangles, object_cuts_made_), true);
+  take_over(build_lod(full_, params_, snap(contact), solver_.kind, active_->cut_sheets_.triangles, object_cuts_made_),
+            true);
 }
 
 void LevelsOfDetail::carry_cuts() {
@@ -178,21 +180,25 @@ std::vector<index_t> LevelsOfDetail::update(const Vec3& contact, bool onset, boo
   contact_ = contact;
   apply_object_cuts();
   if (!asynchronous)
-    return take_over(build_lod(full_, params_, snap(contact), solver_.kind, active_->cut_sheets_.triangles, object_cuts_made_), true);
+    return take_over(
+        build_lod(full_, params_, snap(contact), solver_.kind, active_->cut_sheets_.triangles, object_cuts_made_),
+        true);
   // the worker only reads the object's model: a cut meanwhile reaches it once the build is done (carry_cuts())
   // and, with a probe on the surface, the part of it the new active set carries
   const std::optional<ProbeAttachment>& probe = active_->probe();
-  std::shared_ptr<const ObjectSurface> surface = probe && probe->surface ? (probe->split ? probe->split : probe->surface) : nullptr;
+  std::shared_ptr<const ObjectSurface> surface =
+      probe && probe->surface ? (probe->split ? probe->split : probe->surface) : nullptr;
   const double reach = probe ? tool_reach(probe_shape(probe->tool.contact().params())) : 0.0;
-  pending_ = std::async(std::launch::async, [&full = full_, params = params_, at = snap(contact), kind = solver_.kind,
-                                             sheets = active_->cut_sheets_.triangles, cuts = object_cuts_made_, surface, reach] {
-    LodBuild build = build_lod(full, params, at, kind, sheets, cuts);
-    if (surface) {
-      build.part = restrict_surface(surface->mesh, surface->map, build.active, reach);
-      build.part_of = surface;
-    }
-    return build;
-  });
+  pending_ = std::async(std::launch::async,
+                        [&full = full_, params = params_, at = snap(contact), kind = solver_.kind,
+                         sheets = active_->cut_sheets_.triangles, cuts = object_cuts_made_, surface, reach] {
+                          LodBuild build = build_lod(full, params, at, kind, sheets, cuts);
+                          if (surface) {
+                            build.part = restrict_surface(surface->mesh, surface->map, build.active, reach);
+                            build.part_of = surface;
+                          }
+                          return build;
+                        });
   return {};
 }
 
@@ -203,10 +209,12 @@ std::vector<index_t> LevelsOfDetail::take_over(LodBuild build, bool built_here) 
   // the cuts made while it was built: on the object now (nothing reads it), and on the new set
   carry_cuts();
   if (build.object_cuts != object_cuts_made_) {
-    const CutReport late = cut_as_object(next, full_, active_->cut_sheets_.triangles, solver_.kind != SolverKind::EXPLICIT);
+    const CutReport late =
+        cut_as_object(next, full_, active_->cut_sheets_.triangles, solver_.kind != SolverKind::EXPLICIT);
     if (late.severed_pairs > 0 && build.stable_dt > 0)
-      build.stable_dt = std::min(build.stable_dt, local_stable_time_step(next.model, late.cut_points, ModelSimulation::cut_patch_rings, 0.8,
-                                                                         ModelSimulation::cut_lanczos_steps));
+      build.stable_dt = std::min(
+          build.stable_dt, local_stable_time_step(next.model, late.cut_points, ModelSimulation::cut_patch_rings, 0.8,
+                                                  ModelSimulation::cut_lanczos_steps));
   }
   std::vector<index_t> new_index(first ? 0 : static_cast<std::size_t>(active_->model().n_points), -1);
   double energy_before = 0;
@@ -217,7 +225,8 @@ std::vector<index_t> LevelsOfDetail::take_over(LodBuild build, bool built_here) 
       new_index[k] = now < next.n_selected ? now : -1;
     }
     const ModelSimulation& old = *active_;
-    energy_before = strain_energy(old.model(), old.state().u).total() + kinetic_energy(old.model(), old.state().velocity);
+    energy_before =
+        strain_energy(old.model(), old.state().u).total() + kinetic_energy(old.model(), old.state().velocity);
     carried = object_state();  // the active state so far, back on the object
   }
   const double time = carried.time;
@@ -246,8 +255,7 @@ std::vector<index_t> LevelsOfDetail::take_over(LodBuild build, bool built_here) 
     const ToolShape shape = probe_shape(probe.tool.contact().params());
     if (current && build.part && build.part_of == current)  // made by the worker (a cut split none since)
       surface.emplace(probe_surface_contact(std::move(*build.part), probe.contact, shape, active_->model(), next));
-    else if (current)
-      surface.emplace(probe_surface_contact(*current, probe.contact, shape, active_->model(), &next));
+    else if (current) surface.emplace(probe_surface_contact(*current, probe.contact, shape, active_->model(), &next));
     probe.tool.remap(active_->model(), new_index, std::move(surface));
   }
   active_->set_state(state);

@@ -70,7 +70,8 @@ class LevelsOfDetail {
   /// The contact point of a probe for update(), in the reference configuration: when grabbing (`grabbed`:
   /// active indices), where the grabbed points are in the object; when pushing, the probe carried back by
   /// the mean displacement of the `touched` points (the probe itself if none).
-  Vec3 contact_of_probe(const Vec3& probe, const std::vector<index_t>& grabbed, const std::vector<index_t>& touched) const;
+  Vec3 contact_of_probe(const Vec3& probe, const std::vector<index_t>& grabbed,
+                        const std::vector<index_t>& touched) const;
 
   const ActiveSet& active_set() const { return active_set_; }
   const Selection& selection() const { return selection_; }
@@ -97,10 +98,10 @@ class LevelsOfDetail {
   Vec3 contact_ = Vec3::Constant(NAN);  ///< the contact point the selection was made for
   long long selections_ = 0;
   double last_build_ms_ = 0, max_reselect_ms_ = 0;
-  std::future<LodBuild> pending_;       ///< an asynchronous re-selection in flight
-  std::vector<index_t> object_cuts_;    ///< the object's pairs to sever once no re-selection reads its model
-  long long object_cuts_made_ = 0;      ///< times the object's model was cut
-  std::size_t sheets_carried_ = 0;      ///< sheet triangles whose pairs were found in the object
+  std::future<LodBuild> pending_;     ///< an asynchronous re-selection in flight
+  std::vector<index_t> object_cuts_;  ///< the object's pairs to sever once no re-selection reads its model
+  long long object_cuts_made_ = 0;    ///< times the object's model was cut
+  std::size_t sheets_carried_ = 0;    ///< sheet triangles whose pairs were found in the object
   long long sheet_revision_carried_ = 0;
   double last_selection_time_ = -std::numeric_limits<double>::infinity();  ///< of the last take-over, s
 };

@@ -17,14 +17,15 @@
 
 namespace pointhaptics {
 
-SurfaceContact probe_surface_contact(const ObjectSurface& surface, const SurfaceContactParams& params, const ToolShape& shape,
-                                     const Model& model, const ActiveSet* active) {
+SurfaceContact probe_surface_contact(const ObjectSurface& surface, const SurfaceContactParams& params,
+                                     const ToolShape& shape, const Model& model, const ActiveSet* active) {
   if (!active) return SurfaceContact(model, surface.mesh, surface.map, shape, params);
-  return probe_surface_contact(restrict_surface(surface.mesh, surface.map, *active, tool_reach(shape)), params, shape, model, *active);
+  return probe_surface_contact(restrict_surface(surface.mesh, surface.map, *active, tool_reach(shape)), params, shape,
+                               model, *active);
 }
 
-SurfaceContact probe_surface_contact(ActiveSurface part, const SurfaceContactParams& params, const ToolShape& shape, const Model& model,
-                                     const ActiveSet& active) {
+SurfaceContact probe_surface_contact(ActiveSurface part, const SurfaceContactParams& params, const ToolShape& shape,
+                                     const Model& model, const ActiveSet& active) {
   // with the whole surface's stiffness per point, lowered below per point rather than uniformly: a thinned
   // band's point carries the vertices of the points it absorbed, and lowering the whole part until it met the cap
   // made the contact at the probe 12x softer than the whole surface's (the probe sank in and was held)
@@ -45,11 +46,17 @@ SurfaceContact probe_surface_contact(ActiveSurface part, const SurfaceContactPar
 }
 
 ModelSimulation::ModelSimulation(Model model, const SolverSpec& solver, int n_threads, double stable_dt)
-    : model_(std::move(model)), solver_(solver), state_(State::at_rest(model_)), ws_(model_, n_threads), n_threads_(n_threads) {
+    : model_(std::move(model)),
+      solver_(solver),
+      state_(State::at_rest(model_)),
+      ws_(model_, n_threads),
+      n_threads_(n_threads) {
   // explicit steps below it, so they need it now; the other kinds only report it, and it is computed when
   // first asked (its 40 Lanczos steps were a tenth of a 1,500-point static solve). On the simulation's
   // threads: a third of a 10^6-point set-up on one
-  stable_dt_ = stable_dt > 0 ? stable_dt : solver_.kind == SolverKind::EXPLICIT ? stable_time_step(model_, 0.8, 40, n_threads) : 0.0;
+  stable_dt_ = stable_dt > 0                          ? stable_dt
+               : solver_.kind == SolverKind::EXPLICIT ? stable_time_step(model_, 0.8, 40, n_threads)
+                                                      : 0.0;
   solver_impl_ = make_solver(model_, solver_, stable_dt_);
   hold_points(model_, 0.0, state_.u);  // held points start at their prescribed displacement at t = 0
 }
@@ -66,7 +73,8 @@ void ModelSimulation::set_state(const State& state) {
   state_.velocity = state.velocity;
   state_.time = state.time;
   // a viscoelastic history: the state's when it has one for this model, else at rest
-  if (state.viscous.rows() == state_.viscous.rows() && state.viscous.cols() == state_.viscous.cols()) state_.viscous = state.viscous;
+  if (state.viscous.rows() == state_.viscous.rows() && state.viscous.cols() == state_.viscous.cols())
+    state_.viscous = state.viscous;
   else state_.viscous.setZero();
 }
 
@@ -82,7 +90,8 @@ CutReport ModelSimulation::cut(std::span<const BladeSweep> sweeps) {
     // (elsewhere the model is as it was); implicit and static steps do not depend on the stable step. On one
     // thread: the patch is small, and two threads made it slower (0.9 against 1.2 ms a cut at 10k points)
     if (solver_.kind == SolverKind::EXPLICIT)
-      stable_dt_ = std::min(stable_dt_, local_stable_time_step(model_, report.cut_points, cut_patch_rings, 0.8, cut_lanczos_steps));
+      stable_dt_ = std::min(stable_dt_,
+                            local_stable_time_step(model_, report.cut_points, cut_patch_rings, 0.8, cut_lanczos_steps));
     std::unique_ptr<Solver> next = make_solver(model_, solver_, stable_dt_);
     next->continue_from(*solver_impl_);
     solver_impl_ = std::move(next);
@@ -104,7 +113,8 @@ void ModelSimulation::record_cut_sheet(const BladeSweep& sweep) {
   Vec3 hi = sweep.a0.cwiseMax(sweep.b0).cwiseMax(sweep.a1).cwiseMax(sweep.b1).array() + radius;
   sheet_points_.clear();  // allocates only to grow
   for (index_t j = 0; j < model_.n_points; ++j)
-    if ((cut_positions_.col(j).array() >= lo.array()).all() && (cut_positions_.col(j).array() <= hi.array()).all()) sheet_points_.push_back(j);
+    if ((cut_positions_.col(j).array() >= lo.array()).all() && (cut_positions_.col(j).array() <= hi.array()).all())
+      sheet_points_.push_back(j);
   if (sheet_points_.empty()) return;
   // where the material at current position x was: x less the displacement of the points around it (weighted
   // by (1 - r / R)^2 within two supports), or of the nearest one (a corner of the sweep outside the object)
@@ -125,7 +135,8 @@ void ModelSimulation::record_cut_sheet(const BladeSweep& sweep) {
   // a strip that starts where the last one ended starts on its mapped edge: mapped again at another time (by
   // another displacement) the two would not meet, and the gap or step between them would show
   const bool continues = sheet_edge_.has_value() && (*sheet_edge_)[0] == sweep.a0 && (*sheet_edge_)[1] == sweep.b0;
-  const Vec3 a0 = continues ? (*sheet_edge_)[2] : reference(sweep.a0), b0 = continues ? (*sheet_edge_)[3] : reference(sweep.b0);
+  const Vec3 a0 = continues ? (*sheet_edge_)[2] : reference(sweep.a0),
+             b0 = continues ? (*sheet_edge_)[3] : reference(sweep.b0);
   const Vec3 a1 = reference(sweep.a1), b1 = reference(sweep.b1);
   if (!(a0.allFinite() && b0.allFinite() && a1.allFinite() && b1.allFinite())) return;  // a state that is not finite
   // (a straight run of strips is kept as one quad, to within a hundredth of the spacing)
@@ -140,9 +151,10 @@ void ModelSimulation::refresh_probe_surface() {
   auto take = [&](SplitContact done) {
     std::vector<index_t> same(static_cast<std::size_t>(model_.n_points));
     std::iota(same.begin(), same.end(), index_t{0});
-    SurfaceContact contact = done.contact ? std::move(*done.contact)
-                                          : probe_surface_contact(*done.surface, probe.contact, probe_shape(probe.tool.contact().params()),
-                                                                  model_, probe.active_set);
+    SurfaceContact contact =
+        done.contact ? std::move(*done.contact)
+                     : probe_surface_contact(*done.surface, probe.contact, probe_shape(probe.tool.contact().params()),
+                                             model_, probe.active_set);
     probe.tool.remap(model_, same, std::move(contact));
     probe.split = std::move(done.surface);
     probe.surface_revision = done.revision;
@@ -157,12 +169,14 @@ void ModelSimulation::refresh_probe_surface() {
   // on one thread: in real time the other core runs the haptic loop. The surface is the object's, split along
   // its points (with levels of detail the object's model, which outlives this simulation, not the active one)
   auto split = [surface = probe.surface, sheets = cut_sheets_, params = probe.contact,
-                shape = probe_shape(probe.tool.contact().params()), &object = probe.object_model ? *probe.object_model : model_,
+                shape = probe_shape(probe.tool.contact().params()),
+                &object = probe.object_model ? *probe.object_model : model_,
                 whole_model = probe.active_set == nullptr]() {
     const auto start = std::chrono::steady_clock::now();
     tbb::task_arena one_thread(1);
     SplitContact made = one_thread.execute([&] {
-      SplitContact m{std::make_shared<const ObjectSurface>(split_surface(*surface, object, sheets.triangles)), std::nullopt, sheets.revision};
+      SplitContact m{std::make_shared<const ObjectSurface>(split_surface(*surface, object, sheets.triangles)),
+                     std::nullopt, sheets.revision};
       if (whole_model) m.contact.emplace(probe_surface_contact(*m.surface, params, shape, object, nullptr));
       return m;
     });
@@ -178,7 +192,8 @@ void ModelSimulation::refresh_probe_surface() {
 
 const StepReport& ModelSimulation::step() {
   if (diagnostics_.failed)
-    throw Error(fmt::format("simulation: no step after a failed one (t = {:.6g} s: {})", state_.time, diagnostics_.failure));
+    throw Error(
+        fmt::format("simulation: no step after a failed one (t = {:.6g} s: {})", state_.time, diagnostics_.failure));
   using clock = std::chrono::steady_clock;
   const auto start = clock::now();
   // the tools take their place for this step, from the inputs

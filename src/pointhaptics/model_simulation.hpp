@@ -34,30 +34,30 @@ struct StepInputs {
 
 /// Counters and timers of the steps so far: the simulation's diagnostics, read by summary().
 struct StepDiagnostics {
-  long long steps = 0;          ///< steps taken (a static solve is one)
-  long long substeps = 0;       ///< explicit sub-steps, static load increments
-  long long iterations = 0;     ///< Newton iterations (explicit: sub-steps)
+  long long steps = 0;       ///< steps taken (a static solve is one)
+  long long substeps = 0;    ///< explicit sub-steps, static load increments
+  long long iterations = 0;  ///< Newton iterations (explicit: sub-steps)
   long long cg_iterations = 0;
-  long long factorisations = 0; ///< preconditioner = "cholesky": numeric factorisations of the tangent
+  long long factorisations = 0;             ///< preconditioner = "cholesky": numeric factorisations of the tangent
   long long background_factorisations = 0;  ///< ... of them, made on a worker thread
-  double factor_bytes = 0;      ///< ... and the largest factor's size, bytes (two_level: the coarse factor's)
-  long long coarse_points = 0;  ///< preconditioner = "two_level": the coarse level's points (the largest)
-  long long budget_steps = 0;   ///< implicit steps the iteration budget ended above the tolerance
-  double residual = 0;          ///< the last Newton residual
-  long long inverted_steps = 0; ///< steps that ended with inverted neighbourhoods (det F <= 0)
-  index_t inverted = 0;         ///< inverted neighbourhoods at the end of the last step (of its last force
-                                ///< evaluation: explicit steps one sub-step before the end)
+  double factor_bytes = 0;       ///< ... and the largest factor's size, bytes (two_level: the coarse factor's)
+  long long coarse_points = 0;   ///< preconditioner = "two_level": the coarse level's points (the largest)
+  long long budget_steps = 0;    ///< implicit steps the iteration budget ended above the tolerance
+  double residual = 0;           ///< the last Newton residual
+  long long inverted_steps = 0;  ///< steps that ended with inverted neighbourhoods (det F <= 0)
+  index_t inverted = 0;          ///< inverted neighbourhoods at the end of the last step (of its last force
+                                 ///< evaluation: explicit steps one sub-step before the end)
   StepStatus status = StepStatus::CONVERGED;  ///< of the last step
-  bool failed = false;          ///< a step failed: the state is not a result, and no step follows
-  std::string failure;          ///< why
+  bool failed = false;                        ///< a step failed: the state is not a result, and no step follows
+  std::string failure;                        ///< why
   double max_step_seconds = 0;  ///< the longest step, s (Simulation::step: the active set's selection included)
   double step_seconds = 0;      ///< wall time in steps, s, and in its stages:
   double active_set_seconds = 0, tools_seconds = 0, solve_seconds = 0;
-  long long cuts = 0;           ///< cut updates (ModelSimulation::cut: a blade step's sweeps)
-  double max_cut_seconds = 0;   ///< the longest of them, the stable step and the solver's rebuild included, s
-  double cut_seconds = 0;       ///< all of them, s
-  long long surface_splits = 0; ///< a probe's surface split along the cuts' sheets (when it stops cutting)
-  double max_split_seconds = 0; ///< the longest split, s (off the simulation's thread in real time)
+  long long cuts = 0;            ///< cut updates (ModelSimulation::cut: a blade step's sweeps)
+  double max_cut_seconds = 0;    ///< the longest of them, the stable step and the solver's rebuild included, s
+  double cut_seconds = 0;        ///< all of them, s
+  long long surface_splits = 0;  ///< a probe's surface split along the cuts' sheets (when it stops cutting)
+  double max_split_seconds = 0;  ///< the longest split, s (off the simulation's thread in real time)
 };
 
 /// The probe's tool and its settings, as a simulation holds them (carried to the next active model).
@@ -70,7 +70,8 @@ struct ProbeAttachment {
   /// levels of detail every new active set gets the part of it that it carries (probe_surface_contact()).
   std::shared_ptr<const ObjectSurface> surface;
   SurfaceContactParams contact;
-  long long surface_revision = 0;  ///< of the cut sheets the contact's surface is split along (ModelSimulation::cut_sheets)
+  long long surface_revision =
+      0;  ///< of the cut sheets the contact's surface is split along (ModelSimulation::cut_sheets)
   std::shared_ptr<const ObjectSurface> split;  ///< `surface` split along them (null before any cut)
   /// With levels of detail (set by LevelsOfDetail): the object's model, which carries the surface and along
   /// whose points it is split, and the active set the simulation's model is; null without.
@@ -80,11 +81,11 @@ struct ProbeAttachment {
 
 /// The probe's contact with `surface` (of the object) over `model`'s points: the whole surface, or with
 /// levels of detail (`active`: the active set `model` is) the part of it that the active set carries.
-SurfaceContact probe_surface_contact(const ObjectSurface& surface, const SurfaceContactParams& params, const ToolShape& shape,
-                                     const Model& model, const ActiveSet* active);
+SurfaceContact probe_surface_contact(const ObjectSurface& surface, const SurfaceContactParams& params,
+                                     const ToolShape& shape, const Model& model, const ActiveSet* active);
 /// The same with the part already made (restrict_surface(), on the worker that built the active set).
-SurfaceContact probe_surface_contact(ActiveSurface part, const SurfaceContactParams& params, const ToolShape& shape, const Model& model,
-                                     const ActiveSet& active);
+SurfaceContact probe_surface_contact(ActiveSurface part, const SurfaceContactParams& params, const ToolShape& shape,
+                                     const Model& model, const ActiveSet& active);
 
 class ModelSimulation {
  public:
@@ -150,11 +151,11 @@ class ModelSimulation {
   State state_;
   Workspace ws_;
   int n_threads_ = 0;
-  mutable double stable_dt_ = 0;  ///< 0: not computed yet (static and implicit kinds, until stable_dt())
-  Points cut_positions_;                 ///< X + u at a cut (kept: no allocation per blade step)
+  mutable double stable_dt_ = 0;          ///< 0: not computed yet (static and implicit kinds, until stable_dt())
+  Points cut_positions_;                  ///< X + u at a cut (kept: no allocation per blade step)
   std::vector<BladeSweep> blade_strips_;  ///< a blade's strips this step
   CutSheets cut_sheets_;
-  std::vector<index_t> sheet_points_;     ///< the points near a sheet being recorded (kept: no allocation per step)
+  std::vector<index_t> sheet_points_;  ///< the points near a sheet being recorded (kept: no allocation per step)
   /// The pairs the cuts severed, kept for the layer above when it asks (levels of detail carry them to the
   /// object), and drained by it.
   bool log_severed_ = false;

@@ -17,7 +17,8 @@
 namespace pointhaptics {
 
 TriangleMesh reconstruct_surface(const Model& model, double edge, double max_nodes) {
-  if (!(edge > 0) || !std::isfinite(edge)) throw Error(fmt::format("surface reconstruction: the grid edge must be > 0 (m), got {}", edge));
+  if (!(edge > 0) || !std::isfinite(edge))
+    throw Error(fmt::format("surface reconstruction: the grid edge must be > 0 (m), got {}", edge));
   const bool own_support = model.support.size() == model.n_points;
   const double h_max = own_support ? model.support.maxCoeff() : model.h;
   // the grid covers the points' supports and one cell more, so the field is 0 on its boundary (closed)
@@ -29,9 +30,12 @@ TriangleMesh reconstruct_surface(const Model& model, double edge, double max_nod
   double total = 1;
   for (int a = 0; a < 3; ++a) total *= std::ceil((hi[a] - lo[a]) / edge) + 1;
   if (!(total <= max_nodes))
-    throw Error(fmt::format("surface reconstruction: a {:.3g} m grid over the object needs {:.3g} nodes (at most {:.3g}); a "
-                            "coarser surface_edge", edge, total, max_nodes));
-  for (int a = 0; a < 3; ++a) field.nodes[static_cast<std::size_t>(a)] = static_cast<index_t>(std::ceil((hi[a] - lo[a]) / edge)) + 1;
+    throw Error(
+        fmt::format("surface reconstruction: a {:.3g} m grid over the object needs {:.3g} nodes (at most {:.3g}); a "
+                    "coarser surface_edge",
+                    edge, total, max_nodes));
+  for (int a = 0; a < 3; ++a)
+    field.nodes[static_cast<std::size_t>(a)] = static_cast<index_t>(std::ceil((hi[a] - lo[a]) / edge)) + 1;
   field.values.assign(static_cast<std::size_t>(total), 0.0);
   const index_t nx = field.nodes[0], ny = field.nodes[1];
   // each point adds its share V_j w(r, h_j) to the nodes within its support
@@ -41,14 +45,18 @@ TriangleMesh reconstruct_surface(const Model& model, double edge, double max_nod
     index_t first[3], last[3];
     for (int a = 0; a < 3; ++a) {
       first[a] = std::max<index_t>(0, static_cast<index_t>(std::ceil((x[a] - h - lo[a]) / edge)));
-      last[a] = std::min<index_t>(field.nodes[static_cast<std::size_t>(a)] - 1, static_cast<index_t>(std::floor((x[a] + h - lo[a]) / edge)));
+      last[a] = std::min<index_t>(field.nodes[static_cast<std::size_t>(a)] - 1,
+                                  static_cast<index_t>(std::floor((x[a] + h - lo[a]) / edge)));
     }
     for (index_t k = first[2]; k <= last[2]; ++k)
       for (index_t jj = first[1]; jj <= last[1]; ++jj)
         for (index_t i = first[0]; i <= last[0]; ++i) {
-          const double r = (lo + edge * Vec3(static_cast<double>(i), static_cast<double>(jj), static_cast<double>(k)) - x).norm();
+          const double r =
+              (lo + edge * Vec3(static_cast<double>(i), static_cast<double>(jj), static_cast<double>(k)) - x).norm();
           // the viscosity kernel is infinite at r = 0: a node on a point takes it a little off
-          if (r < h) field.values[static_cast<std::size_t>(i + nx * (jj + ny * k))] += model.volume[j] * kernel_value(model.kernel.type, std::max(r, 1e-3 * h), h);
+          if (r < h)
+            field.values[static_cast<std::size_t>(i + nx * (jj + ny * k))] +=
+                model.volume[j] * kernel_value(model.kernel.type, std::max(r, 1e-3 * h), h);
         }
   }
   return marching_tetrahedra(field, 0.5);
@@ -75,8 +83,9 @@ ObjectSurface build_object_surface(const Scene& scene, const Model& model) {
       const bool cloud = is_point_cloud_file(o.file);
       if (cloud || is_volume_file(o.file)) {
         surface.mesh = reconstruct_surface(model, edge);
-        surface.source = fmt::format("reconstructed from the {}'s points (the half level of their kernel density), grid {:.3g} mm",
-                                     cloud ? "point cloud" : "volume image", 1e3 * edge);
+        surface.source =
+            fmt::format("reconstructed from the {}'s points (the half level of their kernel density), grid {:.3g} mm",
+                        cloud ? "point cloud" : "volume image", 1e3 * edge);
         break;
       }
       TriangleMesh input = read_mesh(o.file);
@@ -87,7 +96,8 @@ ObjectSurface build_object_surface(const Scene& scene, const Model& model) {
       break;
     }
   }
-  return carried_surface(std::move(surface.mesh), std::move(surface.source), model, fmt::format("{}: the object's surface", scene.path));
+  return carried_surface(std::move(surface.mesh), std::move(surface.source), model,
+                         fmt::format("{}: the object's surface", scene.path));
 }
 
 ObjectSurface carried_surface(TriangleMesh mesh, std::string source, const Model& model, const std::string& name) {

@@ -12,9 +12,9 @@
 namespace pointhaptics {
 
 struct ObjectSurface {
-  TriangleMesh mesh;   ///< reference vertices Y and triangles, counter-clockwise seen from outside
-  SurfaceMap map;      ///< y = Y + W u
-  std::string source;  ///< what it was built from, for the summary ("exact box boundary, edge 3.75 mm", ...)
+  TriangleMesh mesh;      ///< reference vertices Y and triangles, counter-clockwise seen from outside
+  SurfaceMap map;         ///< y = Y + W u
+  std::string source;     ///< what it was built from, for the summary ("exact box boundary, edge 3.75 mm", ...)
   index_t cut_faces = 0;  ///< the last cut_faces triangles of mesh.F are the faces of cuts (cut_surface.hpp)
 };
 

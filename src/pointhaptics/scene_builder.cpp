@@ -62,11 +62,12 @@ void check_model_fits(double n_points, const Scene& scene, double max_memory) {
   const double limit = asked ? max_memory : available_memory();
   const ModelEstimate e = estimate_model(n_points, scene.kernel, scene.object.spacing);
   if (n_points > static_cast<double>(std::numeric_limits<index_t>::max()) / 64 || e.bytes > limit)
-    throw Error(fmt::format("{}:{}: object: {:.3g} points with about {:.0f} neighbours each would need about {:.3g} GB, more than "
-                            "{} ({:.3g} GB); use a coarser spacing{}",
-                            scene.path, scene.object.line, n_points, e.neighbours_per_point, e.bytes / 1e9,
-                            asked ? "--max-memory" : "the memory available", limit / 1e9,
-                            asked ? "" : " (or allow more with --max-memory)"));
+    throw Error(fmt::format(
+        "{}:{}: object: {:.3g} points with about {:.0f} neighbours each would need about {:.3g} GB, more than "
+        "{} ({:.3g} GB); use a coarser spacing{}",
+        scene.path, scene.object.line, n_points, e.neighbours_per_point, e.bytes / 1e9,
+        asked ? "--max-memory" : "the memory available", limit / 1e9,
+        asked ? "" : " (or allow more with --max-memory)"));
 }
 
 bool is_point_cloud_file(const std::string& path) {
@@ -111,8 +112,10 @@ PointCloud sample_shape(const Scene& scene) {
       // point clouds as they are; surface meshes (and PLY files with faces) volume-sampled at the spacing
       if (is_volume_file(o.file)) {
         if (!std::isfinite(o.threshold_low))
-          throw Error(fmt::format("{}:{}: object.threshold: a volume image needs threshold = [low, high] (the intensities "
-                                  "to sample)", scene.path, o.line));
+          throw Error(
+              fmt::format("{}:{}: object.threshold: a volume image needs threshold = [low, high] (the intensities "
+                          "to sample)",
+                          scene.path, o.line));
         return sample_volume(read_volume(o.file), o.threshold_low, o.threshold_high, o.spacing, o.file);
       }
       if (is_point_cloud_file(o.file)) return read_point_cloud(o.file, o.spacing);
@@ -135,7 +138,9 @@ PointCloud sample_object(const Scene& scene) {
     bounds.min.array() -= tol;
     bounds.max.array() += tol;
     try {
-      refine_region(cloud, Refinement{[&r](const Vec3& x, double grow) { return r.contains(x, grow); }, fine_lattice(o, r.spacing, bounds)},
+      refine_region(cloud,
+                    Refinement{[&r](const Vec3& x, double grow) { return r.contains(x, grow); },
+                               fine_lattice(o, r.spacing, bounds)},
                     object_inside(o), support);
     } catch (const Error& e) {
       throw Error(fmt::format("{}:{}: {}", scene.path, r.line, e.what()));
@@ -158,7 +163,9 @@ std::vector<index_t> points_in(const Points& X, const PointSelector& where, doub
     if (where.contains(X.col(i), tol)) inside.push_back(i);
   return inside;
 }
-std::vector<index_t> points_in(const Model& model, const Aabb& box) { return points_in(model.X, PointSelector{box, {}, {}}, region_tolerance(model)); }
+std::vector<index_t> points_in(const Model& model, const Aabb& box) {
+  return points_in(model.X, PointSelector{box, {}, {}}, region_tolerance(model));
+}
 
 // [[region]] tables: each point's material, the object's unless a region (the last one that holds it) says
 // otherwise; none without regions
@@ -192,8 +199,9 @@ void apply_stiffness_map(const Scene& scene, PointCloud& cloud) {
   const auto& map = scene.object.stiffness_map;
   if (map.empty()) return;
   if (cloud.intensity.size() != cloud.size())
-    throw Error(fmt::format("{}:{}: object.stiffness_map: needs a volume image (.nii, .nii.gz, .nrrd, .nhdr) for its intensities",
-                            scene.path, scene.object.line));
+    throw Error(fmt::format(
+        "{}:{}: object.stiffness_map: needs a volume image (.nii, .nii.gz, .nrrd, .nhdr) for its intensities",
+        scene.path, scene.object.line));
   cloud.stiffness_scale.resize(cloud.size());
   for (index_t i = 0; i < cloud.size(); ++i) {
     const double v = cloud.intensity[i];
@@ -230,7 +238,8 @@ Model build_scene_model(const Scene& scene, double max_memory) {
     group.ramp = spec.ramp;
     group.points = points_in(model.X, spec, region_tolerance(model));
     if (group.points.empty())
-      throw Error(fmt::format("{}:{}: fixed[{}].{}: holds no point of the object", scene.path, spec.line, k, spec.key()));
+      throw Error(
+          fmt::format("{}:{}: fixed[{}].{}: holds no point of the object", scene.path, spec.line, k, spec.key()));
     for (index_t i : group.points) model.fixed[i] = 1;
     model.fixed_groups.push_back(std::move(group));
   }
@@ -273,19 +282,22 @@ Vec3 scene_lod_contact(const Scene& scene, const Model& model) {
     const Vec3 lo = model.X.rowwise().minCoeff(), hi = model.X.rowwise().maxCoeff();
     const double away = (scene.lod.contact.cwiseMax(lo).cwiseMin(hi) - scene.lod.contact).stableNorm();
     if (!(away <= model.h))
-      throw Error(fmt::format("{}:{}: lod.contact: [{:.4g}, {:.4g}, {:.4g}] lies {:.3g} m outside the object's bounding box (at most h = {:.3g} m)",
-                              scene.path, scene.lod.line, scene.lod.contact.x(), scene.lod.contact.y(), scene.lod.contact.z(), away, model.h));
+      throw Error(fmt::format(
+          "{}:{}: lod.contact: [{:.4g}, {:.4g}, {:.4g}] lies {:.3g} m outside the object's bounding box (at most h = {:.3g} m)",
+          scene.path, scene.lod.line, scene.lod.contact.x(), scene.lod.contact.y(), scene.lod.contact.z(), away,
+          model.h));
     return scene.lod.contact;
   }
   if (scene.probe.present) {
     const Vec3 lo = model.X.rowwise().minCoeff(), hi = model.X.rowwise().maxCoeff();
-    const Vec3 origin = scene.probe.origin.allFinite() ? scene.probe.origin : Vec3(0.5 * (lo.x() + hi.x()), hi.y(), 0.5 * (lo.z() + hi.z()));
+    const Vec3 origin = scene.probe.origin.allFinite() ? scene.probe.origin
+                                                       : Vec3(0.5 * (lo.x() + hi.x()), hi.y(), 0.5 * (lo.z() + hi.z()));
     return Vec3(origin.x(), std::min(origin.y(), hi.y()), origin.z());
   }
   for (const LoadSpec& l : scene.loads)
     if (l.kind == LoadKind::POINT) return model.X.col(static_cast<index_t>(l.point));
-  throw Error(fmt::format("{}:{}: lod.contact: missing (give contact = [x, y, z], a [probe] or one point load)", scene.path,
-                          scene.lod.line));
+  throw Error(fmt::format("{}:{}: lod.contact: missing (give contact = [x, y, z], a [probe] or one point load)",
+                          scene.path, scene.lod.line));
 }
 
 }  // namespace pointhaptics

@@ -17,7 +17,8 @@ namespace pointhaptics {
 SceneSession open_scene(Scene scene, const SessionOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   SceneSession s;
-  s.simulation = std::make_unique<Simulation>(build_scene_model(scene, options.max_memory), scene.solver, options.threads);
+  s.simulation =
+      std::make_unique<Simulation>(build_scene_model(scene, options.max_memory), scene.solver, options.threads);
   if (scene.lod.present) s.simulation->enable_lod(scene.lod.params, scene_lod_contact(scene, s.simulation->model()));
   for (const CutSpec& cut : scene.cuts) s.simulation->add_scripted_cut(cut);
   if (scene.probe.held()) {
@@ -32,8 +33,8 @@ SceneSession open_scene(Scene scene, const SessionOptions& options) {
     contact.friction = scene.probe.friction;
     contact.non_negative_weights = scene.probe.non_negative_surface_map;
     contact.sample_spacing = scene.probe.sample_spacing;
-    s.simulation->hold_tool(shape, ToolPose{scene.probe.position, Eigen::Quaterniond(q[0], q[1], q[2], q[3])}, surface.mesh, surface.map,
-                            contact);
+    s.simulation->hold_tool(shape, ToolPose{scene.probe.position, Eigen::Quaterniond(q[0], q[1], q[2], q[3])},
+                            surface.mesh, surface.map, contact);
   } else if (scene.probe.present) {
     s.interactive = scene_interactive_options(scene, s.simulation->model());
     // the probe pushes on the object's surface (with levels of detail, on the part the active set carries)
@@ -66,9 +67,12 @@ DeviceSpecs scene_device_specs(const DeviceSpec& d) {
 std::unique_ptr<Device> make_scene_device(const Scene& scene) {
   const DeviceSpecs specs = scene_device_specs(scene.device);
   if (scene.device.kind == "replay") return std::make_unique<ReplayDevice>(read_haptic_log(scene.device.log), specs);
-  if (scene.device.kind == "openhaptics") return std::make_unique<OpenHapticsDevice>(scene.device.library);  // its own specs
-  if (scene.device.kind != "virtual") throw Error(fmt::format("{}: device.kind = \"{}\" is not available", scene.path, scene.device.kind));
-  if (!scene.probe.trajectory.empty()) return std::make_unique<VirtualDevice>(Trajectory::from_csv(scene.probe.trajectory), specs);
+  if (scene.device.kind == "openhaptics")
+    return std::make_unique<OpenHapticsDevice>(scene.device.library);  // its own specs
+  if (scene.device.kind != "virtual")
+    throw Error(fmt::format("{}: device.kind = \"{}\" is not available", scene.path, scene.device.kind));
+  if (!scene.probe.trajectory.empty())
+    return std::make_unique<VirtualDevice>(Trajectory::from_csv(scene.probe.trajectory), specs);
   std::vector<Keyframe> frames;
   for (const auto& k : scene.probe.keyframes) frames.push_back({k[0], Vec3(k[1], k[2], k[3]), k[4] != 0});
   try {

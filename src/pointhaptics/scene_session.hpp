@@ -12,9 +12,9 @@
 namespace pointhaptics {
 
 struct SessionOptions {
-  int threads = 0;          ///< for the force evaluation (0: all hardware threads)
-  double max_memory = 0;    ///< bytes a model may take (0: the memory available); a larger one is refused
-  bool make_device = true;  ///< with a [probe]: open the scene's device (a viewer or Python brings its own)
+  int threads = 0;                     ///< for the force evaluation (0: all hardware threads)
+  double max_memory = 0;               ///< bytes a model may take (0: the memory available); a larger one is refused
+  bool make_device = true;             ///< with a [probe]: open the scene's device (a viewer or Python brings its own)
   std::vector<SceneSetting> settings;  ///< open_scene_file(): keys set over the file's (`--set`, a study's parameters)
 };
 
@@ -25,7 +25,8 @@ struct SceneSession {
   std::unique_ptr<Device> device;
   /// With a [probe]: the probe, workspace mapping and duration of the scene (scene_interactive_options()).
   InteractiveOptions interactive;
-  double setup_seconds = 0;  ///< reading the scene file (open_scene_file), building the model, the solver and the first active set, s
+  double setup_seconds =
+      0;  ///< reading the scene file (open_scene_file), building the model, the solver and the first active set, s
 };
 
 /// Build `scene`: its model (refused beyond options.max_memory), its simulation, levels of detail around

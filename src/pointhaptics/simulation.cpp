@@ -41,7 +41,8 @@ const StepReport& Simulation::step() {
     lod_->mark_stale();
   }
   StepDiagnostics& d = core().diagnostics();  // (the active set's simulation: it may have changed above)
-  d.max_step_seconds = std::max(d.max_step_seconds, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  d.max_step_seconds =
+      std::max(d.max_step_seconds, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   return report;
 }
 
@@ -90,9 +91,10 @@ void Simulation::apply_scripted_cuts() {
     for (index_t i = 0; i < model.n_points; ++i) held[piece_of[i]] |= model.fixed[i];
     for (std::size_t p = 0; p < size.size(); ++p)
       if (!held[p])
-        throw Error(fmt::format("cut: the cuts leave piece {} of {} ({} points) held nowhere: a static solve has no equilibrium "
-                                "for it (use solver.kind = \"explicit\" or \"implicit\", or hold it)",
-                                p + 1, size.size(), size[p]));
+        throw Error(fmt::format(
+            "cut: the cuts leave piece {} of {} ({} points) held nowhere: a static solve has no equilibrium "
+            "for it (use solver.kind = \"explicit\" or \"implicit\", or hold it)",
+            p + 1, size.size(), size[p]));
   }
 }
 
@@ -114,8 +116,8 @@ void Simulation::set_state(const State& state) {
   else object_->set_state(state);
 }
 
-void Simulation::attach_probe(const ProbeParams& params, double coupling_stiffness, double max_force, bool asynchronous_lod,
-                              std::shared_ptr<const ObjectSurface> surface) {
+void Simulation::attach_probe(const ProbeParams& params, double coupling_stiffness, double max_force,
+                              bool asynchronous_lod, std::shared_ptr<const ObjectSurface> surface) {
   ModelSimulation& sim = core();
   if (sim.solver().kind == SolverKind::STATIC) throw Error("probe: needs a dynamic solver (explicit or implicit)");
   if (params.mode == ProbeMode::CUT && !(params.length > 0))
@@ -142,19 +144,23 @@ void Simulation::attach_probe(const ProbeParams& params, double coupling_stiffne
     whole_params.sample_spacing = -1;
     const SurfaceContact whole(lod_->object_model(), surface->mesh, surface->map, probe_shape(params), whole_params);
     contact.penalty = whole.per_area_penalty();
-    contact.object_point_stiffness = std::make_shared<const std::vector<double>>(whole.point_stiffness(lod_->object_model().n_points));
+    contact.object_point_stiffness =
+        std::make_shared<const std::vector<double>>(whole.point_stiffness(lod_->object_model().n_points));
   }
   std::optional<SurfaceContact> on_surface;
   if (surface)
-    on_surface.emplace(probe_surface_contact(*surface, contact, probe_shape(params), sim.model(), lod_ ? &lod_->active_set() : nullptr));
-  sim.probe().emplace(ProbeAttachment{ProbeTool(sim.model(), params, coupling_stiffness, max_force, std::move(on_surface)),
-                                      asynchronous_lod, std::move(surface), contact, 0, nullptr, nullptr, nullptr});
+    on_surface.emplace(probe_surface_contact(*surface, contact, probe_shape(params), sim.model(),
+                                             lod_ ? &lod_->active_set() : nullptr));
+  sim.probe().emplace(
+      ProbeAttachment{ProbeTool(sim.model(), params, coupling_stiffness, max_force, std::move(on_surface)),
+                      asynchronous_lod, std::move(surface), contact, 0, nullptr, nullptr, nullptr});
   sim.inputs() = StepInputs{};
 }
 
 void Simulation::hold_tool(const ToolShape& shape, const ToolPose& pose, const TriangleMesh& mesh, SurfaceMap map,
                            const SurfaceContactParams& params) {
-  if (lod_) throw Error("tool: a held tool with levels of detail is not available yet (its surface map is the object's)");
+  if (lod_)
+    throw Error("tool: a held tool with levels of detail is not available yet (its surface map is the object's)");
   ModelSimulation& sim = core();
   if (sim.probe()) throw Error("tool: the simulation already has a probe (one tool at a time)");
   SurfaceContactParams contact = params;
@@ -229,11 +235,15 @@ void check_physical(const Model& model, Workspace& ws, const StepDiagnostics& d,
   s.converged = false;
   if (!s.failure.empty()) return;
   if (s.inverted > 0)
-    s.failure = fmt::format("{} of {} neighbourhoods are inverted (det F <= 0): the state is not physical (try "
-                            "model = \"neo_hookean\", a finer load ramp or a finer spacing)", s.inverted, model.stencil_end());
+    s.failure = fmt::format(
+        "{} of {} neighbourhoods are inverted (det F <= 0): the state is not physical (try "
+        "model = \"neo_hookean\", a finer load ramp or a finer spacing)",
+        s.inverted, model.stencil_end());
   else
-    s.failure = fmt::format("{}: the support force opposes the prescribed motion (the body collapsed: its stress fell "
-                            "instead of rising; try model = \"neo_hookean\")", s.collapsed.front());
+    s.failure = fmt::format(
+        "{}: the support force opposes the prescribed motion (the body collapsed: its stress fell "
+        "instead of rising; try model = \"neo_hookean\")",
+        s.collapsed.front());
 }
 
 }  // namespace
@@ -248,8 +258,14 @@ ToolSummary Simulation::tool_summary() {
   ModelSimulation& sim = core();
   if (HeldTool* tool = sim.held_tool().get()) {
     const ToolLoad load = tool->load(sim.model(), sim.state().u);
-    return {true, tool_kind_name(tool->shape()), tool->pose().position, load.force, load.torque,
-            load.contacts, load.penetration, load.friction};
+    return {true,
+            tool_kind_name(tool->shape()),
+            tool->pose().position,
+            load.force,
+            load.torque,
+            load.contacts,
+            load.penetration,
+            load.friction};
   }
   if (const ProbeTool* probe = this->probe()) {
     // the probe's local model at the last step's end: the force the object exerts on it there; on the surface
@@ -257,8 +273,14 @@ ToolSummary Simulation::tool_summary() {
     const ContactModel& c = probe->contact_model();
     if (const SurfaceContact* surface = probe->surface_contact()) {
       const ToolLoad& load = surface->last_load();
-      return {true, tool_kind_name(surface->shape()), probe->probe(), c.f0, load.torque, c.contacts,
-              load.penetration, load.friction};
+      return {true,
+              tool_kind_name(surface->shape()),
+              probe->probe(),
+              c.f0,
+              load.torque,
+              c.contacts,
+              load.penetration,
+              load.friction};
     }
     return {true, "sphere", probe->probe(), c.f0, Vec3::Zero(), c.contacts, 0.0, Vec3::Zero()};
   }

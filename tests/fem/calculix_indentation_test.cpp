@@ -12,7 +12,8 @@ namespace pointhaptics::fem {
 namespace {
 
 int count(const std::string& text, const std::regex& pattern) {
-  return static_cast<int>(std::distance(std::sregex_iterator(text.begin(), text.end(), pattern), std::sregex_iterator()));
+  return static_cast<int>(
+      std::distance(std::sregex_iterator(text.begin(), text.end(), pattern), std::sregex_iterator()));
 }
 
 TEST(CalculixIndentationDeck, HasTheSphereTheBlockTheContactAndOneMovedSet) {
@@ -25,7 +26,8 @@ TEST(CalculixIndentationDeck, HasTheSphereTheBlockTheContactAndOneMovedSet) {
   EXPECT_EQ(count(deck, std::regex("\\*ELEMENT, TYPE=CAX8")), 2);
   EXPECT_EQ(count(deck, std::regex("\\n\\d+, \\d+, \\d+, \\d+, \\d+, \\d+, \\d+, \\d+, \\d+\\n")) > 0, true);
   EXPECT_NE(deck.find("*HYPERELASTIC, NEO HOOKE"), std::string::npos);
-  EXPECT_NE(deck.find("*CONTACT PAIR, INTERACTION=FRICTIONLESS, TYPE=SURFACE TO SURFACE\nSTOP, SBALL"), std::string::npos);
+  EXPECT_NE(deck.find("*CONTACT PAIR, INTERACTION=FRICTIONLESS, TYPE=SURFACE TO SURFACE\nSTOP, SBALL"),
+            std::string::npos);
   EXPECT_EQ(deck.find("*FRICTION"), std::string::npos);
   EXPECT_NE(deck.find("NMOVE, 2, 2, -0.003"), std::string::npos);
   EXPECT_NE(deck.find("*STEP, NLGEOM"), std::string::npos);

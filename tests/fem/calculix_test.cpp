@@ -24,7 +24,8 @@ BoxProblem cantilever(double force, int nx, int ny, int nz) {
 }
 
 int count(const std::string& text, const std::regex& pattern) {
-  return static_cast<int>(std::distance(std::sregex_iterator(text.begin(), text.end(), pattern), std::sregex_iterator()));
+  return static_cast<int>(
+      std::distance(std::sregex_iterator(text.begin(), text.end(), pattern), std::sregex_iterator()));
 }
 
 TEST(CalculixDeck, MeshHasTheNodesAndElementsOfAQuadraticGrid) {
@@ -64,7 +65,7 @@ TEST(CalculixDeck, TractionBecomesConsistentNodalForcesThatSumToTheTotal) {
     if (nodes(1, node - 1) == 0 && nodes(2, node - 1) == 0) corner = value;
     if (nodes(1, node - 1) == 0 && std::abs(nodes(2, node - 1) - 0.0075) < 1e-12) mid = value;
   }
-  EXPECT_EQ(lines, 21);  // the 5 x 5 node face without its 4 face centres
+  EXPECT_EQ(lines, 21);            // the 5 x 5 node face without its 4 face centres
   EXPECT_NEAR(sum, -0.01, 1e-14);  // 13 significant digits in the deck
   EXPECT_NEAR(corner, 0.01 / 4 / 12, 1e-15);
   EXPECT_NEAR(mid, -0.01 / 4 / 3, 1e-15);
@@ -176,7 +177,8 @@ TEST(CalculixDeck, HyperelasticCardsCarryOurModelsConstants) {
   EXPECT_EQ(p.material, FemMaterial::NEO_HOOKE);
   EXPECT_NEAR(p.c10, m.mu() / 2, 1e-9);
   EXPECT_NEAR(p.d1, 2 / m.bulk_modulus(), 1e-18);
-  EXPECT_NE(write_inp(p).find(fmt::format("*HYPERELASTIC, NEO HOOKE\n{:.13g}, {:.13g}\n", p.c10, p.d1)), std::string::npos);
+  EXPECT_NE(write_inp(p).find(fmt::format("*HYPERELASTIC, NEO HOOKE\n{:.13g}, {:.13g}\n", p.c10, p.d1)),
+            std::string::npos);
   m.model = MaterialModel::MOONEY_RIVLIN;
   m.c10 = 3, m.c01 = 1;
   set_material(p, m);

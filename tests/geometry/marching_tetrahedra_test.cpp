@@ -16,10 +16,12 @@ GridField sample(const std::function<double(const Vec3&)>& f, const Vec3& lo, co
   GridField g;
   g.origin = lo;
   g.cell = cell;
-  for (int a = 0; a < 3; ++a) g.nodes[static_cast<std::size_t>(a)] = static_cast<index_t>(std::ceil((hi[a] - lo[a]) / cell)) + 1;
+  for (int a = 0; a < 3; ++a)
+    g.nodes[static_cast<std::size_t>(a)] = static_cast<index_t>(std::ceil((hi[a] - lo[a]) / cell)) + 1;
   for (index_t k = 0; k < g.nodes[2]; ++k)
     for (index_t j = 0; j < g.nodes[1]; ++j)
-      for (index_t i = 0; i < g.nodes[0]; ++i) g.values.push_back(f(lo + cell * Vec3(static_cast<double>(i), static_cast<double>(j), static_cast<double>(k))));
+      for (index_t i = 0; i < g.nodes[0]; ++i)
+        g.values.push_back(f(lo + cell * Vec3(static_cast<double>(i), static_cast<double>(j), static_cast<double>(k))));
   return g;
 }
 
@@ -29,7 +31,8 @@ TEST(MarchingTetrahedra, ASphereIsClosedOutwardAndConvergesToTheSphere) {
   double previous = 1;
   for (double cell : {0.1, 0.05, 0.025}) {
     // a field whose level 0 is the sphere: R - |x - c|, linear along rays
-    const GridField g = sample([&](const Vec3& x) { return R - (x - c).norm(); }, Vec3::Constant(-0.5), Vec3::Constant(0.5), cell);
+    const GridField g =
+        sample([&](const Vec3& x) { return R - (x - c).norm(); }, Vec3::Constant(-0.5), Vec3::Constant(0.5), cell);
     const TriangleMesh mesh = marching_tetrahedra(g, 0.0);
     EXPECT_NO_THROW(check_closed_manifold(mesh, "sphere"));
     double worst = 0;

@@ -96,7 +96,8 @@ TEST(MeshDistance, TheNearestPointWithinARadiusIsSignedAsTheWholeMeshsDistance) 
   // its edge or corner, where the part ends, it is not
   TriangleMesh top = mesh;
   std::erase_if(top.F, [&](const std::array<index_t, 3>& f) {
-    return mesh.V(1, f[0]) < size.y() - 1e-12 || mesh.V(1, f[1]) < size.y() - 1e-12 || mesh.V(1, f[2]) < size.y() - 1e-12;
+    return mesh.V(1, f[0]) < size.y() - 1e-12 || mesh.V(1, f[1]) < size.y() - 1e-12 ||
+           mesh.V(1, f[2]) < size.y() - 1e-12;
   });
   ASSERT_GT(top.F.size(), 10u);
   const Vec3 middle = origin + Vec3(0.31 * size.x(), size.y(), 0.43 * size.z());
@@ -105,8 +106,10 @@ TEST(MeshDistance, TheNearestPointWithinARadiusIsSignedAsTheWholeMeshsDistance) 
     EXPECT_TRUE(side->sure);
     EXPECT_NEAR(side->distance, off, 1e-12);
   }
-  EXPECT_FALSE(nearest_surface_within(origin + Vec3(-0.001, size.y() - 0.002, 0.5 * size.z()), top.V, top.F, radius)->sure);  // an edge
-  EXPECT_FALSE(nearest_surface_within(origin + Vec3(-0.001, size.y() - 0.002, -0.001), top.V, top.F, radius)->sure);  // a corner
+  EXPECT_FALSE(nearest_surface_within(origin + Vec3(-0.001, size.y() - 0.002, 0.5 * size.z()), top.V, top.F, radius)
+                   ->sure);  // an edge
+  EXPECT_FALSE(
+      nearest_surface_within(origin + Vec3(-0.001, size.y() - 0.002, -0.001), top.V, top.F, radius)->sure);  // a corner
 }
 
 }  // namespace

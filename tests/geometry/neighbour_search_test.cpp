@@ -36,7 +36,8 @@ TEST(RadiusNeighbours, PerPointSupportsAreSymmetricAndMatchBruteForce) {
   std::vector<index_t> offset{0}, index;
   for (index_t i = 0; i < X.cols(); ++i) {
     for (index_t j = 0; j < X.cols(); ++j)
-      if (j != i && within_support((X.col(j) - X.col(i)).squaredNorm(), std::max(support[i], support[j]))) index.push_back(j);
+      if (j != i && within_support((X.col(j) - X.col(i)).squaredNorm(), std::max(support[i], support[j])))
+        index.push_back(j);
     offset.push_back(static_cast<index_t>(index.size()));
   }
   EXPECT_EQ(a.offset, offset);

@@ -28,7 +28,8 @@ TEST(Remesh, AFarFinerSphereIsSimplifiedClosedAndFaithful) {
   EXPECT_NE(r.change.find("simplified"), std::string::npos) << r.change;
   EXPECT_LT(r.mesh.F.size(), sphere.F.size() / 20);
   EXPECT_NO_THROW(check_closed_manifold(r.mesh, "simplified sphere"));
-  EXPECT_NEAR(enclosed_volume(r.mesh), enclosed_volume(sphere), 0.015 * enclosed_volume(sphere));  // inscribed at 8 mm: -1%
+  EXPECT_NEAR(enclosed_volume(r.mesh), enclosed_volume(sphere),
+              0.015 * enclosed_volume(sphere));  // inscribed at 8 mm: -1%
   EXPECT_GT(mean_edge_length(r.mesh), 0.5 * 0.008);
 }
 

@@ -76,8 +76,8 @@ TEST(HalfSphereSurface, IsClosedOutwardOnTheDomeAndTheDiskAndConvergesToItsVolum
     for (Eigen::Index v = 0; v < mesh.V.cols(); ++v) {
       const Vec3 p = mesh.V.col(v) - centre;
       EXPECT_GE(p.y(), 0);
-      if (p.y() > 0) EXPECT_NEAR(p.norm(), radius, 1e-14);        // the dome
-      else EXPECT_LE(p.norm(), radius * (1 + 1e-14));             // the disk
+      if (p.y() > 0) EXPECT_NEAR(p.norm(), radius, 1e-14);  // the dome
+      else EXPECT_LE(p.norm(), radius * (1 + 1e-14));       // the disk
     }
     // the disk faces down, the dome up
     for (const auto& f : mesh.F) {

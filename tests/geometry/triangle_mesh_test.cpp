@@ -22,7 +22,8 @@ namespace {
 TriangleMesh box(const Vec3& lo, const Vec3& hi) {
   TriangleMesh m;
   m.V.resize(3, 8);
-  for (int c = 0; c < 8; ++c) m.V.col(c) = Vec3(c & 1 ? hi.x() : lo.x(), c & 2 ? hi.y() : lo.y(), c & 4 ? hi.z() : lo.z());
+  for (int c = 0; c < 8; ++c)
+    m.V.col(c) = Vec3(c & 1 ? hi.x() : lo.x(), c & 2 ? hi.y() : lo.y(), c & 4 ? hi.z() : lo.z());
   m.F = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
          {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
   return m;
@@ -31,11 +32,12 @@ TriangleMesh box(const Vec3& lo, const Vec3& hi) {
 // an icosphere (3 subdivisions: 1280 triangles)
 TriangleMesh sphere(double r) {
   const double t = (1 + std::sqrt(5.0)) / 2;
-  std::vector<Vec3> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                         {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-  std::vector<std::array<index_t, 3>> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-                                           {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-                                           {3, 8, 9},  {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+  std::vector<Vec3> v = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
+                         {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
+  std::vector<std::array<index_t, 3>> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                                           {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                                           {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                                           {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
   for (int level = 0; level < 3; ++level) {
     std::map<std::pair<index_t, index_t>, index_t> mid;
     auto middle = [&](index_t a, index_t b) {
@@ -119,7 +121,8 @@ std::string write(const std::string& name, const std::string& text) {
 TEST(MeshFile, ObjStlAndPlyMeshesBecomeSolidsInAScene) {
   const TriangleMesh b = box(Vec3::Zero(), Vec3(0.04, 0.03, 0.02));
   std::ostringstream obj, stl, ply;
-  for (Eigen::Index v = 0; v < b.V.cols(); ++v) obj << "v " << b.V(0, v) << ' ' << b.V(1, v) << ' ' << b.V(2, v) << '\n';
+  for (Eigen::Index v = 0; v < b.V.cols(); ++v)
+    obj << "v " << b.V(0, v) << ' ' << b.V(1, v) << ' ' << b.V(2, v) << '\n';
   for (const auto& f : b.F) obj << "f " << f[0] + 1 << ' ' << f[1] + 1 << ' ' << f[2] + 1 << '\n';
   stl << "solid box\n";
   for (const auto& f : b.F) {
@@ -135,17 +138,21 @@ TEST(MeshFile, ObjStlAndPlyMeshesBecomeSolidsInAScene) {
   for (const auto& [name, text] : {std::pair{"box.obj", obj.str()}, {"box.stl", stl.str()}, {"box.ply", ply.str()}}) {
     const std::string path = write(name, text);
     EXPECT_EQ(read_mesh(path).F.size(), 12u) << name;
-    const Scene scene = parse_scene("[object]\nshape = \"file\"\nfile = \"" + path + "\"\nspacing = 0.01\n", "mesh.toml");
+    const Scene scene =
+        parse_scene("[object]\nshape = \"file\"\nfile = \"" + path + "\"\nspacing = 0.01\n", "mesh.toml");
     const Model m = build_scene_model(scene);
     EXPECT_EQ(m.n_points, 4 * 3 * 2) << name;
   }
   // an open mesh in a file: the scene says why
   std::ostringstream open;
-  for (Eigen::Index v = 0; v < b.V.cols(); ++v) open << "v " << b.V(0, v) << ' ' << b.V(1, v) << ' ' << b.V(2, v) << '\n';
-  for (std::size_t t = 0; t + 1 < b.F.size(); ++t) open << "f " << b.F[t][0] + 1 << ' ' << b.F[t][1] + 1 << ' ' << b.F[t][2] + 1 << '\n';
+  for (Eigen::Index v = 0; v < b.V.cols(); ++v)
+    open << "v " << b.V(0, v) << ' ' << b.V(1, v) << ' ' << b.V(2, v) << '\n';
+  for (std::size_t t = 0; t + 1 < b.F.size(); ++t)
+    open << "f " << b.F[t][0] + 1 << ' ' << b.F[t][1] + 1 << ' ' << b.F[t][2] + 1 << '\n';
   const std::string path = write("open.obj", open.str());
   try {
-    build_scene_model(parse_scene("[object]\nshape = \"file\"\nfile = \"" + path + "\"\nspacing = 0.01\n", "open.toml"));
+    build_scene_model(
+        parse_scene("[object]\nshape = \"file\"\nfile = \"" + path + "\"\nspacing = 0.01\n", "open.toml"));
     ADD_FAILURE() << "an open mesh was sampled";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("open.obj: the mesh is open"), std::string::npos) << e.what();

@@ -37,7 +37,8 @@ TEST(ContactSamples, SplitsEveryLongEdgeOnceAndCarriesEachSampleByItsTrianglesVe
   ASSERT_EQ(out.parents.size(), 21u);
   EXPECT_EQ(out.triangles.size(), 32u);
   std::set<std::pair<long, long>> places;  // no two points at one place
-  for (index_t p = 0; p < 25; ++p) places.insert({std::lround(position(mesh, out, p).x() * 1e6), std::lround(position(mesh, out, p).z() * 1e6)});
+  for (index_t p = 0; p < 25; ++p)
+    places.insert({std::lround(position(mesh, out, p).x() * 1e6), std::lround(position(mesh, out, p).z() * 1e6)});
   EXPECT_EQ(places.size(), 25u);
   double area = 0;
   for (const auto& t : out.triangles) {

@@ -48,7 +48,7 @@ TEST(ProbeContact, PushMovesTouchedPointsOutAndTheProbeFeelsTheOpposite) {
     if (f.col(i).norm() == 0) continue;
     ++touched;
     EXPECT_LE((model.X.col(i) - probe).norm(), p.radius + 0.5 * s + 1e-12);  // only overlapping spheres
-    EXPECT_GT((model.X.col(i) - probe).dot(f.col(i)), 0.0);  // pushed away from the probe centre
+    EXPECT_GT((model.X.col(i) - probe).dot(f.col(i)), 0.0);                  // pushed away from the probe centre
   }
   EXPECT_EQ(touched, cm.contacts);
   // K is symmetric negative semi-definite

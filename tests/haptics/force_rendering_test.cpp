@@ -159,7 +159,8 @@ TEST(ForceRenderer, PassivityControllerKeepsTheObserverAtOrAboveZero) {
   ForceRules rules;
   rules.ramp_time = 0;
   rules.max_change = 100;
-  rules.passivity_speed = 0;  // the force's part along the velocity taken out at any speed (the default fades it, below)
+  rules.passivity_speed =
+      0;  // the force's part along the velocity taken out at any speed (the default fades it, below)
   const DeviceSpecs touch = known_device_specs("touch");
   const double dt = 1e-3;
   ForceRenderer active(touch, rules), spring(touch, rules);
@@ -184,7 +185,8 @@ TEST(ForceRenderer, PassivityControllerKeepsTheObserverAtOrAboveZero) {
   }
   EXPECT_GT(least, -1e-12);
   EXPECT_GT(active.controller_ticks(), 290);
-  EXPECT_NEAR(active.controller_dissipated(), 300 * 0.5 * 0.02 * dt + active.observed_energy(), 1e-9);  // what the force gave beyond 1 mJ
+  EXPECT_NEAR(active.controller_dissipated(), 300 * 0.5 * 0.02 * dt + active.observed_energy(),
+              1e-9);  // what the force gave beyond 1 mJ
   // a spring the hand goes into and back out of along the same path needs no control
   for (int t = 0; t < 2000; ++t) {
     const double x = 0.005 * std::sin(M_PI * t / 1000.0), speed = 0.005 * M_PI * std::cos(M_PI * t / 1000.0);

@@ -13,7 +13,8 @@ std::string temp(const std::string& name) { return ::testing::TempDir() + name; 
 TEST(HapticLog, RoundTrips) {
   std::vector<HapticLogRow> rows;
   for (int k = 0; k <= 10; ++k)
-    rows.push_back({k * 1e-3, Vec3(0, -1e-3 * k, 0), Vec3(0, -1.0, 0), k >= 5 ? 1u : 0u, Vec3(0, 0.01 * k, 0), Vec3(1e-4 * k, 0, -2e-4)});
+    rows.push_back({k * 1e-3, Vec3(0, -1e-3 * k, 0), Vec3(0, -1.0, 0), k >= 5 ? 1u : 0u, Vec3(0, 0.01 * k, 0),
+                    Vec3(1e-4 * k, 0, -2e-4)});
   write_haptic_log(temp("log.csv"), rows);
   const std::vector<HapticLogRow> back = read_haptic_log(temp("log.csv"));
   ASSERT_EQ(back.size(), rows.size());
@@ -45,8 +46,8 @@ TEST(HapticLog, BadLogsAreNamedErrors) {
     return std::string("accepted");
   };
   EXPECT_NE(error_of("t,x,y,z,vx,vy,vz,buttons,fx,fy,fz\n").find("no rows"), std::string::npos);
-  EXPECT_NE(error_of("0,0,0,0,0,0,0,0,0,0\n").find("bad.csv:1:"), std::string::npos);        // 10 fields
-  EXPECT_NE(error_of("0,0,0,0,0,0,0,0,0,0,0,0\n").find("bad.csv:1:"), std::string::npos);    // 12 fields
+  EXPECT_NE(error_of("0,0,0,0,0,0,0,0,0,0\n").find("bad.csv:1:"), std::string::npos);            // 10 fields
+  EXPECT_NE(error_of("0,0,0,0,0,0,0,0,0,0,0,0\n").find("bad.csv:1:"), std::string::npos);        // 12 fields
   EXPECT_NE(error_of("0,0,0,0,0,0,0,0,0,0,0,0,0,0,0\n").find("bad.csv:1:"), std::string::npos);  // 15 fields
   EXPECT_NE(error_of("0,0,nan,0,0,0,0,0,0,0,0\n").find("bad.csv:1:"), std::string::npos);
   EXPECT_NE(error_of("1,0,0,0,0,0,0,0,0,0,0\n0.5,0,0,0,0,0,0,0,0,0,0\n").find("bad.csv:2: time does not increase"),

@@ -12,7 +12,10 @@ namespace pointhaptics {
 namespace {
 
 // a device held still at its origin (no hand dynamics to speak of)
-VirtualDevice still_device() { return VirtualDevice(Trajectory({{0.0, Vec3::Zero(), false}, {10.0, Vec3::Zero(), false}}), known_device_specs("touch")); }
+VirtualDevice still_device() {
+  return VirtualDevice(Trajectory({{0.0, Vec3::Zero(), false}, {10.0, Vec3::Zero(), false}}),
+                       known_device_specs("touch"));
+}
 
 TEST(HapticLoop, WithoutContactTheProbeIsTheDevicePointAndNoForceIsFelt) {
   VirtualDevice device = still_device();

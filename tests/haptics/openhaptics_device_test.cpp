@@ -22,17 +22,17 @@ TEST(OpenHapticsDevice, ConvertsUnitsAndReadsSpecs) {
   OpenHapticsDevice device(PH_FAKE_HD_PATH);
   const DeviceSpecs s = device.specs();
   EXPECT_DOUBLE_EQ(s.max_force, 0.88);
-  EXPECT_DOUBLE_EQ(s.max_stiffness, 400.0);          // 0.4 N/mm
-  EXPECT_NEAR(s.max_damping, 3.0, 1e-12);            // 0.003 N s/mm
-  EXPECT_NEAR(s.workspace_radius, 0.035, 1e-12);     // the 70 mm depth of the usable box, halved
+  EXPECT_DOUBLE_EQ(s.max_stiffness, 400.0);       // 0.4 N/mm
+  EXPECT_NEAR(s.max_damping, 3.0, 1e-12);         // 0.003 N s/mm
+  EXPECT_NEAR(s.workspace_radius, 0.035, 1e-12);  // the 70 mm depth of the usable box, halved
   EXPECT_EQ(hook<int (*)()>("fake_hd_enabled")(), 1);
   const DeviceState st = device.read(0.001);
-  EXPECT_NEAR(st.position.norm(), 0.010, 1e-12);     // 10 mm
+  EXPECT_NEAR(st.position.norm(), 0.010, 1e-12);  // 10 mm
   EXPECT_NEAR(st.velocity.norm(), 0.010 * 1000 * M_PI / 180, 1e-12);
   device.command(Vec3(0.1, -0.2, 0.3));
   double f[3];
   hook<void (*)(double*)>("fake_hd_last_force")(f);
-  EXPECT_DOUBLE_EQ(f[1], -0.2);                      // N at the boundary, as HD wants
+  EXPECT_DOUBLE_EQ(f[1], -0.2);  // N at the boundary, as HD wants
   device.stop();
   hook<void (*)(double*)>("fake_hd_last_force")(f);
   EXPECT_EQ(f[0] * f[0] + f[1] * f[1] + f[2] * f[2], 0.0);
@@ -75,7 +75,8 @@ TEST(OpenHapticsDevice, ASixDegreeOfFreedomDeviceTakesTheToolsTorqueInMilliNewto
     EXPECT_DOUBLE_EQ(device.specs().max_torque, 0.15);  // 150 mN m
     // the stylus's orientation from its transform: turned about z by one degree a frame
     const DeviceState st = device.read(0.001);
-    EXPECT_NEAR(st.orientation.angularDistance(Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 180, Vec3::UnitZ()))), 0.0, 1e-12);
+    EXPECT_NEAR(st.orientation.angularDistance(Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 180, Vec3::UnitZ()))), 0.0,
+                1e-12);
     device.command(Vec3::Zero());  // (ends the frame the read began)
     // through the loop: the published contact's torque, ramped in with the force and within the device's
     // maximum, reaches the device in mN m
@@ -91,7 +92,7 @@ TEST(OpenHapticsDevice, ASixDegreeOfFreedomDeviceTakesTheToolsTorqueInMilliNewto
     double t[3];
     hook<void (*)(double*)>("fake_hd_last_torque")(t);
     const Vec3 sent = Vec3(t[0], t[1], t[2]);
-    EXPECT_NEAR(sent.norm(), 150.0, 1e-9);  // mN m: clamped to the maximum
+    EXPECT_NEAR(sent.norm(), 150.0, 1e-9);                                  // mN m: clamped to the maximum
     EXPECT_NEAR(sent.normalized().dot(m.torque.normalized()), 1.0, 1e-12);  // in the contact's direction
     loop.frames().update();
     EXPECT_NEAR((loop.frames().front().torque - 1e-3 * sent).norm(), 0.0, 1e-12);

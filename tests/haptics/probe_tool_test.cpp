@@ -94,9 +94,11 @@ struct SurfaceProbe {
   /// (sample_spacing: SurfaceContactParams's; negative, the surface's vertices only)
   SurfaceProbe(double radius, double edge, double k, double sample_spacing = 0)
       : model(build_model(sample_box(Vec3::Zero(), Vec3(0.04, 0.02, 0.04), 0.005), MaterialParams{}, KernelParams{})),
-        mesh(box_surface(Vec3::Zero(), Vec3(0.04, 0.02, 0.04), edge)), params(with_radius(radius)),
+        mesh(box_surface(Vec3::Zero(), Vec3(0.04, 0.02, 0.04), edge)),
+        params(with_radius(radius)),
         tool(model, params, k, 10.0,
-             SurfaceContact(model, mesh, build_surface_map(model, mesh.V), probe_shape(params), capped(model, sample_spacing))) {}
+             SurfaceContact(model, mesh, build_surface_map(model, mesh.V), probe_shape(params),
+                            capped(model, sample_spacing))) {}
   static SurfaceContactParams capped(const Model& model, double sample_spacing) {
     SurfaceContactParams p;
     p.sample_spacing = sample_spacing;
@@ -120,7 +122,7 @@ TEST(ProbeTool, OnTheSurfaceAPushIsNotTakenThroughAFaceBetweenItsVertices) {
   s.tool.place(s.model, state, above, false);
   ASSERT_NEAR((s.tool.probe() - above).norm(), 0.0, 1e-12);  // nothing touched yet
   for (int step = 0; step < 20; ++step) s.tool.place(s.model, state, deep, false);
-  EXPECT_GE(s.tool.probe().y(), 0.02);  // its centre stopped at the face
+  EXPECT_GE(s.tool.probe().y(), 0.02);          // its centre stopped at the face
   EXPECT_LT(s.tool.probe().y(), 0.02 + 0.004);  // it moved down to it
   EXPECT_NEAR(s.tool.probe().x(), 0.012, 1e-9);
 }
@@ -134,7 +136,7 @@ TEST(ProbeTool, OnTheSurfaceAProbeTheSurfaceFlowedOverIsPutBackOnIt) {
   const Vec3 device(0.02, 0.02 + 0.5 * radius, 0.02);
   s.tool.place(s.model, state, device, false);
   ASSERT_LT(s.tool.probe().y(), 0.02 + radius);  // on the surface: touching it
-  state.u.row(1).setConstant(2 * radius);  // the top face now 1.5 R above the probe's centre
+  state.u.row(1).setConstant(2 * radius);        // the top face now 1.5 R above the probe's centre
   s.tool.place(s.model, state, device, false);
   EXPECT_GE(s.tool.probe().y(), 0.02 + 2 * radius);
   EXPECT_TRUE(s.tool.probe().allFinite());

@@ -35,9 +35,7 @@ TEST(ReplayDevice, IsOpenLoopAndReadsBackwardsToo) {
   EXPECT_NEAR(replay.read(1e-3).position.y(), -1e-3, 1e-12);  // the cursor goes back as well
 }
 
-TEST(ReplayDevice, AnEmptyLogIsANamedError) {
-  EXPECT_THROW(ReplayDevice({}, known_device_specs("touch")), Error);
-}
+TEST(ReplayDevice, AnEmptyLogIsANamedError) { EXPECT_THROW(ReplayDevice({}, known_device_specs("touch")), Error); }
 
 }  // namespace
 }  // namespace pointhaptics

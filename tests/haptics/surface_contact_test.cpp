@@ -72,8 +72,8 @@ std::vector<ToolCase> tools() {
 
 // Forces are the energy's gradient (central differences of the energy) and the exact tangent their
 // derivative (central differences of the forces), at u along a random direction.
-void expect_forces_are_the_gradient_and_the_tangent_their_derivative(SurfaceContact& contact, const Model& model, const Points& u,
-                                                                      const Points& f) {
+void expect_forces_are_the_gradient_and_the_tangent_their_derivative(SurfaceContact& contact, const Model& model,
+                                                                     const Points& u, const Points& f) {
   const Points du = random_field(model.n_points, 1e-4, 5);
   const double eps = 1e-4;
   const double dE = (contact.energy(model, u + eps * du) - contact.energy(model, u - eps * du)) / (2 * eps);
@@ -148,7 +148,8 @@ TEST(SurfaceContact, ItsTangentEntersTheAssembledMatrixWithItsCoupling) {
     // the coupling is there: K's off-diagonal blocks carry most of the contact (a diagonal alone would be far off)
     for (index_t j = 0; j < b.model.n_points; ++j)
       for (index_t e = K.pattern.begin(j); e < K.pattern.end(j); ++e)
-        if (K.pattern.index[e] != j) coupled += Eigen::Map<const Mat3>(K.values.data() + 9 * static_cast<std::size_t>(e)).norm();
+        if (K.pattern.index[e] != j)
+          coupled += Eigen::Map<const Mat3>(K.values.data() + 9 * static_cast<std::size_t>(e)).norm();
     EXPECT_GT(coupled, 0);
     EXPECT_LT(worst, 0.5 * scale) << "close to the contact's own tangent";
   }
@@ -167,8 +168,9 @@ Press pressed_block(double radius, double depth, double x, double z, const Surfa
   SolverSpec spec;
   spec.kind = SolverKind::STATIC;
   Simulation sim(std::move(b.model), spec, 2);
-  sim.hold_tool(ToolShape{ToolKind::SPHERE, radius, 0}, ToolPose{Vec3(x, 0.02 + radius - depth, z), Eigen::Quaterniond::Identity()},
-                surface, build_surface_map(sim.model(), surface.V), params);
+  sim.hold_tool(ToolShape{ToolKind::SPHERE, radius, 0},
+                ToolPose{Vec3(x, 0.02 + radius - depth, z), Eigen::Quaterniond::Identity()}, surface,
+                build_surface_map(sim.model(), surface.V), params);
   return {std::move(sim), std::move(surface)};
 }
 
@@ -227,7 +229,8 @@ TEST(SurfaceContact, StaticIndentationByASphereNarrowerThanTheTrianglesMeetsTheC
     const SurfaceContact& contact = sim.held_tool()->contact();
     double under = NAN;
     for (index_t v = contact.surface_vertices(); v < contact.vertices().cols(); ++v)
-      if (std::hypot(contact.vertices()(0, v) - 0.02125, contact.vertices()(2, v) - 0.02125) < 1e-5 && contact.vertices()(1, v) > 0.01)
+      if (std::hypot(contact.vertices()(0, v) - 0.02125, contact.vertices()(2, v) - 0.02125) < 1e-5 &&
+          contact.vertices()(1, v) > 0.01)
         under = contact.vertices()(1, v);
     EXPECT_NEAR(under, 0.02 - depth, 0.01 * depth);
   }
@@ -304,10 +307,12 @@ TEST(SurfaceContact, APressingToolPushesEveryPointThatCarriesTheSurfaceAwayFromI
   // them (non_negative_weights) every point's contact force points down, away from a tool pressing the top
   // (a ball: its surface lies beyond the outer points everywhere, where a lattice's box has points on its faces)
   const double ball = 0.02, radius = 0.01, depth = 0.002;
-  const Block b{build_model(sample_sphere(Vec3::Zero(), ball, spacing), MaterialParams{}, KernelParams{}), sphere_surface(Vec3::Zero(), ball, spacing / 2)};
+  const Block b{build_model(sample_sphere(Vec3::Zero(), ball, spacing), MaterialParams{}, KernelParams{}),
+                sphere_surface(Vec3::Zero(), ball, spacing / 2)};
   SurfaceContactParams params;
   params.non_negative_weights = true;
-  SurfaceContact contact(b.model, b.surface, build_surface_map(b.model, b.surface.V), ToolShape{ToolKind::SPHERE, radius, 0}, params);
+  SurfaceContact contact(b.model, b.surface, build_surface_map(b.model, b.surface.V),
+                         ToolShape{ToolKind::SPHERE, radius, 0}, params);
   contact.set_pose(ToolPose{Vec3(0, ball + radius - depth, 0), Eigen::Quaterniond::Identity()});
   Points f = Points::Zero(3, b.model.n_points);
   const Points u = Points::Zero(3, b.model.n_points);
@@ -315,9 +320,11 @@ TEST(SurfaceContact, APressingToolPushesEveryPointThatCarriesTheSurfaceAwayFromI
   ASSERT_GT(contact.last_load().contacts, 3);
   EXPECT_LE(f.row(1).maxCoeff(), 0.0);
   EXPECT_NEAR(-f.row(1).sum(), contact.last_load().force.y(), 1e-12 * contact.last_load().force.y());
-  for (index_t e = 0; e < static_cast<index_t>(contact.map().weight.size()); ++e) EXPECT_GE(contact.map().weight[static_cast<std::size_t>(e)], 0.0);
+  for (index_t e = 0; e < static_cast<index_t>(contact.map().weight.size()); ++e)
+    EXPECT_GE(contact.map().weight[static_cast<std::size_t>(e)], 0.0);
   // the exact map (the default) pulls some points up, into the tool
-  SurfaceContact exact(b.model, b.surface, build_surface_map(b.model, b.surface.V), ToolShape{ToolKind::SPHERE, radius, 0});
+  SurfaceContact exact(b.model, b.surface, build_surface_map(b.model, b.surface.V),
+                       ToolShape{ToolKind::SPHERE, radius, 0});
   exact.set_pose(contact.pose());
   f.setZero();
   exact.add_forces(b.model, u, f);
@@ -345,7 +352,8 @@ TEST(SurfaceContact, StaticIndentationMeetsTheConstraintAndBalancesTheSupports) 
   const Points y = sim.held_tool()->contact().vertices();
   double lowest_top = 1;
   for (index_t v = 0; v < y.cols(); ++v)
-    if (surface.V(1, v) > 0.02 - 1e-9 && (surface.V.col(v) - Vec3(0.02, 0.02, 0.02)).norm() < 1e-9) lowest_top = y(1, v);
+    if (surface.V(1, v) > 0.02 - 1e-9 && (surface.V.col(v) - Vec3(0.02, 0.02, 0.02)).norm() < 1e-9)
+      lowest_top = y(1, v);
   EXPECT_NEAR(lowest_top, 0.02 - depth, 0.01 * depth);
 }
 
@@ -380,8 +388,11 @@ TEST(SurfaceContact, FrictionSticksForASmallMoveAndSlidesWithMuTimesTheNormalFor
   const double radius = 0.01, depth = 0.001, mu = 0.3;
   SurfaceContactParams params;
   params.friction = mu;
-  const auto at = [&](double x) { return ToolPose{Vec3(0.02 + x, 0.02 + radius - depth, 0.02), Eigen::Quaterniond::Identity()}; };
-  sim.hold_tool(ToolShape{ToolKind::SPHERE, radius, 0}, at(0), surface, build_surface_map(sim.model(), surface.V), params);
+  const auto at = [&](double x) {
+    return ToolPose{Vec3(0.02 + x, 0.02 + radius - depth, 0.02), Eigen::Quaterniond::Identity()};
+  };
+  sim.hold_tool(ToolShape{ToolKind::SPHERE, radius, 0}, at(0), surface, build_surface_map(sim.model(), surface.V),
+                params);
   const StepReport first = sim.step();
   ASSERT_EQ(first.status, StepStatus::CONVERGED) << first.failure;
   const double pressed = sim.summary().tool.force.y();
@@ -416,7 +427,8 @@ TEST(SurfaceContact, FrictionSticksForASmallMoveAndSlidesWithMuTimesTheNormalFor
 // it is carried, is seen, one leaving it or beside it is not.
 TEST(SurfaceContact, AMoveIntoTheCarriedSurfaceIsSeenAndOneOutOfItIsNot) {
   const Block b = block();
-  SurfaceContact contact(b.model, b.surface, build_surface_map(b.model, b.surface.V), ToolShape{ToolKind::SPHERE, 0.002, 0});
+  SurfaceContact contact(b.model, b.surface, build_surface_map(b.model, b.surface.V),
+                         ToolShape{ToolKind::SPHERE, 0.002, 0});
   Points u = Points::Zero(3, b.model.n_points);
   u.row(1).setConstant(0.01);  // the block carried 1 cm up: its top face at y = 3 cm
   contact.load(b.model, u);

@@ -31,7 +31,8 @@ std::string write(const std::string& name, const std::string& text) {
 }
 
 TEST(Trajectory, ReadsCsvAndNamesTheBadLine) {
-  const Trajectory tr = Trajectory::from_csv(write("probe.csv", "t,x,y,z,button\n0, 0, 0, 0\n0.5, 0, 0.01, 0, 1 # grab\n\n1 0 0 0\n"));
+  const Trajectory tr =
+      Trajectory::from_csv(write("probe.csv", "t,x,y,z,button\n0, 0, 0, 0\n0.5, 0, 0.01, 0, 1 # grab\n\n1 0 0 0\n"));
   ASSERT_EQ(tr.keyframes().size(), 3u);
   EXPECT_TRUE(tr.button(0.6));
   try {

@@ -59,17 +59,18 @@ void put(std::string& out, T value, bool big) {
 // a PLY of the five points: float x y z, a uchar colour to ignore, uchar fixed, double volume, behind an
 // element that comes first and must be skipped; `header_format` may lie about the data's byte order
 std::string ply(const std::string& format, bool big_data, const std::string& header_format = "") {
-  std::string s = "ply\nformat " + (header_format.empty() ? format : header_format) +
-                  " 1.0\ncomment made by the tests\nelement camera 1\nproperty float view\n"
-                  "element vertex 5\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\n"
-                  "property uchar fixed\nproperty double volume\nelement face 0\nproperty list uchar int vertex_indices\n"
-                  "end_header\n";
+  std::string s =
+      "ply\nformat " + (header_format.empty() ? format : header_format) +
+      " 1.0\ncomment made by the tests\nelement camera 1\nproperty float view\n"
+      "element vertex 5\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\n"
+      "property uchar fixed\nproperty double volume\nelement face 0\nproperty list uchar int vertex_indices\n"
+      "end_header\n";
   if (format == "ascii") {
     s += "1.5\n";
     std::ostringstream lines;
     for (int i = 0; i < 5; ++i)
-      lines << corners[i][0] << ' ' << corners[i][1] << ' ' << corners[i][2] << " 200 " << (i == 3 ? 1 : 0) << ' ' << (i + 1) * 1e-6
-            << '\n';
+      lines << corners[i][0] << ' ' << corners[i][1] << ' ' << corners[i][2] << " 200 " << (i == 3 ? 1 : 0) << ' '
+            << (i + 1) * 1e-6 << '\n';
     return s + lines.str();
   }
   put<float>(s, 1.5f, big_data);
@@ -104,7 +105,8 @@ TEST(PointCloudFile, ReadsXyzAndCsvWithAndWithoutAttributes) {
   std::ostringstream reordered;
   reordered << "volume, fixed, z, y, x\r\n";
   for (int i = 0; i < 5; ++i)
-    reordered << (i + 1) * 1e-6 << ", " << (i == 3 ? 1 : 0) << ", " << corners[i][2] << ", " << corners[i][1] << ", " << corners[i][0] << "\r\n";
+    reordered << (i + 1) * 1e-6 << ", " << (i == 3 ? 1 : 0) << ", " << corners[i][2] << ", " << corners[i][1] << ", "
+              << corners[i][0] << "\r\n";
   expect_the_five_points(read_point_cloud(write("d.csv", reordered.str()), 0.01), true);
 }
 
@@ -120,9 +122,11 @@ TEST(PointCloudFile, HeldPointsOfAFileAreHeldInTheScene) {
   s << "x y z fixed\n";
   for (int i = 0; i < 4; ++i)
     for (int j = 0; j < 4; ++j)
-      for (int k = 0; k < 4; ++k) s << 0.01 * i << ' ' << 0.01 * j << ' ' << 0.01 * k << ' ' << (j == 0 ? 1 : 0) << '\n';
+      for (int k = 0; k < 4; ++k)
+        s << 0.01 * i << ' ' << 0.01 * j << ' ' << 0.01 * k << ' ' << (j == 0 ? 1 : 0) << '\n';
   const std::string cloud = write("lattice.xyz", s.str());
-  const Scene scene = parse_scene("[object]\nshape = \"file\"\nfile = \"" + cloud + "\"\nspacing = 0.01\n", "file.toml");
+  const Scene scene =
+      parse_scene("[object]\nshape = \"file\"\nfile = \"" + cloud + "\"\nspacing = 0.01\n", "file.toml");
   const Model m = build_scene_model(scene);
   ASSERT_EQ(m.n_points, 64);
   for (index_t i = 0; i < m.n_points; ++i) EXPECT_EQ(m.fixed[i] != 0, m.X(1, i) < 1e-9) << "point " << i;
@@ -140,7 +144,8 @@ TEST(PointCloudFile, DevicesFifosAndFoldersAreRefusedBeforeReading) {
     } catch (const Error& e) {
       const std::string what = e.what();
       EXPECT_NE(what.find(path), std::string::npos) << what;
-      EXPECT_TRUE(what.find("not a regular file") != std::string::npos || what.find("is a folder") != std::string::npos) << what;
+      EXPECT_TRUE(what.find("not a regular file") != std::string::npos || what.find("is a folder") != std::string::npos)
+          << what;
     }
   }
   std::filesystem::remove(fifo);
@@ -150,9 +155,11 @@ TEST(PointCloudFile, APlyMeshWithALongHeaderIsAMesh) {
   // issue 21: a header of more than 1000 lines hid the faces, and the mesh was refused as a cloud
   std::string header = "ply\nformat ascii 1.0\n";
   for (int k = 0; k < 1500; ++k) header += "comment line " + std::to_string(k) + "\n";
-  header += "element vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 4\n"
-            "property list uchar int vertex_indices\nend_header\n";
-  EXPECT_TRUE(ply_has_faces(write("long_header.ply", header + "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n")));
+  header +=
+      "element vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 4\n"
+      "property list uchar int vertex_indices\nend_header\n";
+  EXPECT_TRUE(ply_has_faces(
+      write("long_header.ply", header + "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n")));
 }
 
 TEST(PointCloudFile, MalformedTruncatedAndHostileFilesAreNamedErrors) {
@@ -176,16 +183,18 @@ TEST(PointCloudFile, MalformedTruncatedAndHostileFilesAreNamedErrors) {
   // PLY
   has(error_of("plx\n", ".ply"), "not a PLY file");
   has(error_of("ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\n", ".ply"), "no end_header");
-  has(error_of("ply\nformat ascii 1.0\nelement vertex 1\nproperty quaternion x\nend_header\n", ".ply"), "unknown property type");
+  has(error_of("ply\nformat ascii 1.0\nelement vertex 1\nproperty quaternion x\nend_header\n", ".ply"),
+      "unknown property type");
   has(error_of("ply\nformat ebcdic 1.0\nend_header\n", ".ply"), "unknown PLY format");
-  has(error_of("ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\nend_header\n", ".ply"), "lacks x, y or z");
+  has(error_of("ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\nend_header\n", ".ply"),
+      "lacks x, y or z");
   const std::string binary = ply("binary_little_endian", false);
-  has(error_of(binary.substr(0, binary.size() - 7), ".ply"), "holds only");                         // truncated
+  has(error_of(binary.substr(0, binary.size() - 7), ".ply"), "holds only");  // truncated
   has(error_of(ply("ascii", false).substr(0, ply("ascii", false).size() - 20), ".ply"), "vertex 4: expected 6 numbers");
   std::string huge = binary;
   huge.replace(huge.find("element vertex 5"), 16, "element vertex 99999999999999");
-  has(error_of(huge, ".ply"), "declares 99999999999999 vertices");                                     // a count to exhaust memory
-  has(error_of(ply("binary_big_endian", true, "binary_little_endian"), ".ply"), "bad.ply: point");    // wrong byte order
+  has(error_of(huge, ".ply"), "declares 99999999999999 vertices");  // a count to exhaust memory
+  has(error_of(ply("binary_big_endian", true, "binary_little_endian"), ".ply"), "bad.ply: point");  // wrong byte order
   std::string nan = ply("ascii", false);
   nan.replace(nan.find("0.01 0 0 200"), 12, "nan 0 0 200");
   has(error_of(nan, ".ply"), "not finite");

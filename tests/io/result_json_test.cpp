@@ -28,11 +28,14 @@ TEST(ResultJson, HasEveryContractKeyWithOneEntryPerPoint) {
     ASSERT_TRUE(doc["points"].contains(key)) << key;
     EXPECT_EQ(doc["points"][key].size(), static_cast<size_t>(model.n_points)) << key;
   }
-  for (const char* key : {"kind", "converged", "iterations", "residual", "steps"}) EXPECT_TRUE(doc["solver"].contains(key)) << key;
+  for (const char* key : {"kind", "converged", "iterations", "residual", "steps"})
+    EXPECT_TRUE(doc["solver"].contains(key)) << key;
   for (const char* key : {"strain", "kinetic"}) EXPECT_TRUE(doc["energy"].contains(key)) << key;
   for (const char* key : {"wall_s", "step_ms_mean", "steps_per_s"}) EXPECT_TRUE(doc["timing"].contains(key)) << key;
-  for (const char* key : {"active_set_s", "tools_s", "solve_s"}) EXPECT_TRUE(doc["timing"]["stages"].contains(key)) << key;
-  for (const char* key : {"ticks", "rate_hz", "period_p99_us", "max_force_n"}) EXPECT_TRUE(doc["haptic"].contains(key)) << key;
+  for (const char* key : {"active_set_s", "tools_s", "solve_s"})
+    EXPECT_TRUE(doc["timing"]["stages"].contains(key)) << key;
+  for (const char* key : {"ticks", "rate_hz", "period_p99_us", "max_force_n"})
+    EXPECT_TRUE(doc["haptic"].contains(key)) << key;
   for (const char* key : {"selected", "selection_ms", "enabled", "band_count", "band_selected", "selections", "frozen"})
     EXPECT_TRUE(doc["lod"].contains(key)) << key;
   EXPECT_EQ(doc["points"]["displacement"][3][1].get<double>(), -2e-3);

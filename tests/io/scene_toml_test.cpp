@@ -103,8 +103,9 @@ TEST(SceneToml, UnknownKeyNamesFileLineAndKey) {
 
 TEST(SceneToml, UnknownSectionAndNestedKeys) {
   EXPECT_NE(error_of("[solver]", "[solvr]").find("solvr: unknown key"), std::string::npos);
-  EXPECT_NE(error_of("max = [0.0, 1.0, 1.0] }", "max = [0.0, 1.0, 1.0], mid = 1 }").find("fixed[0].box.mid: unknown key"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of("max = [0.0, 1.0, 1.0] }", "max = [0.0, 1.0, 1.0], mid = 1 }").find("fixed[0].box.mid: unknown key"),
+      std::string::npos);
   EXPECT_NE(error_of("g = [0, -9.81, 0]", "gg = [0, -9.81, 0]").find("load[1].gg: unknown key"), std::string::npos);
 }
 
@@ -138,13 +139,16 @@ TEST(SceneToml, OutOfRangeValuesAreNamed) {
 }
 
 TEST(SceneToml, UnknownChoicesListTheAllowedOnes) {
-  EXPECT_NE(error_of("type = \"quadratic\"", "type = \"gauss\"").find("unknown value \"gauss\" (expected poly6 | spiky | viscosity | quadratic)"),
+  EXPECT_NE(error_of("type = \"quadratic\"", "type = \"gauss\"")
+                .find("unknown value \"gauss\" (expected poly6 | spiky | viscosity | quadratic)"),
             std::string::npos);
   EXPECT_NE(error_of("shape   = \"box\"", "shape = \"cube\"").find("object.shape"), std::string::npos);
   EXPECT_NE(error_of("kind = \"explicit\"", "kind = \"rk4\"").find("solver.kind"), std::string::npos);
   // the material model: one table of names (core/parameters.hpp) for the scene, the CLI and Python
-  EXPECT_NE(error_of("young = 1e5", "model = \"jelly\"\nyoung = 1e5").find("material.model: unknown value \"jelly\" (expected svk | neo_hookean | mooney_rivlin | corotated)"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of("young = 1e5", "model = \"jelly\"\nyoung = 1e5")
+          .find("material.model: unknown value \"jelly\" (expected svk | neo_hookean | mooney_rivlin | corotated)"),
+      std::string::npos);
   std::string svk = full_scene;
   svk.replace(svk.find("young = 1e5"), 11, "model = \"svk\"\nyoung = 1e5");
   EXPECT_EQ(parse_scene(svk).material.model, MaterialModel::SVK);
@@ -165,7 +169,8 @@ TEST(SceneToml, ThePreconditionerIsChosen) {
   EXPECT_NE(error_of("dt = 2e-3", "dt = 2e-3\npreconditioner = \"ilu\"")
                 .find("solver.preconditioner: unknown value \"ilu\" (expected block_jacobi | cholesky | two_level)"),
             std::string::npos);
-  EXPECT_NE(error_of("dt = 2e-3", "dt = 2e-3\nrefactor_iterations = 0").find("solver.refactor_iterations"), std::string::npos);
+  EXPECT_NE(error_of("dt = 2e-3", "dt = 2e-3\nrefactor_iterations = 0").find("solver.refactor_iterations"),
+            std::string::npos);
   // where its refactorisations run
   EXPECT_EQ(scene.solver.refactorisation, Refactorisation::AUTO);
   EXPECT_EQ(with_solver("refactorisation = \"background\"").solver.refactorisation, Refactorisation::BACKGROUND);
@@ -183,11 +188,14 @@ TEST(SceneToml, MooneyRivlinTakesC10C01AndBulkInsteadOfYoungAndPoisson) {
   EXPECT_DOUBLE_EQ(m.c10, 3000);
   EXPECT_NEAR(m.mu(), 2 * (3000 + 1000), 1e-9);  // young and poisson follow: the small-strain moduli
   EXPECT_NEAR(m.bulk_modulus(), 2e5, 1e-6);
-  EXPECT_NE(error_of(material, "c10 = 3000\nc01 = 1000\nbulk = 2e5").find("material.c10: c10, c01 and bulk are Mooney-Rivlin's"),
+  EXPECT_NE(error_of(material, "c10 = 3000\nc01 = 1000\nbulk = 2e5")
+                .find("material.c10: c10, c01 and bulk are Mooney-Rivlin's"),
             std::string::npos);
-  EXPECT_NE(error_of(material, "model = \"mooney_rivlin\"\nc10 = 3000").find("give all of c10, c01 and bulk"), std::string::npos);
-  EXPECT_NE(error_of(material, "model = \"mooney_rivlin\"\nyoung = 1e5\nc10 = 3000\nc01 = 1\nbulk = 2e5").find("not both"),
+  EXPECT_NE(error_of(material, "model = \"mooney_rivlin\"\nc10 = 3000").find("give all of c10, c01 and bulk"),
             std::string::npos);
+  EXPECT_NE(
+      error_of(material, "model = \"mooney_rivlin\"\nyoung = 1e5\nc10 = 3000\nc01 = 1\nbulk = 2e5").find("not both"),
+      std::string::npos);
 }
 
 TEST(SceneToml, PronySeriesIsReadAndChecked) {
@@ -204,14 +212,18 @@ TEST(SceneToml, PronySeriesIsReadAndChecked) {
   const std::string sum = error_of(material, "young = 1e5\nprony = [[0.6, 0.1],\n [0.5, 2]]");
   EXPECT_NE(sum.find("material.prony: expected [[g, tau], ...]"), std::string::npos) << sum;
   EXPECT_NE(sum.find(":" + std::to_string(line_of(material) + 2) + ":"), std::string::npos) << sum;
-  for (const char* bad : {"prony = [[0, 1]]", "prony = [[0.5, 0]]", "prony = [[0.5]]", "prony = []", "prony = 0.5",
-                          "prony = [[0.5, nan]]", "prony = [[0.1, 1], [0.1, 1], [0.1, 1], [0.1, 1], [0.1, 1], [0.1, 1], [0.1, 1], [0.1, 1], [0.1, 1]]"})
+  for (const char* bad :
+       {"prony = [[0, 1]]", "prony = [[0.5, 0]]", "prony = [[0.5]]", "prony = []", "prony = 0.5",
+        "prony = [[0.5, nan]]",
+        "prony = [[0.1, 1], [0.1, 1], [0.1, 1], [0.1, 1], [0.1, 1], [0.1, 1], [0.1, 1], [0.1, 1], [0.1, 1]]"})
     EXPECT_NE(error_of(material, std::string("young = 1e5\n") + bad).find("material.prony"), std::string::npos) << bad;
 }
 
 TEST(SceneToml, RegionsTakeASelectorAndAnyOfTheMaterialKeys) {
-  std::string text = std::string(full_scene) + "\n[[region]]\nsphere = { centre = [0.05, 0.015, 0.015], radius = 0.01 }\nyoung = 1e6\n"
-                                  "model = \"neo_hookean\"\n\n[[region]]\nbox = { min = [0, 0, 0], max = [0.01, 0.03, 0.03] }\ndensity = 2000\n";
+  std::string text =
+      std::string(full_scene) +
+      "\n[[region]]\nsphere = { centre = [0.05, 0.015, 0.015], radius = 0.01 }\nyoung = 1e6\n"
+      "model = \"neo_hookean\"\n\n[[region]]\nbox = { min = [0, 0, 0], max = [0.01, 0.03, 0.03] }\ndensity = 2000\n";
   const Scene s = parse_scene(text);
   ASSERT_EQ(s.regions.size(), 2u);
   EXPECT_EQ(*s.regions[0].young, 1e6);
@@ -219,7 +231,8 @@ TEST(SceneToml, RegionsTakeASelectorAndAnyOfTheMaterialKeys) {
   EXPECT_FALSE(s.regions[0].poisson.has_value());
   EXPECT_EQ(*s.regions[1].density, 2000);
   EXPECT_FALSE(s.regions[1].young.has_value());
-  const std::string bad = std::string(full_scene) + "\n[[region]]\nsphere = { centre = [0, 0, 0], radius = 0.01 }\nyoung = -3\n";
+  const std::string bad =
+      std::string(full_scene) + "\n[[region]]\nsphere = { centre = [0, 0, 0], radius = 0.01 }\nyoung = -3\n";
   try {
     parse_scene(bad, "bad.toml");
     ADD_FAILURE() << "no error";
@@ -227,7 +240,9 @@ TEST(SceneToml, RegionsTakeASelectorAndAnyOfTheMaterialKeys) {
     EXPECT_NE(std::string(e.what()).find("region[0].young"), std::string::npos) << e.what();
   }
   EXPECT_THROW(parse_scene(std::string(full_scene) + "\n[[region]]\nyoung = 1e6\n"), Error);  // no selector
-  EXPECT_THROW(parse_scene(std::string(full_scene) + "\n[[region]]\nbox = { min = [0, 0, 0], max = [1, 1, 1] }\nstiffness = 3\n"), Error);
+  EXPECT_THROW(parse_scene(std::string(full_scene) +
+                           "\n[[region]]\nbox = { min = [0, 0, 0], max = [1, 1, 1] }\nstiffness = 3\n"),
+               Error);
 }
 
 TEST(SceneToml, FixedRegionsAreCheckedAndNamed) {
@@ -242,7 +257,8 @@ TEST(SceneToml, FixedRegionsAreCheckedAndNamed) {
             std::string::npos);
   EXPECT_NE(error_of(box, "sphere = { centre = [0, 0, 0], radius = 1, colour = 2 }").find("colour"), std::string::npos);
   std::string text = full_scene;
-  text.replace(text.find(box), box.size(), "cylinder = { centre = [0, 0, 0], axis = [0, 2, 0], radius = 0.01, half_length = 0.02 }");
+  text.replace(text.find(box), box.size(),
+               "cylinder = { centre = [0, 0, 0], axis = [0, 2, 0], radius = 0.01, half_length = 0.02 }");
   const Scene s = parse_scene(text);
   ASSERT_TRUE(s.fixed[0].cylinder.has_value());
   EXPECT_LE((s.fixed[0].cylinder->axis - Vec3::UnitY()).norm(), 1e-15);  // normalised
@@ -257,7 +273,9 @@ TEST(SceneToml, MissingRequiredKeys) {
 
 TEST(SceneToml, SyntaxErrorNamesTheLine) {
   const std::string e = error_of("density = 1000.0", "density = = 1000.0");
-  EXPECT_NE(e.find("bad.toml:" + std::to_string(line_of("density = 1000.0")) + ": TOML syntax error"), std::string::npos) << e;
+  EXPECT_NE(e.find("bad.toml:" + std::to_string(line_of("density = 1000.0")) + ": TOML syntax error"),
+            std::string::npos)
+      << e;
 }
 
 TEST(SceneToml, DeeplyNestedKeysAreANamedErrorNotACrash) {
@@ -283,15 +301,19 @@ TEST(SceneToml, DeeplyNestedKeysAreANamedErrorNotACrash) {
   // dots in values, strings and comments are not keys: many on one line are fine
   std::string floats = "keyframes = [";
   for (int k = 0; k < 200; ++k) floats.append(fmt::format("[{}.5, 0.0, 0.5, 0.0], ", k));
-  const std::string fine = object + "# a.b.c.d.e.f.g.h.i.j.k.l.m.n.o.p.q.r.s.t.u.v.w.x.y.z.a.b.c.d.e.f.g.h.i.j.k.l.m.n.o.p.q.r.s.t.u.v.w.x.y.z.a\n"
-                           "[probe]\n" + floats + "]\n";
+  const std::string fine =
+      object +
+      "# a.b.c.d.e.f.g.h.i.j.k.l.m.n.o.p.q.r.s.t.u.v.w.x.y.z.a.b.c.d.e.f.g.h.i.j.k.l.m.n.o.p.q.r.s.t.u.v.w.x.y.z.a\n"
+      "[probe]\n" +
+      floats + "]\n";
   EXPECT_NO_THROW(parse_scene(fine, "fine.toml"));
 }
 
 TEST(SceneToml, ReadsTheLodSection) {
-  const std::string lod = "[lod]\nk1 = 1.5\nk2 = 2\nlevels = [ { distance = 2.5, K = 6 }, { distance = 4.0, K = 8 } ]\n"
-                          "seed = 7\nscheme = \"dither\"\nreselect = 0.25\nmin_neighbours = 10\nmax_widening = 2.5\n"
-                          "contact = [0.1, 0.03, 0.0]\n[solver]";
+  const std::string lod =
+      "[lod]\nk1 = 1.5\nk2 = 2\nlevels = [ { distance = 2.5, K = 6 }, { distance = 4.0, K = 8 } ]\n"
+      "seed = 7\nscheme = \"dither\"\nreselect = 0.25\nmin_neighbours = 10\nmax_widening = 2.5\n"
+      "contact = [0.1, 0.03, 0.0]\n[solver]";
   std::string text = full_scene;
   text.replace(text.find("[solver]"), 8, lod);
   const Scene s = parse_scene(text, "lod.toml");
@@ -318,7 +340,8 @@ TEST(SceneToml, BadLodSectionsNameTheKey) {
   EXPECT_NE(lod_error("levels = [ { distance = 3.0, K = 8 }, { distance = 4.0, K = 6 } ]").find("non-decreasing"),
             std::string::npos);
   EXPECT_NE(lod_error("levels = [ { distance = 3.0 } ]").find("both distance and K"), std::string::npos);
-  EXPECT_NE(lod_error("levels = [ { distance = 3.0, K = 6, w = 1 } ]").find("lod.levels.w: unknown key"), std::string::npos);
+  EXPECT_NE(lod_error("levels = [ { distance = 3.0, K = 6, w = 1 } ]").find("lod.levels.w: unknown key"),
+            std::string::npos);
   EXPECT_NE(lod_error("scheme = \"blue\"").find("lod.scheme"), std::string::npos);
   EXPECT_NE(lod_error("reselect = 0").find("lod.reselect"), std::string::npos);
   EXPECT_NE(lod_error("seed = -1").find("lod.seed"), std::string::npos);
@@ -380,8 +403,9 @@ TEST(SceneToml, ReadsProbeAndDevice) {
   EXPECT_EQ(s.device.max_torque, 0.0);
   // custom specs with a torque (a device with six output degrees of freedom)
   std::string six_dof = std::string(full_scene) + probe_section;
-  six_dof.replace(six_dof.find("specs = \"omni\""), 14,
-                  "specs = \"custom\"\nmax_force = 3.0\nmax_stiffness = 500.0\nworkspace_radius = 0.1\nmax_torque = 0.05");
+  six_dof.replace(
+      six_dof.find("specs = \"omni\""), 14,
+      "specs = \"custom\"\nmax_force = 3.0\nmax_stiffness = 500.0\nworkspace_radius = 0.1\nmax_torque = 0.05");
   EXPECT_DOUBLE_EQ(parse_scene(six_dof, "p.toml").device.max_torque, 0.05);
   // a trajectory file is resolved against the scene's folder
   std::string text = std::string(full_scene) + "[probe]\ntrajectory = \"probe.csv\"\n";
@@ -417,11 +441,13 @@ TEST(SceneToml, BadHeldToolIsANamedError) {
   EXPECT_NE(error("length = 0.02", "").find("probe.length: a capsule needs length > 0"), std::string::npos);
   EXPECT_NE(error("shape = \"capsule\"", "").find("only a capsule has a length"), std::string::npos);
   EXPECT_NE(error("friction = 0.3", "friction = -1").find("probe.friction"), std::string::npos);
-  EXPECT_NE(error("shape = \"capsule\"", "shape = \"cone\"").find("probe.shape: unknown value \"cone\""), std::string::npos);
+  EXPECT_NE(error("shape = \"capsule\"", "shape = \"cone\"").find("probe.shape: unknown value \"cone\""),
+            std::string::npos);
   EXPECT_NE(error("[0.0, 1.0, 0.0, 0.0]", "[1.0, 1.0, 0.0, 0.0]").find("norm is 1.41421, not 1"), std::string::npos);
   EXPECT_NE(error("[0.0, 1.0, 0.0, 0.0]", "[1.0, 0.0]").find("unit quaternion [w, x, y, z]"), std::string::npos);
-  EXPECT_NE(error("length = 0.02", "length = 0.02\nkeyframes = [[0.0, 0.0, 0.0, 0.0]]").find("no trajectory or keyframes"),
-            std::string::npos);
+  EXPECT_NE(
+      error("length = 0.02", "length = 0.02\nkeyframes = [[0.0, 0.0, 0.0, 0.0]]").find("no trajectory or keyframes"),
+      std::string::npos);
   EXPECT_NE(error("friction = 0.3", "friction = 0.3\n[device]\nkind = \"virtual\"").find("not driven by a [device]"),
             std::string::npos);
 }
@@ -431,7 +457,8 @@ template <class Flag>
 void expect_probe_choice(const std::string& key, const std::string& value, Flag flag) {
   const std::string probe = "\n[probe]\nkeyframes = [[0.0, 0.0, 0.0, 0.0]]\n";
   EXPECT_FALSE(flag(parse_scene(std::string(full_scene) + probe, "t.toml", ".").probe)) << key;
-  EXPECT_TRUE(flag(parse_scene(std::string(full_scene) + probe + key + " = \"" + value + "\"\n", "t.toml", ".").probe)) << key;
+  EXPECT_TRUE(flag(parse_scene(std::string(full_scene) + probe + key + " = \"" + value + "\"\n", "t.toml", ".").probe))
+      << key;
   EXPECT_NE(error_of("keyframes = [[0.0, 0.0, 0.0, 0.0]]", "keyframes = [[0.0, 0.0, 0.0, 0.0]]\n" + key + " = \"soft\"",
                      std::string(full_scene) + probe)
                 .find("probe." + key + ": unknown value \"soft\""),
@@ -470,16 +497,19 @@ TEST(SceneToml, AHeldToolPressesAlongItsDirection) {
   EXPECT_EQ(parse_scene(text, "t.toml", ".").probe.direction, Vec3(0, -1, 0));  // the default
   text += "direction = [0.0, 0.0, -2.0]\n";
   EXPECT_EQ(parse_scene(text, "t.toml", ".").probe.direction, Vec3(0, 0, -1));  // normalised
-  EXPECT_NE(error_of("direction = [0.0, 0.0, -2.0]", "direction = [0.0, 0.0, 0.0]", text).find("probe.direction: must not be zero"),
+  EXPECT_NE(error_of("direction = [0.0, 0.0, -2.0]", "direction = [0.0, 0.0, 0.0]", text)
+                .find("probe.direction: must not be zero"),
             std::string::npos);
-  EXPECT_NE(error_of("position = [0.0, 0.06, 0.0]", "", text).find("probe.direction: only a tool held at a position"), std::string::npos);
+  EXPECT_NE(error_of("position = [0.0, 0.06, 0.0]", "", text).find("probe.direction: only a tool held at a position"),
+            std::string::npos);
 }
 
 // A setting (--set, a study's parameter) changes a key as if the file said it, makes missing tables, indexes
 // arrays of tables, and its errors name the setting.
 TEST(SceneToml, SettingsChangeKeysAndTheirErrorsNameThem) {
-  const std::vector<SceneSetting> settings = {parse_scene_setting("material.young=2e5"), parse_scene_setting("material.model=neo_hookean"),
-                                              parse_scene_setting("load.0.total=[0, -0.5, 0]"), parse_scene_setting("lod.k1=0.5")};
+  const std::vector<SceneSetting> settings = {
+      parse_scene_setting("material.young=2e5"), parse_scene_setting("material.model=neo_hookean"),
+      parse_scene_setting("load.0.total=[0, -0.5, 0]"), parse_scene_setting("lod.k1=0.5")};
   const Scene s = parse_scene(full_scene, "t.toml", ".", settings);
   EXPECT_DOUBLE_EQ(s.material.young, 2e5);
   EXPECT_EQ(s.material.model, MaterialModel::NEO_HOOKEAN);
@@ -495,11 +525,15 @@ TEST(SceneToml, SettingsChangeKeysAndTheirErrorsNameThem) {
     }
     return std::string("no error");
   };
-  EXPECT_EQ(error("material.young=-1"), "t.toml: material.young (set to -1): -1 is out of range: must lie in (0, 1e13] (Pa)");
-  EXPECT_NE(error("material.young=abc").find("material.young (set to abc): expected a number, got a string"), std::string::npos);
-  EXPECT_NE(error("load.7.total=[0, 0, 0]").find("\"7\" is not an index of the array (it has 3 entries)"), std::string::npos);
+  EXPECT_EQ(error("material.young=-1"),
+            "t.toml: material.young (set to -1): -1 is out of range: must lie in (0, 1e13] (Pa)");
+  EXPECT_NE(error("material.young=abc").find("material.young (set to abc): expected a number, got a string"),
+            std::string::npos);
+  EXPECT_NE(error("load.7.total=[0, 0, 0]").find("\"7\" is not an index of the array (it has 3 entries)"),
+            std::string::npos);
   EXPECT_NE(error("material.young.x=1").find("\"young\" is a value, not a table"), std::string::npos);
-  EXPECT_NE(error("materia.young=1").find("materia (made for the setting materia.young=1): unknown key"), std::string::npos);
+  EXPECT_NE(error("materia.young=1").find("materia (made for the setting materia.young=1): unknown key"),
+            std::string::npos);
   EXPECT_NE(error("material.poisson=[1").find("not a TOML value"), std::string::npos);
   EXPECT_NE(error("material..young=1").find("an empty key on the path"), std::string::npos);
   EXPECT_THROW(parse_scene_setting("young"), Error);
@@ -515,7 +549,9 @@ TEST(SceneToml, ReadsRefineRegionsAndNamesTheirErrors) {
   EXPECT_DOUBLE_EQ(s.refine[0].bounds().max.y(), 0.04);
   const std::string text = std::string(full_scene) + refine;
   EXPECT_NE(error_of("spacing = 0.003", "", text).find("needs spacing"), std::string::npos);
-  EXPECT_NE(error_of("spacing = 0.003", "spacing = 0.0075", text).find("refine[0].spacing: 0.0075 is out of range: must be finer"), std::string::npos);
+  EXPECT_NE(error_of("spacing = 0.003", "spacing = 0.0075", text)
+                .find("refine[0].spacing: 0.0075 is out of range: must be finer"),
+            std::string::npos);
   EXPECT_NE(error_of("spacing = 0.003", "spacing = 0.0001", text).find("at least a twentieth"), std::string::npos);
   EXPECT_NE(error_of("sphere = {", "box = { min = [0.0, 0.0, 0.0], max = [0.01, 0.01, 0.01] }\nsphere = {", text)
                 .find("exactly one of box"),
@@ -523,8 +559,9 @@ TEST(SceneToml, ReadsRefineRegionsAndNamesTheirErrors) {
 }
 
 TEST(SceneToml, ReadsScriptedCutsAndNamesTheirErrors) {
-  const std::string cut = "\n[[cut]]\nedge = [[0.02, 0.05, -0.01], [0.02, 0.05, 0.05]]\nto = [[0.02, -0.01, -0.01], [0.02, -0.01, 0.05]]\n"
-                          "start = 0.1\nduration = 0.05\n";
+  const std::string cut =
+      "\n[[cut]]\nedge = [[0.02, 0.05, -0.01], [0.02, 0.05, 0.05]]\nto = [[0.02, -0.01, -0.01], [0.02, -0.01, 0.05]]\n"
+      "start = 0.1\nduration = 0.05\n";
   const std::string text = std::string(full_scene) + cut;
   const Scene s = parse_scene(text, "t.toml", ".");
   ASSERT_EQ(s.cuts.size(), 1u);
@@ -532,13 +569,17 @@ TEST(SceneToml, ReadsScriptedCutsAndNamesTheirErrors) {
   EXPECT_DOUBLE_EQ(s.cuts[0].to[0].y(), -0.01);
   EXPECT_DOUBLE_EQ(s.cuts[0].start, 0.1);
   EXPECT_DOUBLE_EQ(s.cuts[0].duration, 0.05);
-  EXPECT_NE(error_of("to = [[0.02, -0.01, -0.01], [0.02, -0.01, 0.05]]", "", text).find("cut[0].to: a [[cut]] needs edge"),
-            std::string::npos);
-  EXPECT_NE(error_of("to = [[0.02, -0.01, -0.01], [0.02, -0.01, 0.05]]", "to = [[0.02, -0.01, -0.01]]", text).find("cut[0].to"),
+  EXPECT_NE(
+      error_of("to = [[0.02, -0.01, -0.01], [0.02, -0.01, 0.05]]", "", text).find("cut[0].to: a [[cut]] needs edge"),
+      std::string::npos);
+  EXPECT_NE(error_of("to = [[0.02, -0.01, -0.01], [0.02, -0.01, 0.05]]", "to = [[0.02, -0.01, -0.01]]", text)
+                .find("cut[0].to"),
             std::string::npos);
   EXPECT_NE(error_of("[0.02, 0.05, 0.05]]", "[0.02, 0.05, -0.01]]", text).find("zero length"), std::string::npos);
-  EXPECT_NE(error_of("duration = 0.05", "duration = -1", text).find("cut[0].duration: -1 is out of range"), std::string::npos);
-  EXPECT_NE(error_of("start = 0.1", "start = 0.1\nspeed = 2", text).find("cut[0].speed: unknown key"), std::string::npos);
+  EXPECT_NE(error_of("duration = 0.05", "duration = -1", text).find("cut[0].duration: -1 is out of range"),
+            std::string::npos);
+  EXPECT_NE(error_of("start = 0.1", "start = 0.1\nspeed = 2", text).find("cut[0].speed: unknown key"),
+            std::string::npos);
   // with levels of detail too (a cut in the active set reaches the object)
   std::string with_lod = text;
   with_lod.replace(with_lod.find("[solver]"), 8, "[lod]\nk1 = 1.5\ncontact = [0.0, 0.0, 0.0]\n[solver]");
@@ -553,16 +594,20 @@ std::string probe_error(const std::string& find, const std::string& replace) {
 
 TEST(SceneToml, ABladeIsACapsuleThatCutsAndNamesItsErrors) {
   std::string blade = std::string(full_scene) + probe_section;
-  blade.replace(blade.find("mode = \"grab\""), 13, "mode = \"cut\"\nshape = \"capsule\"\nlength = 0.04\ncut_resistance = 200");
+  blade.replace(blade.find("mode = \"grab\""), 13,
+                "mode = \"cut\"\nshape = \"capsule\"\nlength = 0.04\ncut_resistance = 200");
   const Scene s = parse_scene(blade, "t.toml", ".");
   EXPECT_TRUE(s.probe.cut);
   EXPECT_FALSE(s.probe.grab);
   EXPECT_DOUBLE_EQ(s.probe.cut_resistance, 200);
-  EXPECT_NE(error_of("shape = \"capsule\"\nlength = 0.04\n", "", blade).find("probe.shape: a blade (mode = \"cut\") is a capsule"),
+  EXPECT_NE(error_of("shape = \"capsule\"\nlength = 0.04\n", "", blade)
+                .find("probe.shape: a blade (mode = \"cut\") is a capsule"),
             std::string::npos);
-  EXPECT_NE(error_of("cut_resistance = 200", "cut_resistance = -1", blade).find("probe.cut_resistance: -1 is out of range"),
+  EXPECT_NE(
+      error_of("cut_resistance = 200", "cut_resistance = -1", blade).find("probe.cut_resistance: -1 is out of range"),
+      std::string::npos);
+  EXPECT_NE(probe_error("mode = \"grab\"", "mode = \"grab\"\ncut_resistance = 5").find("only a blade cuts"),
             std::string::npos);
-  EXPECT_NE(probe_error("mode = \"grab\"", "mode = \"grab\"\ncut_resistance = 5").find("only a blade cuts"), std::string::npos);
   std::string blade_lod = blade;
   blade_lod.replace(blade_lod.find("[solver]"), 8, "[lod]\nk1 = 1.5\n[solver]");
   const Scene cutting_lod = parse_scene(blade_lod, "t.toml", ".");
@@ -580,20 +625,26 @@ TEST(SceneToml, ADevicesProbeHasFrictionButNotOnThePointSpheresOfLevelsOfDetail)
 
 TEST(SceneToml, BadProbeOrDeviceIsANamedError) {
   EXPECT_NE(probe_error("radius = 0.01", "radius = -1").find("probe.radius"), std::string::npos);
-  EXPECT_NE(probe_error("mode = \"grab\"", "mode = \"poke\"").find("probe.mode: unknown value \"poke\""), std::string::npos);
+  EXPECT_NE(probe_error("mode = \"grab\"", "mode = \"poke\"").find("probe.mode: unknown value \"poke\""),
+            std::string::npos);
   EXPECT_NE(probe_error("[1.0, 0.0, -0.01, 0.0, 1]", "[0.0, 0.0, -0.01]").find("probe.keyframes"), std::string::npos);
-  EXPECT_NE(probe_error("[1.0, 0.0, -0.01, 0.0, 1]", "[0.0, 0.0, -0.01, 0.0]").find("times must increase"), std::string::npos);
+  EXPECT_NE(probe_error("[1.0, 0.0, -0.01, 0.0, 1]", "[0.0, 0.0, -0.01, 0.0]").find("times must increase"),
+            std::string::npos);
   EXPECT_NE(probe_error("keyframes = [[0.0, 0.0, 0.0, 0.0], [1.0, 0.0, -0.01, 0.0, 1]]", "").find("needs trajectory"),
             std::string::npos);
   EXPECT_NE(probe_error("specs = \"omni\"", "specs = \"custom\"").find("custom specs need"), std::string::npos);
   const std::string custom = "specs = \"custom\"\nmax_force = 3.0\nmax_stiffness = 500.0\nworkspace_radius = 0.1\n";
-  EXPECT_NE(probe_error("specs = \"omni\"", custom + "max_torque = -0.1").find("device.max_torque: -0.1 is out of range: must lie in [0, 100]"),
+  EXPECT_NE(probe_error("specs = \"omni\"", custom + "max_torque = -0.1")
+                .find("device.max_torque: -0.1 is out of range: must lie in [0, 100]"),
             std::string::npos);
-  EXPECT_NE(probe_error("specs = \"omni\"", "max_torque = 0.1").find("device.max_torque: unknown key"), std::string::npos);
+  EXPECT_NE(probe_error("specs = \"omni\"", "max_torque = 0.1").find("device.max_torque: unknown key"),
+            std::string::npos);
   EXPECT_NE(probe_error("kind = \"virtual\"", "kind = \"replay\"").find("needs log"), std::string::npos);
-  EXPECT_NE(probe_error("kind = \"virtual\"", "kind = \"openhaptics\"\nlibary = \"x.so\"").find("device.libary: unknown key"),
+  EXPECT_NE(
+      probe_error("kind = \"virtual\"", "kind = \"openhaptics\"\nlibary = \"x.so\"").find("device.libary: unknown key"),
+      std::string::npos);
+  EXPECT_NE(probe_error("kind = \"explicit\"", "kind = \"static\"").find("give position = [x, y, z]"),
             std::string::npos);
-  EXPECT_NE(probe_error("kind = \"explicit\"", "kind = \"static\"").find("give position = [x, y, z]"), std::string::npos);
   EXPECT_NE(probe_error("scale = 2.0", "scael = 2.0").find("probe.scael: unknown key"), std::string::npos);
 }
 

@@ -44,18 +44,25 @@ void put(std::string& h, std::size_t at, T value) {
 std::string write_nifti(const std::string& name, const Grid& g, const std::vector<float>& v, int dims = 3) {
   std::string h(352, '\0');
   put<std::int32_t>(h, 0, 348);
-  const std::int16_t dim[8] = {static_cast<std::int16_t>(dims), static_cast<std::int16_t>(g.n), static_cast<std::int16_t>(g.n),
-                               static_cast<std::int16_t>(g.n), static_cast<std::int16_t>(dims > 3 ? 2 : 1), 1, 1, 1};
+  const std::int16_t dim[8] = {static_cast<std::int16_t>(dims),
+                               static_cast<std::int16_t>(g.n),
+                               static_cast<std::int16_t>(g.n),
+                               static_cast<std::int16_t>(g.n),
+                               static_cast<std::int16_t>(dims > 3 ? 2 : 1),
+                               1,
+                               1,
+                               1};
   for (int d = 0; d < 8; ++d) put<std::int16_t>(h, 40 + 2 * d, dim[d]);
   put<std::int16_t>(h, 70, 16);  // float32
   put<std::int16_t>(h, 72, 32);
   const float pixdim[8] = {-1, 1, 1, 1, 1, 0, 0, 0};
   for (int d = 0; d < 8; ++d) put<float>(h, 76 + 4 * d, pixdim[d]);
-  put<float>(h, 108, 352.0f);  // vox_offset
-  put<float>(h, 112, 1.0f);    // scl_slope
-  h[123] = 2;                  // millimetres
+  put<float>(h, 108, 352.0f);    // vox_offset
+  put<float>(h, 112, 1.0f);      // scl_slope
+  h[123] = 2;                    // millimetres
   put<std::int16_t>(h, 254, 1);  // sform_code
-  const float srow[3][4] = {{-1, 0, 0, static_cast<float>(g.origin[0])}, {0, 1, 0, static_cast<float>(g.origin[1])},
+  const float srow[3][4] = {{-1, 0, 0, static_cast<float>(g.origin[0])},
+                            {0, 1, 0, static_cast<float>(g.origin[1])},
                             {0, 0, 1, static_cast<float>(g.origin[2])}};
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 4; ++c) put<float>(h, 280 + 16 * r + 4 * c, srow[r][c]);
@@ -71,8 +78,9 @@ std::string write_nrrd(const std::string& name, const Grid& g, const std::vector
   const std::string path = dir + "/" + name;
   std::ofstream out(path, std::ios::binary);
   out << "NRRD0004\ntype: float\ndimension: 3\nsizes: " << g.n << ' ' << g.n << ' ' << g.n
-      << "\nspace: right-anterior-superior\nspace directions: (-1,0,0) (0,1,0) (0,0,1)\nspace origin: (" << g.origin[0] << ','
-      << g.origin[1] << ',' << g.origin[2] << ")\nspace units: \"mm\" \"mm\" \"mm\"\nencoding: raw\nendian: little\n\n";
+      << "\nspace: right-anterior-superior\nspace directions: (-1,0,0) (0,1,0) (0,0,1)\nspace origin: (" << g.origin[0]
+      << ',' << g.origin[1] << ',' << g.origin[2]
+      << ")\nspace units: \"mm\" \"mm\" \"mm\"\nencoding: raw\nendian: little\n\n";
   out.write(reinterpret_cast<const char*>(v.data()), static_cast<std::streamsize>(v.size() * sizeof(float)));
   return path;
 }
@@ -91,7 +99,8 @@ void expect_sphere(const PointCloud& c, const std::string& what) {
   const double exact = 4.0 / 3.0 * std::numbers::pi * 1e-6;  // r = 1 cm
   EXPECT_NEAR(c.volume.sum(), exact, 0.08 * exact) << what;
   const Vec3 mean = c.X.rowwise().mean();
-  EXPECT_LE((mean - 1e-3 * centre_mm).norm(), 5e-4) << what << ": centroid " << mean.transpose();  // metres, orientation honoured
+  EXPECT_LE((mean - 1e-3 * centre_mm).norm(), 5e-4)
+      << what << ": centroid " << mean.transpose();  // metres, orientation honoured
 }
 
 class VolumeFile : public ::testing::Test {
@@ -116,15 +125,17 @@ TEST_F(VolumeFile, NiftiAndNrrdSpheresLandWhereTheImageSays) {
 TEST_F(VolumeFile, AnEllipsoidWithAHoleKeepsItsHoleInAScene) {
   const Grid g;
   const std::string nii = write_nifti("ellipsoid.nii", g, voxels(g, ellipsoid_with_hole));
-  const Scene scene = parse_scene("[object]\nshape = \"file\"\nfile = \"" + nii + "\"\nspacing = 0.001\nthreshold = [150, 250]\n",
-                                  "volume.toml");
+  const Scene scene = parse_scene(
+      "[object]\nshape = \"file\"\nfile = \"" + nii + "\"\nspacing = 0.001\nthreshold = [150, 250]\n", "volume.toml");
   const Model m = build_scene_model(scene);
   const double exact = 4.0 / 3.0 * std::numbers::pi * (15.0 * 10.0 * 8.0 - 64.0) * 1e-9;
   EXPECT_NEAR(m.volume.sum(), exact, 0.1 * exact);
-  for (index_t i = 0; i < m.n_points; ++i) ASSERT_GT((m.X.col(i) - 1e-3 * centre_mm).norm(), 3e-3) << "a point in the hole";
+  for (index_t i = 0; i < m.n_points; ++i)
+    ASSERT_GT((m.X.col(i) - 1e-3 * centre_mm).norm(), 3e-3) << "a point in the hole";
   // without a threshold the scene says what is missing
   try {
-    build_scene_model(parse_scene("[object]\nshape = \"file\"\nfile = \"" + nii + "\"\nspacing = 0.001\n", "volume.toml"));
+    build_scene_model(
+        parse_scene("[object]\nshape = \"file\"\nfile = \"" + nii + "\"\nspacing = 0.001\n", "volume.toml"));
     ADD_FAILURE() << "a volume without a threshold was accepted";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("object.threshold"), std::string::npos) << e.what();
@@ -140,9 +151,10 @@ float sphere_with_core(const Vec3& x) {
 TEST_F(VolumeFile, AStiffnessMapGivesEachPointTheYoungsModulusOfItsIntensity) {
   const Grid g;
   const std::string nii = write_nifti("core.nii", g, voxels(g, sphere_with_core));
-  const std::string text = "[object]\nshape = \"file\"\nfile = \"" + nii +
-                           "\"\nspacing = 0.001\nthreshold = [50, 350]\nstiffness_map = [[100, 1e4], [200, 5e4], [300, 9e4]]\n"
-                           "[material]\nyoung = 2e4\n";
+  const std::string text =
+      "[object]\nshape = \"file\"\nfile = \"" + nii +
+      "\"\nspacing = 0.001\nthreshold = [50, 350]\nstiffness_map = [[100, 1e4], [200, 5e4], [300, 9e4]]\n"
+      "[material]\nyoung = 2e4\n";
   const Model m = build_scene_model(parse_scene(text, "core.toml"));
   ASSERT_EQ(m.stiffness_scale.size(), m.n_points);
   int core = 0, soft = 0;
@@ -163,8 +175,10 @@ TEST_F(VolumeFile, AStiffnessMapGivesEachPointTheYoungsModulusOfItsIntensity) {
   // interpolation between the rows, and the named errors
   EXPECT_THROW(parse_scene(std::string(text).replace(text.find("[[100, 1e4]"), 11, "[[200, 1e4]"), "bad.toml"), Error);
   try {
-    build_scene_model(parse_scene("[object]\nshape = \"box\"\nsize = [0.01, 0.01, 0.01]\nspacing = 0.005\n"
-                                  "stiffness_map = [[0, 1e4], [1, 2e4]]\n", "box.toml"));
+    build_scene_model(
+        parse_scene("[object]\nshape = \"box\"\nsize = [0.01, 0.01, 0.01]\nspacing = 0.005\n"
+                    "stiffness_map = [[0, 1e4], [1, 2e4]]\n",
+                    "box.toml"));
     ADD_FAILURE() << "a stiffness map without a volume image was accepted";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("object.stiffness_map: needs a volume image"), std::string::npos) << e.what();
@@ -192,7 +206,8 @@ TEST_F(VolumeFile, BadVolumesAreNamedErrors) {
   // 4-D
   std::vector<float> twice = v;
   twice.insert(twice.end(), v.begin(), v.end());
-  EXPECT_NE(error_of([&] { read_volume(write_nifti("4d.nii", g, twice, 4)); }).find("a 3-D image is needed"), std::string::npos);
+  EXPECT_NE(error_of([&] { read_volume(write_nifti("4d.nii", g, twice, 4)); }).find("a 3-D image is needed"),
+            std::string::npos);
   // NaN intensities: nifti2 sets non-finite floats to 0 while reading (its documented fallback)
   std::vector<float> nan = v;
   nan[77] = NAN;
@@ -208,12 +223,16 @@ TEST_F(VolumeFile, BadVolumesAreNamedErrors) {
   EXPECT_NE(error_of([&] { read_volume(bad_nrrd); }).find("bad.nrrd: not a readable NRRD file"), std::string::npos);
   // issue 21: a small file whose header declares gigabytes is refused before anything is allocated
   const std::string huge = dir + "/huge.nrrd";
-  std::ofstream(huge) << "NRRD0004\ntype: float\ndimension: 3\nsizes: 2000 2000 2000\nencoding: raw\nendian: little\n\n0000";
-  EXPECT_NE(error_of([&] { read_volume(huge); }).find("huge.nrrd: the header declares 8e+09 voxels"), std::string::npos);
-  const std::string short_raw = dir + "/short.nrrd";
-  std::ofstream(short_raw) << "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 700 700 700\nencoding: raw\nendian: little\n\n0000";
-  EXPECT_NE(error_of([&] { read_volume(short_raw); }).find("short.nrrd: truncated: the header declares 343000000 bytes"),
+  std::ofstream(huge)
+      << "NRRD0004\ntype: float\ndimension: 3\nsizes: 2000 2000 2000\nencoding: raw\nendian: little\n\n0000";
+  EXPECT_NE(error_of([&] { read_volume(huge); }).find("huge.nrrd: the header declares 8e+09 voxels"),
             std::string::npos);
+  const std::string short_raw = dir + "/short.nrrd";
+  std::ofstream(short_raw)
+      << "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 700 700 700\nencoding: raw\nendian: little\n\n0000";
+  EXPECT_NE(
+      error_of([&] { read_volume(short_raw); }).find("short.nrrd: truncated: the header declares 343000000 bytes"),
+      std::string::npos);
   // a device or a folder is not an image
   EXPECT_NE(error_of([] { read_volume("/dev/zero.nii"); }).find("no such file"), std::string::npos);
   EXPECT_NE(error_of([&] { read_volume(dir); }).find("is a folder"), std::string::npos);

@@ -30,7 +30,8 @@ TEST(Vtk, FramesAndTheirCollection) {
   const std::string frame = slurp(first);
   EXPECT_NE(frame.find("<Piece NumberOfPoints=\"2\" NumberOfVerts=\"2\""), std::string::npos) << frame;
   EXPECT_NE(frame.find("0 0 0.5\n1 2 3\n"), std::string::npos) << frame;  // points, column by column
-  EXPECT_NE(frame.find("Name=\"speed\" NumberOfComponents=\"1\" format=\"ascii\">\n1.5\n2.5\n"), std::string::npos) << frame;
+  EXPECT_NE(frame.find("Name=\"speed\" NumberOfComponents=\"1\" format=\"ascii\">\n1.5\n2.5\n"), std::string::npos)
+      << frame;
   EXPECT_NE(frame.find("type=\"UInt8\" Name=\"held\""), std::string::npos) << frame;
   const std::string pvd = slurp(series.collection_path());
   EXPECT_NE(pvd.find("timestep=\"0.25\" group=\"\" part=\"0\" file=\"frame_000001.vtp\""), std::string::npos) << pvd;

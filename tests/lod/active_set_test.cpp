@@ -77,7 +77,8 @@ TEST(ActiveSet, KeepsMassAndLoadAndGivesSparsePointsEnoughNeighbours) {
   EXPECT_NEAR(mass_active, mass_bands, 1e-12 * mass_bands);
   EXPECT_NEAR(load_active, load_bands, 1e-12 * std::abs(load_bands));
   for (index_t k = 0; k < a.n_selected; ++k) {
-    const bool enough = a.model.neighbours.row_size(k) >= std::min<index_t>(params.min_neighbours, full.neighbours.row_size(a.full_of[k]));
+    const bool enough = a.model.neighbours.row_size(k) >=
+                        std::min<index_t>(params.min_neighbours, full.neighbours.row_size(a.full_of[k]));
     const bool at_limit = a.model.support[k] >= params.max_widening * full.h * (1 - 1e-12);
     EXPECT_TRUE(enough || at_limit) << "active point " << k;
   }
@@ -97,7 +98,8 @@ TEST(ActiveSet, ThePassiveOuterRingOnlyCompletesNeighbourhoodsAndForcesStayExact
   // passive points are held, last, and no simulated point has one as a neighbour
   for (index_t k = m.stencil_end(); k < m.n_points; ++k) {
     EXPECT_TRUE(m.fixed[k]);
-    for (index_t e = m.neighbours.begin(k); e < m.neighbours.end(k); ++e) EXPECT_GE(m.neighbours.index[e], a.n_selected);
+    for (index_t e = m.neighbours.begin(k); e < m.neighbours.end(k); ++e)
+      EXPECT_GE(m.neighbours.index[e], a.n_selected);
   }
   // the forces on the simulated points are still the exact gradient of the energy, and the tangent the
   // exact derivative of the forces, on 1 and 2 threads
@@ -170,7 +172,8 @@ TEST(ActiveSet, NeighbouringAbsorbedPointsMoveTogether) {
     ++n_absorbed;
     absorbed = std::min(absorbed, (Mat3::Identity() + displacement_gradient(full, object.u, j)).determinant());
   }
-  std::printf("worst neighbourhood, det(I + G): %.3f simulated, %.3f over %d absorbed points\n", simulated, absorbed, n_absorbed);
+  std::printf("worst neighbourhood, det(I + G): %.3f simulated, %.3f over %d absorbed points\n", simulated, absorbed,
+              n_absorbed);
   ASSERT_GT(n_absorbed, 100);
   // measured: 0.542 simulated, 0.461 absorbed; each following its nearest alone: 0.123
   EXPECT_GT(absorbed, 0.75 * simulated);
@@ -231,7 +234,7 @@ TEST(ActiveSet, StaticSolveAgreesWithTheFullModelNearTheContact) {
     ASSERT_TRUE(solve_static(full, reference, ws, newton, NewtonSettings{}).converged);
   }
   LodParams p;
-  p.k1 = 6.0;              // the free half of the bar fully selected,
+  p.k1 = 6.0;  // the free half of the bar fully selected,
   p.k2 = 7.0;
   p.levels = {{20.0, 2}};  // the clamped half at selection weight 0.8
   const Selection sel = select(full, full.X.col(loaded), p);

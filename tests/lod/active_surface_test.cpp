@@ -49,18 +49,20 @@ TEST(ActiveSurface, ThePartIsWholeAroundTheContactThroughTheThinnedBand) {
   const Vec3 contact = sim.lod_selection()->centre;
   const double within = 1.5 * sim.model().h;  // T_r2
   const auto [nearest_open, open_near] = open_edges_near(part.mesh, contact, within);
-  std::printf("the part: %zu triangles; its nearest open edge %.1f mm from the contact (T_r2 = %.1f mm)\n", part.mesh.F.size(),
-              1e3 * nearest_open, 1e3 * within);
+  std::printf("the part: %zu triangles; its nearest open edge %.1f mm from the contact (T_r2 = %.1f mm)\n",
+              part.mesh.F.size(), 1e3 * nearest_open, 1e3 * within);
   EXPECT_EQ(open_near, 0);
   // for the shipped probe (6 mm), kept to 2 T_r2 + 2 reaches of the contact: whole within T_r2 still, and
   // smaller (a part of the whole surface made the 100k half-sphere's step four times the point spheres')
   const double reach = s.scene.probe.radius;
   const ActiveSurface near = restrict_surface(surface.mesh, surface.map, active, reach);
   double farthest = 0;
-  for (Eigen::Index v = 0; v < near.mesh.V.cols(); ++v) farthest = std::max(farthest, (near.mesh.V.col(v) - contact).norm());
+  for (Eigen::Index v = 0; v < near.mesh.V.cols(); ++v)
+    farthest = std::max(farthest, (near.mesh.V.col(v) - contact).norm());
   const double nearest_open_near = open_edges_near(near.mesh, contact, within).first;
-  std::printf("kept to the contact's region: %zu triangles, the farthest vertex %.1f mm away, the nearest open edge %.1f mm\n",
-              near.mesh.F.size(), 1e3 * farthest, 1e3 * nearest_open_near);
+  std::printf(
+      "kept to the contact's region: %zu triangles, the farthest vertex %.1f mm away, the nearest open edge %.1f mm\n",
+      near.mesh.F.size(), 1e3 * farthest, 1e3 * nearest_open_near);
   EXPECT_LE(farthest, 2 * active.core_radius + 2 * reach + 1e-12);
   EXPECT_LT(near.mesh.F.size(), part.mesh.F.size());
   EXPECT_GT(nearest_open_near, within);

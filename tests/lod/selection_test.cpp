@@ -15,7 +15,9 @@ namespace {
 
 const double s = 0.002;
 
-Model cube() { return build_model(test::jittered_box(30, 30, 30, s, 0.0), MaterialParams{}, KernelParams{}); }  // 27k points
+Model cube() {
+  return build_model(test::jittered_box(30, 30, 30, s, 0.0), MaterialParams{}, KernelParams{});
+}  // 27k points
 
 LodParams seed_params() {
   LodParams p;
@@ -83,7 +85,8 @@ TEST(LodSelection, DitherSchemeKeepsTheBandsAndIsTheSameForEverySeed) {
   EXPECT_EQ(s1.band_selected[0], s1.band_count[0]);
   const double expected[] = {1.0, 0.8, 0.4, 0.2};
   for (int band = 1; band < 4; ++band)
-    EXPECT_NEAR(static_cast<double>(s1.band_selected[band]) / s1.band_count[band], expected[band], 0.08) << "band " << band;
+    EXPECT_NEAR(static_cast<double>(s1.band_selected[band]) / s1.band_count[band], expected[band], 0.08)
+        << "band " << band;
 }
 
 TEST(LodSelection, EachBandIsSelectedWithTheSeedsProbability) {
@@ -113,7 +116,8 @@ TEST(LodSelection, HeldPointsAreAlwaysSelectedAndASeedGivesOneSelection) {
                   s3 = select_points(model, c, seed_params(), other);
   EXPECT_EQ(s1.selected, s2.selected);
   EXPECT_NE(s1.selected, s3.selected);
-  for (index_t i = 0; i < model.n_points; i += 97) EXPECT_TRUE(std::binary_search(s1.selected.begin(), s1.selected.end(), i));
+  for (index_t i = 0; i < model.n_points; i += 97)
+    EXPECT_TRUE(std::binary_search(s1.selected.begin(), s1.selected.end(), i));
 }
 
 TEST(LodSelection, BadParametersAreNamedErrors) {

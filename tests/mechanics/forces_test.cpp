@@ -109,15 +109,16 @@ TEST_P(ForcesTest, AnyNumberOfThreadsGivesTheSameForcesAsOne) {
 
 INSTANTIATE_TEST_SUITE_P(
     Terms, ForcesTest,
-    ::testing::Values(Config{"elastic_only", 0.0, 0.0}, Config{"with_volume", 3e5, 0.0}, Config{"with_hourglass", 0.0, 0.05},
-                      Config{"all_terms", 3e5, 0.2}, Config{"spiky", 1e5, 0.05, KernelType::SPIKY},
-                      Config{"viscosity", 1e5, 0.05, KernelType::VISCOSITY},
-                      Config{"quadratic_wide", 1e5, 0.05, KernelType::QUADRATIC, VolumeMode::CELL, 2.6},
-                      Config{"kernel_volumes", 1e5, 0.05, KernelType::POLY6, VolumeMode::KERNEL},
-                      // each model through the force loop's four-point stresses (lanes.hpp)
-                      Config{"neo_hookean", 0.0, 0.05, KernelType::POLY6, VolumeMode::CELL, 2.0, MaterialModel::NEO_HOOKEAN},
-                      Config{"mooney_rivlin", 3e5, 0.05, KernelType::POLY6, VolumeMode::CELL, 2.0, MaterialModel::MOONEY_RIVLIN},
-                      Config{"corotated", 0.0, 0.05, KernelType::POLY6, VolumeMode::CELL, 2.0, MaterialModel::COROTATED}),
+    ::testing::Values(
+        Config{"elastic_only", 0.0, 0.0}, Config{"with_volume", 3e5, 0.0}, Config{"with_hourglass", 0.0, 0.05},
+        Config{"all_terms", 3e5, 0.2}, Config{"spiky", 1e5, 0.05, KernelType::SPIKY},
+        Config{"viscosity", 1e5, 0.05, KernelType::VISCOSITY},
+        Config{"quadratic_wide", 1e5, 0.05, KernelType::QUADRATIC, VolumeMode::CELL, 2.6},
+        Config{"kernel_volumes", 1e5, 0.05, KernelType::POLY6, VolumeMode::KERNEL},
+        // each model through the force loop's four-point stresses (lanes.hpp)
+        Config{"neo_hookean", 0.0, 0.05, KernelType::POLY6, VolumeMode::CELL, 2.0, MaterialModel::NEO_HOOKEAN},
+        Config{"mooney_rivlin", 3e5, 0.05, KernelType::POLY6, VolumeMode::CELL, 2.0, MaterialModel::MOONEY_RIVLIN},
+        Config{"corotated", 0.0, 0.05, KernelType::POLY6, VolumeMode::CELL, 2.0, MaterialModel::COROTATED}),
     [](const auto& info) { return std::string(info.param.name); });
 
 TEST(Deformation, AffineFieldGivesItsExactGradientEverywhere) {
@@ -156,11 +157,13 @@ TEST(ZeroEnergyModes, OddEvenFieldIsOnlyResistedWithThePenalty) {
       if (model.neighbours.row_size(i) != 26) continue;
       const Mat3 G = displacement_gradient(model, u, i);
       const Mat3 E = green_strain(G);
-      elastic += model.volume[i] * 0.5 * (StVenantKirchhoff{model.lambda, model.mu}.second_piola(E).array() * E.array()).sum();
+      elastic +=
+          model.volume[i] * 0.5 * (StVenantKirchhoff{model.lambda, model.mu}.second_piola(E).array() * E.array()).sum();
       for (index_t k = model.neighbours.begin(i); k < model.neighbours.end(i); ++k) {
         const index_t j = model.neighbours.index[k];
         const Mat3 G_mean = 0.5 * (G + displacement_gradient(model, u, j));
-        penalty += 0.5 * model.hg_coef[k] * (u.col(j) - u.col(i) - G_mean * (model.X.col(j) - model.X.col(i))).squaredNorm();
+        penalty +=
+            0.5 * model.hg_coef[k] * (u.col(j) - u.col(i) - G_mean * (model.X.col(j) - model.X.col(i))).squaredNorm();
       }
     }
     // what the same amplitude costs as a uniform 0.1% stretch of the interior

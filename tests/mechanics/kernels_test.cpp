@@ -49,7 +49,8 @@ TEST_P(KernelTest, DerivativeMatchesFiniteDifferences) {
 }
 
 INSTANTIATE_TEST_SUITE_P(SeedKernels, KernelTest,
-                         ::testing::Values(KernelType::POLY6, KernelType::SPIKY, KernelType::VISCOSITY, KernelType::QUADRATIC),
+                         ::testing::Values(KernelType::POLY6, KernelType::SPIKY, KernelType::VISCOSITY,
+                                           KernelType::QUADRATIC),
                          [](const auto& info) { return std::string(to_string(info.param)); });
 
 TEST(Kernels, QuadraticBranchesMeetAtHalfSupport) {

@@ -151,7 +151,8 @@ TEST(BuildModel, TheModelAndItsEnergyAreTheSameOnOneThreadAndOnMany) {
   const auto build = [&] {
     const Model model = build_model(sample_half_sphere(Vec3::Zero(), 0.05, 0.004), material, KernelParams{});
     Points u(3, model.n_points);
-    for (index_t i = 0; i < model.n_points; ++i) u.col(i) = 1e-3 * Vec3(std::sin(40 * model.X(0, i)), model.X(1, i), 0.0);
+    for (index_t i = 0; i < model.n_points; ++i)
+      u.col(i) = 1e-3 * Vec3(std::sin(40 * model.X(0, i)), model.X(1, i), 0.0);
     return std::make_tuple(model.volume, model.hg_diagonal, strain_energy(model, u).total());
   };
   tbb::task_arena one(1);

@@ -25,7 +25,8 @@ Model cut_block() {
   m.hourglass = 0.5;
   Model model = build_model(test::jittered_box(8, 5, 5, 0.01, 0.2), m, KernelParams{});
   // a slit from the top into the middle of the block
-  const BladeSweep slit{Vec3(0.035, 0.06, -0.01), Vec3(0.035, 0.06, 0.06), Vec3(0.035, 0.02, -0.01), Vec3(0.035, 0.02, 0.06)};
+  const BladeSweep slit{Vec3(0.035, 0.06, -0.01), Vec3(0.035, 0.06, 0.06), Vec3(0.035, 0.02, -0.01),
+                        Vec3(0.035, 0.02, 0.06)};
   EXPECT_GT(cut(model, model.X, slit).severed_pairs, 0);
   return model;
 }

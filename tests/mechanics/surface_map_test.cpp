@@ -33,9 +33,11 @@ struct Case {
 std::vector<Case> cases() {
   const Vec3 size(0.06, 0.03, 0.04);
   return {{"box", sample_box(Vec3::Zero(), size, spacing), box_surface(Vec3::Zero(), size, spacing / 2)},
-          {"jittered box", test::jittered_box(6, 4, 5, spacing, 0.2), box_surface(Vec3::Zero(), Vec3(0.05, 0.03, 0.04), spacing / 2)},
+          {"jittered box", test::jittered_box(6, 4, 5, spacing, 0.2),
+           box_surface(Vec3::Zero(), Vec3(0.05, 0.03, 0.04), spacing / 2)},
           {"sphere", sample_sphere(Vec3::Zero(), 0.03, spacing), sphere_surface(Vec3::Zero(), 0.03, spacing / 2)},
-          {"half-sphere", sample_half_sphere(Vec3::Zero(), 0.03, spacing), half_sphere_surface(Vec3::Zero(), 0.03, spacing / 2)}};
+          {"half-sphere", sample_half_sphere(Vec3::Zero(), 0.03, spacing),
+           half_sphere_surface(Vec3::Zero(), 0.03, spacing / 2)}};
 }
 
 TEST(SurfaceMap, CarriesAffineAndRigidFieldsExactly) {

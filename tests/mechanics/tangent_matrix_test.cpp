@@ -67,7 +67,8 @@ TEST(TangentMatrix, IsSymmetricBlockForBlock) {
     for (index_t e = K.pattern.begin(j); e < K.pattern.end(j); ++e) {
       const index_t k = K.pattern.index[e];
       const auto* row_k = &K.pattern.index[K.pattern.begin(k)];
-      const index_t f = K.pattern.begin(k) + static_cast<index_t>(std::lower_bound(row_k, row_k + K.pattern.row_size(k), j) - row_k);
+      const index_t f =
+          K.pattern.begin(k) + static_cast<index_t>(std::lower_bound(row_k, row_k + K.pattern.row_size(k), j) - row_k);
       ASSERT_EQ(K.pattern.index[f], j) << "the pattern is symmetric";
       const Mat3 Kjk = Eigen::Map<const Mat3>(K.values.data() + 9 * static_cast<std::size_t>(e));
       const Mat3 Kkj = Eigen::Map<const Mat3>(K.values.data() + 9 * static_cast<std::size_t>(f));
@@ -122,7 +123,9 @@ TEST(TangentMatrix, ACouplingEntersItsBlocksOrIsLumpedOntoTheDiagonal) {
   ASSERT_GE(far, 0) << "the box is wider than two stencils";
   Mat3 S;
   S << 2, 0.5, 0, 0.5, 1, 0.2, 0, 0.2, 3;  // symmetric positive definite
-  const auto block = [&](index_t e) { return Mat3(Eigen::Map<const Mat3>(K.values.data() + 9 * static_cast<std::size_t>(e))); };
+  const auto block = [&](index_t e) {
+    return Mat3(Eigen::Map<const Mat3>(K.values.data() + 9 * static_cast<std::size_t>(e)));
+  };
   for (const double a : {0.7, -0.7}) {
     SCOPED_TRACE(a);
     K.values.assign(9 * static_cast<std::size_t>(K.n_blocks()), 0.0);

@@ -33,7 +33,8 @@ TEST(VariableSupport, NeighbourhoodsFollowTheMaxRuleAndAreSymmetric) {
   for (index_t i = 0; i < cloud.size(); ++i)
     for (index_t j = 0; j < cloud.size(); ++j) {
       if (i == j) continue;
-      const bool expected = within_support((cloud.X.col(j) - cloud.X.col(i)).squaredNorm(), std::max(cloud.support[i], cloud.support[j]));
+      const bool expected =
+          within_support((cloud.X.col(j) - cloud.X.col(i)).squaredNorm(), std::max(cloud.support[i], cloud.support[j]));
       const bool found = std::binary_search(nbr.index.begin() + nbr.begin(i), nbr.index.begin() + nbr.end(i), j);
       ASSERT_EQ(found, expected) << i << " " << j;
     }

@@ -169,7 +169,9 @@ TEST(ExplicitSolver, ThePlannedStiffeningRisesAtOnceAndFallsSlowly) {
   EXPECT_EQ(explicit_step(model, rest, ws, 0.99 * stable, stable, nullptr, &planned).substeps, 2);
   EXPECT_GT(planned, 2.8);
   int steps_to_one = 1;
-  while (explicit_step(model, rest, ws, 0.99 * stable, stable, nullptr, &planned).substeps > 1 && steps_to_one < 1000000) ++steps_to_one;
+  while (explicit_step(model, rest, ws, 0.99 * stable, stable, nullptr, &planned).substeps > 1 &&
+         steps_to_one < 1000000)
+    ++steps_to_one;
   // 1 + 1.875 e^(-t / 0.5 s) falls to 1.25 / 0.99^2 = 1.2754 at t = 0.96 s
   EXPECT_NEAR(steps_to_one * 0.99 * stable, 0.96, 0.02);
   // without a plan, each step plans for its own last evaluation

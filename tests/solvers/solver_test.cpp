@@ -62,7 +62,7 @@ TEST(Solver, HeldPointsFollowTheirRampAndTheLoadFactor) {
   hold_points(model, 0.05, u, &v, 0.01);  // half-way up the 0.1 s ramp
   const index_t held = model.fixed_groups[0].points.front();
   EXPECT_DOUBLE_EQ(u(0, held), 0.001);
-  EXPECT_DOUBLE_EQ(v(0, held), 0.1);  // 1 mm over the 10 ms step
+  EXPECT_DOUBLE_EQ(v(0, held), 0.1);                                                 // 1 mm over the 10 ms step
   hold_points(model, std::numeric_limits<double>::infinity(), u, nullptr, 0, 0.25);  // static, a quarter of the load
   EXPECT_DOUBLE_EQ(u(0, held), 0.0005);
   // free points are not touched

@@ -366,7 +366,8 @@ TEST(CholeskyPreconditioner, InRealTimeStepsGoOnWhileTheWorkerFactorises) {
     if (started_at >= 0 && step == started_at + 20) {
       gate.release();
       // let it finish, then the next Newton iteration takes it up
-      for (int k = 0; k < 10000 && !chol.background_ready(); ++k) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      for (int k = 0; k < 10000 && !chol.background_ready(); ++k)
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
       EXPECT_TRUE(chol.background_ready());
     }
   });

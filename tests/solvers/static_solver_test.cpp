@@ -60,11 +60,14 @@ TEST(StaticSolver, FindsTheEquilibriumAtSmallAndLargeLoads) {
       EXPECT_GT(-tip, 0.2 * 8 * spacing);  // geometrically nonlinear regime
     }
     // the supports carry the load
-    EXPECT_NEAR(support_reactions(model, [&] {
-                  Workspace w(model, 1);
-                  compute_internal_forces(model, state.u, w);
-                  return w.f_int;
-                }())[0].y(), force, 1e-7 * force);
+    EXPECT_NEAR(support_reactions(model,
+                                  [&] {
+                                    Workspace w(model, 1);
+                                    compute_internal_forces(model, state.u, w);
+                                    return w.f_int;
+                                  }())[0]
+                    .y(),
+                force, 1e-7 * force);
   }
 }
 

@@ -68,14 +68,27 @@ HDErrorInfo hdGetError() {
 void hdGetDoublev(HDenum what, double* v) {
   const double a = frames * M_PI / 180.0;
   switch (what) {
-    case 0x2050: v[0] = 10 * std::cos(a); v[1] = 10 * std::sin(a); v[2] = 0; break;  // position, mm
-    case 0x2051: v[0] = -10 * std::sin(a) * 1000 * M_PI / 180; v[1] = 10 * std::cos(a) * 1000 * M_PI / 180; v[2] = 0; break;  // mm/s at 1 kHz
+    case 0x2050:
+      v[0] = 10 * std::cos(a);
+      v[1] = 10 * std::sin(a);
+      v[2] = 0;
+      break;  // position, mm
+    case 0x2051:
+      v[0] = -10 * std::sin(a) * 1000 * M_PI / 180;
+      v[1] = 10 * std::cos(a) * 1000 * M_PI / 180;
+      v[2] = 0;
+      break;                           // mm/s at 1 kHz
     case 0x2604: v[0] = 0.88; break;   // continuous force, N
     case 0x2602: v[0] = 0.4; break;    // stiffness, N/mm
     case 0x2609: v[0] = 0.003; break;  // damping, N s/mm
-    case 0x2551: { const double box[6] = {-80, -60, -35, 80, 60, 35}; std::memcpy(v, box, sizeof box); break; }
+    case 0x2551: {
+      const double box[6] = {-80, -60, -35, 80, 60, 35};
+      std::memcpy(v, box, sizeof box);
+      break;
+    }
     case 0x2052: {  // the stylus's transform: turned about z by a, at the position; column-major, mm
-      const double m[16] = {std::cos(a), std::sin(a), 0, 0, -std::sin(a), std::cos(a), 0, 0, 0, 0, 1, 0, 10 * std::cos(a), 10 * std::sin(a), 0, 1};
+      const double m[16] = {std::cos(a), std::sin(a), 0, 0, -std::sin(a),     std::cos(a),      0, 0,
+                            0,           0,           1, 0, 10 * std::cos(a), 10 * std::sin(a), 0, 1};
       std::memcpy(v, m, sizeof m);
       break;
     }

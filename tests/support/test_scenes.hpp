@@ -24,8 +24,10 @@ kind = "traction"
 box = { min = [0.15, -1.0, -1.0], max = [1.0, 1.0, 1.0] }
 total = [0.0, -0.01, 0.0]
 [solver]
-kind = ")" + solver + R"("
-dt = )" + dt + R"(
+kind = ")" +
+         solver + R"("
+dt = )" + dt +
+         R"(
 duration = 2.0
 )";
 }

@@ -62,7 +62,8 @@ TEST(ViewerSession, ProbeSourcesAreNamedAndScriptsAreNeeded) {
   const DisplayFrame stepped = simulate_frame(*lod, 0.05);
   ASSERT_EQ(stepped.lod_band.size(), 90u);
   EXPECT_LT(stepped.simulated, 90);
-  EXPECT_EQ(static_cast<index_t>(std::count_if(stepped.lod_band.begin(), stepped.lod_band.end(), [](auto b) { return b >= 0; })),
+  EXPECT_EQ(static_cast<index_t>(
+                std::count_if(stepped.lod_band.begin(), stepped.lod_band.end(), [](auto b) { return b >= 0; })),
             stepped.simulated);
   // a static scene is shown with implicit dynamics, and says so
   Scene still = beam_scene();
@@ -183,7 +184,9 @@ TEST(ViewerSession, AScriptedCutSplitsTheDrawnSurfaceInAStillFrameAndInRealTime)
   ViewerSession session(prepare(scene, ProbeSource::MOUSE, 1), ProbeSource::MOUSE, 1);
   session.start();
   // (the first strips are above the beam: a split of them has no faces inside it yet)
-  EXPECT_TRUE(poll_until(session, [&](bool) { return session.current().cut_surface && session.current().cut_surface->cut_faces > 0; }, 300));
+  EXPECT_TRUE(poll_until(
+      session, [&](bool) { return session.current().cut_surface && session.current().cut_surface->cut_faces > 0; },
+      300));
   EXPECT_GT(session.current().cut_revision, 0);
   session.stop();
 }

@@ -14,26 +14,26 @@ namespace pointhaptics {
 
 /// A set of held points (one `[[fixed]]` table): at zero or at a prescribed displacement.
 struct FixedGroup {
-  std::string name;                       ///< for messages, e.g. "fixed #1"
-  Vec3 displacement = Vec3::Zero();       ///< prescribed displacement, m
-  double ramp = 0.0;                      ///< ramp-in time of the prescribed displacement, s
-  std::vector<index_t> points;            ///< held points
+  std::string name;                  ///< for messages, e.g. "fixed #1"
+  Vec3 displacement = Vec3::Zero();  ///< prescribed displacement, m
+  double ramp = 0.0;                 ///< ramp-in time of the prescribed displacement, s
+  std::vector<index_t> points;       ///< held points
 };
 
 /// Static, precomputed data of a point-based object (MuJoCo's mjModel). Built by build_model()
 /// and then only read: the solvers take it by const reference.
 struct Model {
   index_t n_points = 0;
-  Points X;                         ///< reference positions, m  (3 x n)
-  Eigen::VectorXd volume;           ///< v_i, m^3  (n)
-  Eigen::VectorXd mass;             ///< m_i, kg  (n)
-  double spacing = 0;               ///< nominal sample spacing, m
-  double h = 0;                     ///< kernel support radius, m (the base one when `support` is set)
-  Eigen::VectorXd support;          ///< per-point support h_i, m, when they differ (levels of detail); else empty
-  double extent = 0;                ///< diagonal of the reference bounding box plus h, m (scale for divergence checks)
+  Points X;                 ///< reference positions, m  (3 x n)
+  Eigen::VectorXd volume;   ///< v_i, m^3  (n)
+  Eigen::VectorXd mass;     ///< m_i, kg  (n)
+  double spacing = 0;       ///< nominal sample spacing, m
+  double h = 0;             ///< kernel support radius, m (the base one when `support` is set)
+  Eigen::VectorXd support;  ///< per-point support h_i, m, when they differ (levels of detail); else empty
+  double extent = 0;        ///< diagonal of the reference bounding box plus h, m (scale for divergence checks)
   KernelParams kernel;
-  MaterialParams material;          ///< the object's material (its points' unless material_of says otherwise)
-  double lambda = 0, mu = 0;        ///< Lame parameters of `material`, Pa
+  MaterialParams material;    ///< the object's material (its points' unless material_of says otherwise)
+  double lambda = 0, mu = 0;  ///< Lame parameters of `material`, Pa
   /// per-point materials ([[region]] tables, a stiffness map): the point i has point_materials[material_of[i]]
   /// (point_materials[0] is `material`); both empty when every point has `material`
   std::vector<MaterialParams> point_materials;
@@ -49,19 +49,19 @@ struct Model {
   Csr neighbours;
   std::vector<index_t> reverse_pair;  ///< for each pair e = (i, j), the pair (j, i)  (n_pairs)
   // per-pair data, aligned with neighbours.index
-  Points d;                         ///< d_ij = M_i^-1 X_ij w_ij, 1/m  (3 x n_pairs), seed Eq. 10-11
-  Eigen::VectorXd hg_coef;          ///< k_ij = (alpha E / 2) (v_i w^_ij + v_j w^_ji) / |X_ij|^2, symmetric, N/m  (n_pairs)
+  Points d;                 ///< d_ij = M_i^-1 X_ij w_ij, 1/m  (3 x n_pairs), seed Eq. 10-11
+  Eigen::VectorXd hg_coef;  ///< k_ij = (alpha E / 2) (v_i w^_ij + v_j w^_ji) / |X_ij|^2, symmetric, N/m  (n_pairs)
   /// 1 where a cut severed the pair (mechanics/cut.hpp): it stays in the lists, with d_ij = 0 and k_ij = 0, so
   /// it carries nothing; empty while nothing was cut  (n_pairs)
   std::vector<std::uint8_t> severed;
   // per-point data
-  Points d_self;                    ///< d_ii = -sum_j d_ij, 1/m  (3 x n)
-  Eigen::VectorXd hg_diagonal;      ///< diagonal of the (constant) hourglass Hessian per point, N/m  (n)
+  Points d_self;                ///< d_ii = -sum_j d_ij, 1/m  (3 x n)
+  Eigen::VectorXd hg_diagonal;  ///< diagonal of the (constant) hourglass Hessian per point, N/m  (n)
 
   // boundary conditions and constant external loads
-  std::vector<unsigned char> fixed; ///< 1 where the point is held  (n)
+  std::vector<unsigned char> fixed;  ///< 1 where the point is held  (n)
   std::vector<FixedGroup> fixed_groups;
-  Points f_ext;                     ///< constant external force per point (gravity, tractions, point loads), N  (3 x n)
+  Points f_ext;  ///< constant external force per point (gravity, tractions, point loads), N  (3 x n)
 
   ModelDiagnostics diagnostics;
 
@@ -71,9 +71,13 @@ struct Model {
   index_t n_passive = 0;
 
   /// The material of point i.
-  const MaterialParams& material_at(index_t i) const { return material_of.empty() ? material : point_materials[material_of[i]]; }
+  const MaterialParams& material_at(index_t i) const {
+    return material_of.empty() ? material : point_materials[material_of[i]];
+  }
   /// Young's modulus of point i, Pa (its material's, times its stiffness scale).
-  double young_at(index_t i) const { return material_at(i).young * (stiffness_scale.size() ? stiffness_scale[i] : 1.0); }
+  double young_at(index_t i) const {
+    return material_at(i).young * (stiffness_scale.size() ? stiffness_scale[i] : 1.0);
+  }
   /// The largest P-wave modulus lambda + 2 mu over the object's materials and stiffness scales, Pa (the explicit
   /// stable step).
   double max_p_wave_modulus() const {

@@ -4,9 +4,7 @@
 
 namespace pointhaptics {
 
-double MaterialParams::p_wave_speed() const {
-  return std::sqrt((lambda() + 2.0 * mu() + volume_stiffness) / density);
-}
+double MaterialParams::p_wave_speed() const { return std::sqrt((lambda() + 2.0 * mu() + volume_stiffness) / density); }
 
 bool valid_prony(const std::vector<PronyTerm>& series) {
   if (series.empty() || series.size() > max_prony_terms) return false;

@@ -41,12 +41,13 @@ struct PronyTerm {
 
 struct MaterialParams {
   MaterialModel model = MaterialModel::SVK;
-  double young = 1e5;              ///< Young's modulus E, Pa
-  double poisson = 0.4;            ///< Poisson ratio nu, in (-1, 0.5)
-  double density = 1000.0;         ///< rho, kg/m^3
-  double volume_stiffness = 0.0;   ///< k_v of the volume term 0.5 k_v v (det F - 1)^2, Pa
-  double damping = 0.0;            ///< mass-proportional damping, 1/s
-  double hourglass = 0.3;          ///< alpha of the zero-energy-mode penalty (averaged-gradient form, docs/mechanics.md); 0: off
+  double young = 1e5;             ///< Young's modulus E, Pa
+  double poisson = 0.4;           ///< Poisson ratio nu, in (-1, 0.5)
+  double density = 1000.0;        ///< rho, kg/m^3
+  double volume_stiffness = 0.0;  ///< k_v of the volume term 0.5 k_v v (det F - 1)^2, Pa
+  double damping = 0.0;           ///< mass-proportional damping, 1/s
+  double hourglass =
+      0.3;  ///< alpha of the zero-energy-mode penalty (averaged-gradient form, docs/mechanics.md); 0: off
   VolumeMode volume = VolumeMode::CELL;
   /// Mooney-Rivlin's split of the shear modulus mu = 2 (c10 + c01), Pa: when given (the scene's c10, c01 and
   /// bulk), young and poisson are set from them; otherwise both are mu / 4
@@ -105,14 +106,14 @@ struct LodParams {
   std::vector<LodLevel> levels;  ///< propagation levels beyond T_r2 (none: nothing beyond T_r2)
   std::uint64_t seed = 1;        ///< of the random generator, so that runs are reproducible
   LodScheme scheme = LodScheme::RANDOM;
-  double reselect = 0.5;         ///< re-select when the contact point moved farther than this (units of h)
+  double reselect = 0.5;  ///< re-select when the contact point moved farther than this (units of h)
   /// no re-selection sooner than this after the last one (s of simulated time; contact onset excepted): a
   /// take-over is a small shock, and a slow real-time session that re-selected every few milliseconds
   /// diverged (issue 21)
   double reselect_interval = 0.05;
-  int min_neighbours = 12;       ///< a selected point's support widens until it reaches this many points
-                                 ///< (or as many as it had in the full model, if fewer) ...
-  double max_widening = 3.0;     ///< ... but never beyond this multiple of h
+  int min_neighbours = 12;    ///< a selected point's support widens until it reaches this many points
+                              ///< (or as many as it had in the full model, if fewer) ...
+  double max_widening = 3.0;  ///< ... but never beyond this multiple of h
 };
 
 enum class SolverKind { STATIC, EXPLICIT, IMPLICIT };
@@ -138,14 +139,14 @@ enum class Refactorisation {
 /// [solver]: which solver advances the object, and how far.
 struct SolverSpec {
   SolverKind kind = SolverKind::EXPLICIT;
-  double dt = 1e-3;            ///< s
-  double duration = 1.0;       ///< s
-  double tolerance = 0;        ///< static, implicit: relative residual; 0 = default (1e-8 static, 1e-6 implicit)
-  int max_iterations = 50;     ///< static, implicit: Newton iterations per solve
-  int max_cg_iterations = 2000;///< static, implicit: CG iterations per Newton iteration
-  int iteration_budget = 0;    ///< implicit: Newton iterations per step in real time, keeping the iterate (0 = off)
+  double dt = 1e-3;              ///< s
+  double duration = 1.0;         ///< s
+  double tolerance = 0;          ///< static, implicit: relative residual; 0 = default (1e-8 static, 1e-6 implicit)
+  int max_iterations = 50;       ///< static, implicit: Newton iterations per solve
+  int max_cg_iterations = 2000;  ///< static, implicit: CG iterations per Newton iteration
+  int iteration_budget = 0;      ///< implicit: Newton iterations per step in real time, keeping the iterate (0 = off)
   Preconditioner preconditioner = Preconditioner::BLOCK_JACOBI;  ///< static, implicit
-  int refactor_iterations = 8; ///< cholesky: refactorise after a CG solve of more iterations than this
+  int refactor_iterations = 8;  ///< cholesky: refactorise after a CG solve of more iterations than this
   Refactorisation refactorisation = Refactorisation::AUTO;  ///< cholesky: where refactorisations run
 };
 
@@ -155,33 +156,42 @@ template <class E>
 struct EnumNames;
 template <>
 struct EnumNames<KernelType> {
-  static constexpr std::array<std::pair<KernelType, std::string_view>, 4> table{
-      {{KernelType::POLY6, "poly6"}, {KernelType::SPIKY, "spiky"}, {KernelType::VISCOSITY, "viscosity"}, {KernelType::QUADRATIC, "quadratic"}}};
+  static constexpr std::array<std::pair<KernelType, std::string_view>, 4> table{{{KernelType::POLY6, "poly6"},
+                                                                                 {KernelType::SPIKY, "spiky"},
+                                                                                 {KernelType::VISCOSITY, "viscosity"},
+                                                                                 {KernelType::QUADRATIC, "quadratic"}}};
 };
 template <>
 struct EnumNames<MaterialModel> {
-  static constexpr std::array<std::pair<MaterialModel, std::string_view>, 4> table{{{MaterialModel::SVK, "svk"},
-                                                                                    {MaterialModel::NEO_HOOKEAN, "neo_hookean"},
-                                                                                    {MaterialModel::MOONEY_RIVLIN, "mooney_rivlin"},
-                                                                                    {MaterialModel::COROTATED, "corotated"}}};
+  static constexpr std::array<std::pair<MaterialModel, std::string_view>, 4> table{
+      {{MaterialModel::SVK, "svk"},
+       {MaterialModel::NEO_HOOKEAN, "neo_hookean"},
+       {MaterialModel::MOONEY_RIVLIN, "mooney_rivlin"},
+       {MaterialModel::COROTATED, "corotated"}}};
 };
 template <>
 struct EnumNames<VolumeMode> {
-  static constexpr std::array<std::pair<VolumeMode, std::string_view>, 2> table{{{VolumeMode::CELL, "cell"}, {VolumeMode::KERNEL, "kernel"}}};
+  static constexpr std::array<std::pair<VolumeMode, std::string_view>, 2> table{
+      {{VolumeMode::CELL, "cell"}, {VolumeMode::KERNEL, "kernel"}}};
 };
 template <>
 struct EnumNames<LodScheme> {
-  static constexpr std::array<std::pair<LodScheme, std::string_view>, 2> table{{{LodScheme::RANDOM, "random"}, {LodScheme::DITHER, "dither"}}};
+  static constexpr std::array<std::pair<LodScheme, std::string_view>, 2> table{
+      {{LodScheme::RANDOM, "random"}, {LodScheme::DITHER, "dither"}}};
 };
 template <>
 struct EnumNames<Preconditioner> {
   static constexpr std::array<std::pair<Preconditioner, std::string_view>, 3> table{
-      {{Preconditioner::BLOCK_JACOBI, "block_jacobi"}, {Preconditioner::CHOLESKY, "cholesky"}, {Preconditioner::TWO_LEVEL, "two_level"}}};
+      {{Preconditioner::BLOCK_JACOBI, "block_jacobi"},
+       {Preconditioner::CHOLESKY, "cholesky"},
+       {Preconditioner::TWO_LEVEL, "two_level"}}};
 };
 template <>
 struct EnumNames<Refactorisation> {
   static constexpr std::array<std::pair<Refactorisation, std::string_view>, 3> table{
-      {{Refactorisation::AUTO, "auto"}, {Refactorisation::IN_PLACE, "in_place"}, {Refactorisation::BACKGROUND, "background"}}};
+      {{Refactorisation::AUTO, "auto"},
+       {Refactorisation::IN_PLACE, "in_place"},
+       {Refactorisation::BACKGROUND, "background"}}};
 };
 template <>
 struct EnumNames<SolverKind> {

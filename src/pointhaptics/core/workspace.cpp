@@ -50,7 +50,8 @@ Workspace::~Workspace() = default;
 SolverScratch& Workspace::solver_scratch() {
   if (!solver_sized_) {
     SolverScratch& s = solver_;
-    for (Points* p : {&s.r, &s.dx, &s.trial, &s.cg_r, &s.cg_z, &s.cg_p, &s.cg_q, &s.anchor, &s.next, &s.load, &s.start, &s.tool_forces, &s.term_forces})
+    for (Points* p : {&s.r, &s.dx, &s.trial, &s.cg_r, &s.cg_z, &s.cg_p, &s.cg_q, &s.anchor, &s.next, &s.load, &s.start,
+                      &s.tool_forces, &s.term_forces})
       p->setZero(3, n_points_);
     s.blocks.setZero(9, n_points_);
     s.springs.setZero(9, n_points_);
@@ -65,7 +66,8 @@ Workspace& Workspace::operator=(Workspace&&) noexcept = default;
 
 void Workspace::run_chunks(void (*call)(void*, int), void* context) {
   pool_->arena.execute([&] {
-    tbb::parallel_for(0, n_threads_, [&](int c) { call(context, c); }, tbb::static_partitioner());
+    tbb::parallel_for(
+        0, n_threads_, [&](int c) { call(context, c); }, tbb::static_partitioner());
   });
 }
 

@@ -46,11 +46,11 @@ class Workspace {
   template <class Fn>
   void for_each_chunk(Fn&& fn);
 
-  Points f_int;                     ///< internal elastic forces, N  (3 x n)
-  Points acceleration;              ///< scratch of the explicit solver, m/s^2  (3 x n)
+  Points f_int;         ///< internal elastic forces, N  (3 x n)
+  Points acceleration;  ///< scratch of the explicit solver, m/s^2  (3 x n)
   // scratch of the stencil loop (mechanics/detail/stencil_loop.hpp)
-  PaddedPoints padded_u;                  ///< the displacement (or increment) the loop reads
-  PaddedGradients gradients;              ///< G_i of the last stencil pass, by columns
+  PaddedPoints padded_u;      ///< the displacement (or increment) the loop reads
+  PaddedGradients gradients;  ///< G_i of the last stencil pass, by columns
   /// G_i of the last stencil pass, unpadded.
   Mat3 gradient(index_t i) const {
     Mat3 G;
@@ -63,8 +63,8 @@ class Workspace {
   double viscous_shear_factor = 1;
   bool overstress_active = false;
   Eigen::Matrix<double, 6, Eigen::Dynamic> overstress;
-  std::vector<PaddedPoints> chunk_forces; ///< per-chunk scatter targets, summed into the result  (n_threads)
-  std::vector<double> chunk_scalars;      ///< one value per chunk for reductions without atomics  (n_threads)
+  std::vector<PaddedPoints> chunk_forces;  ///< per-chunk scatter targets, summed into the result  (n_threads)
+  std::vector<double> chunk_scalars;       ///< one value per chunk for reductions without atomics  (n_threads)
   /// The solvers' scratch, sized for the model on the first call (explicit dynamics never pays for it);
   /// after that no call allocates.
   SolverScratch& solver_scratch();
@@ -77,7 +77,7 @@ class Workspace {
   bool solver_sized_ = false;
   std::vector<index_t> chunk_offset_;
   std::vector<index_t> scatter_range_;
-  struct ThreadPool;                ///< a TBB arena of n_threads, kept out of this header
+  struct ThreadPool;  ///< a TBB arena of n_threads, kept out of this header
   std::unique_ptr<ThreadPool> pool_;
 };
 

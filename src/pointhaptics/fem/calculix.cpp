@@ -50,10 +50,9 @@ Vec3 grid_position(const BoxProblem& p, int a, int b, int c) {
 }
 
 // C3D20 local node order as offsets in half steps: corners 1-8, bottom mid-edges 9-12, top 13-16, vertical 17-20
-constexpr std::array<std::array<int, 3>, 20> element_offsets{{
-    {0, 0, 0}, {2, 0, 0}, {2, 2, 0}, {0, 2, 0}, {0, 0, 2}, {2, 0, 2}, {2, 2, 2}, {0, 2, 2},
-    {1, 0, 0}, {2, 1, 0}, {1, 2, 0}, {0, 1, 0}, {1, 0, 2}, {2, 1, 2}, {1, 2, 2}, {0, 1, 2},
-    {0, 0, 1}, {2, 0, 1}, {2, 2, 1}, {0, 2, 1}}};
+constexpr std::array<std::array<int, 3>, 20> element_offsets{
+    {{0, 0, 0}, {2, 0, 0}, {2, 2, 0}, {0, 2, 0}, {0, 0, 2}, {2, 0, 2}, {2, 2, 2}, {0, 2, 2}, {1, 0, 0}, {2, 1, 0},
+     {1, 2, 0}, {0, 1, 0}, {1, 0, 2}, {2, 1, 2}, {1, 2, 2}, {0, 1, 2}, {0, 0, 1}, {2, 0, 1}, {2, 2, 1}, {0, 2, 1}}};
 
 // Consistent nodal forces of uniform tractions on the boundary faces inside each traction's region.
 std::map<int, Vec3> traction_forces(const BoxProblem& p, const Grid& g) {
@@ -95,8 +94,10 @@ std::map<int, Vec3> traction_forces(const BoxProblem& p, const Grid& g) {
     double total_area = 0;
     for (const Face& f : faces) total_area += f.area;
     if (faces.empty())
-      throw Error(fmt::format("CalculiX mesh: traction {} covers no boundary face of the {} x {} x {} mesh "
-                              "(its region must hold whole element faces)", t, p.nx, p.ny, p.nz));
+      throw Error(
+          fmt::format("CalculiX mesh: traction {} covers no boundary face of the {} x {} x {} mesh "
+                      "(its region must hold whole element faces)",
+                      t, p.nx, p.ny, p.nz));
     for (const Face& f : faces) {
       const Vec3 share = traction.total * (f.area / total_area);
       // 8-node serendipity face under uniform pressure: corners -1/12, mid-sides +1/3 of the face's load
@@ -110,7 +111,8 @@ std::map<int, Vec3> traction_forces(const BoxProblem& p, const Grid& g) {
 }
 
 void write_id_list(std::string& out, const std::vector<int>& ids) {
-  for (size_t k = 0; k < ids.size(); ++k) out += fmt::format("{}{}", ids[k], (k + 1) % 16 == 0 || k + 1 == ids.size() ? ",\n" : ", ");
+  for (size_t k = 0; k < ids.size(); ++k)
+    out += fmt::format("{}{}", ids[k], (k + 1) % 16 == 0 || k + 1 == ids.size() ? ",\n" : ", ");
 }
 
 }  // namespace
@@ -159,7 +161,10 @@ std::string write_inp(const BoxProblem& p) {
         for (int n = 0; n < 20; ++n) {
           const auto& o = element_offsets[n];
           // ccx reads at most 16 entries per line: the element number and 15 nodes, then 5 more
-          out += fmt::format("{}{}", g.at(2 * i + o[0], 2 * j + o[1], 2 * k + o[2]), n == 19 ? "\n" : n == 14 ? ",\n" : ", ");
+          out += fmt::format("{}{}", g.at(2 * i + o[0], 2 * j + o[1], 2 * k + o[2]),
+                             n == 19   ? "\n"
+                             : n == 14 ? ",\n"
+                                       : ", ");
         }
       }
   const double tol = 1e-9 * p.size.norm();
@@ -184,7 +189,8 @@ std::string write_inp(const BoxProblem& p) {
       }
   }
   for (size_t s = 0; s < moved.size(); ++s) {
-    if (moved[s].empty()) throw Error(fmt::format("CalculiX mesh: prescribed set {} holds no free node of the mesh", s + 1));
+    if (moved[s].empty())
+      throw Error(fmt::format("CalculiX mesh: prescribed set {} holds no free node of the mesh", s + 1));
     out += fmt::format("*NSET, NSET=NMOVE{}\n", s + 1);
     write_id_list(out, moved[s]);
   }
@@ -194,7 +200,8 @@ std::string write_inp(const BoxProblem& p) {
     for (int k = 0, e = 0; k < p.nz; ++k)
       for (int j = 0; j < p.ny; ++j)
         for (int i = 0; i < p.nx; ++i, ++e)
-          if ((grid_position(p, 2 * i + 1, 2 * j + 1, 2 * k + 1) - p.inclusions[s].centre).norm() <= p.inclusions[s].radius)
+          if ((grid_position(p, 2 * i + 1, 2 * j + 1, 2 * k + 1) - p.inclusions[s].centre).norm() <=
+              p.inclusions[s].radius)
             material_of[e] = static_cast<int>(s + 1);
   out += material_card("MAT", p);
   for (size_t s = 0; s < p.inclusions.size(); ++s) {
@@ -214,17 +221,20 @@ std::string write_inp(const BoxProblem& p) {
   out += "*ELSET, ELSET=EBODY\n";
   write_id_list(out, body);
   out += "*SOLID SECTION, ELSET=EBODY, MATERIAL=MAT\n";
-  for (size_t s = 0; s < p.inclusions.size(); ++s) out += fmt::format("*SOLID SECTION, ELSET=EINC{0}, MATERIAL=MAT{0}\n", s + 1);
+  for (size_t s = 0; s < p.inclusions.size(); ++s)
+    out += fmt::format("*SOLID SECTION, ELSET=EINC{0}, MATERIAL=MAT{0}\n", s + 1);
   out += "*BOUNDARY\nNFIX, 1, 3\n";
   // the mirror planes: one component of the nodes not held or moved already
   for (size_t s = 0; s < p.symmetry.size(); ++s) {
     const Symmetry& plane = p.symmetry[s];
-    if (plane.axis < 0 || plane.axis > 2) throw Error(fmt::format("CalculiX mesh: symmetry plane {} has axis {} (0, 1 or 2)", s + 1, plane.axis));
+    if (plane.axis < 0 || plane.axis > 2)
+      throw Error(fmt::format("CalculiX mesh: symmetry plane {} has axis {} (0, 1 or 2)", s + 1, plane.axis));
     std::vector<int> on;
     for (Eigen::Index k = 0; k < nodes.cols(); ++k) {
       const int id = static_cast<int>(k + 1);
       if (std::abs(nodes(plane.axis, k) - plane.at) > tol || std::binary_search(held.begin(), held.end(), id)) continue;
-      if (std::any_of(moved.begin(), moved.end(), [&](const std::vector<int>& m) { return std::binary_search(m.begin(), m.end(), id); }))
+      if (std::any_of(moved.begin(), moved.end(),
+                      [&](const std::vector<int>& m) { return std::binary_search(m.begin(), m.end(), id); }))
         continue;
       on.push_back(id);
     }
@@ -236,7 +246,8 @@ std::string write_inp(const BoxProblem& p) {
   }
   if (p.nlgeom && p.fixed_increments > 0) {
     const double dt = 1.0 / p.fixed_increments;
-    out += fmt::format("*STEP, NLGEOM, INC=1000\n*STATIC, DIRECT\n{:.13g}, 1.0\n*CONTROLS, PARAMETERS=FIELD\n1e-5, 1e-4\n", dt);
+    out += fmt::format(
+        "*STEP, NLGEOM, INC=1000\n*STATIC, DIRECT\n{:.13g}, 1.0\n*CONTROLS, PARAMETERS=FIELD\n1e-5, 1e-4\n", dt);
   } else if (p.nlgeom) {
     // small first increment, tightened equilibrium tolerances (ccx's defaults leave ~1e-3 error)
     out += "*STEP, NLGEOM, INC=1000\n*STATIC\n0.05, 1.0, 1e-6, 0.25\n*CONTROLS, PARAMETERS=FIELD\n1e-5, 1e-4\n";
@@ -246,7 +257,8 @@ std::string write_inp(const BoxProblem& p) {
   if (!moved.empty()) {
     out += "*BOUNDARY\n";
     for (size_t s = 0; s < moved.size(); ++s)
-      for (int a = 0; a < 3; ++a) out += fmt::format("NMOVE{}, {}, {}, {:.13g}\n", s + 1, a + 1, a + 1, p.prescribed[s].displacement[a]);
+      for (int a = 0; a < 3; ++a)
+        out += fmt::format("NMOVE{}, {}, {}, {:.13g}\n", s + 1, a + 1, a + 1, p.prescribed[s].displacement[a]);
   }
   const std::map<int, Vec3> forces = traction_forces(p, g);
   if (!forces.empty()) {
@@ -257,7 +269,8 @@ std::string write_inp(const BoxProblem& p) {
   }
   if (p.gravity.norm() > 0) {
     const Vec3 dir = p.gravity.normalized();
-    out += fmt::format("*DLOAD\nEALL, GRAV, {:.13g}, {:.13g}, {:.13g}, {:.13g}\n", p.gravity.norm(), dir.x(), dir.y(), dir.z());
+    out += fmt::format("*DLOAD\nEALL, GRAV, {:.13g}, {:.13g}, {:.13g}, {:.13g}\n", p.gravity.norm(), dir.x(), dir.y(),
+                       dir.z());
   }
   out += "*NODE PRINT, NSET=NALL\nU\n";
   for (size_t s = 0; s < moved.size(); ++s) out += fmt::format("*NODE PRINT, NSET=NMOVE{}, TOTALS=ONLY\nRF\n", s + 1);
@@ -337,7 +350,8 @@ std::vector<Reaction> read_dat_totals(std::istream& dat, const std::string& set,
     std::istringstream in(line);
     std::string tokens[3];
     for (int a = 0; a < 3; ++a) {
-      if (!(in >> tokens[a])) throw Error(fmt::format("{}:{}: malformed total force line \"{}\"", source, line_no, line));
+      if (!(in >> tokens[a]))
+        throw Error(fmt::format("{}:{}: malformed total force line \"{}\"", source, line_no, line));
       r.force[a] = std::strtod(tokens[a].c_str(), &end);
       if (end == tokens[a].c_str() || !std::isfinite(r.force[a]))
         throw Error(fmt::format("{}:{}: malformed total force line \"{}\"", source, line_no, line));
@@ -384,8 +398,9 @@ std::string find_ccx() {
     while (std::getline(dirs, dir, ':'))
       if (executable(dir + "/ccx")) return dir + "/ccx";
   }
-  throw Error("CalculiX (the ccx program) was not found on PATH; install the Debian package calculix-ccx "
-              "(apt-get install calculix-ccx) or set PH_CCX to its path");
+  throw Error(
+      "CalculiX (the ccx program) was not found on PATH; install the Debian package calculix-ccx "
+      "(apt-get install calculix-ccx) or set PH_CCX to its path");
 }
 
 CcxRun run_ccx(const std::string& deck, int threads) {

@@ -34,7 +34,7 @@ struct Traction {
 struct Prescribed {
   Box region;
   Vec3 centre = Vec3::Zero(), axis = Vec3::UnitY();
-  double radius = 0;  ///< m; 0: the whole box
+  double radius = 0;                 ///< m; 0: the whole box
   Vec3 displacement = Vec3::Zero();  ///< m, at the end of the step
 
   bool holds(const Vec3& p, double tol) const {
@@ -59,7 +59,7 @@ enum class FemMaterial { ELASTIC, NEO_HOOKE, MOONEY_RIVLIN };
 /// A ball of another material (a stiff nodule): the elements whose centre lies inside take it.
 struct Inclusion {
   Vec3 centre = Vec3::Zero();
-  double radius = 0;  ///< m
+  double radius = 0;        ///< m
   MaterialParams material;  ///< its model and moduli (set_material's mapping)
 };
 
@@ -67,21 +67,21 @@ struct Inclusion {
 struct BoxProblem {
   Vec3 origin = Vec3::Zero();
   Vec3 size = Vec3(0.15, 0.03, 0.03);  ///< m
-  int nx = 20, ny = 4, nz = 4;          ///< elements per direction
+  int nx = 20, ny = 4, nz = 4;         ///< elements per direction
   double young = 1e5, poisson = 0.4, density = 1000.0;
-  std::vector<Box> clamps;              ///< nodes inside are held (all three components)
+  std::vector<Box> clamps;  ///< nodes inside are held (all three components)
   std::vector<Traction> tractions;
-  std::vector<Prescribed> prescribed;   ///< moved nodes (after the clamps: a node in both is held)
-  std::vector<Symmetry> symmetry;       ///< mirror planes (their nodes not held or moved otherwise)
-  Vec3 gravity = Vec3::Zero();          ///< m/s^2
+  std::vector<Prescribed> prescribed;  ///< moved nodes (after the clamps: a node in both is held)
+  std::vector<Symmetry> symmetry;      ///< mirror planes (their nodes not held or moved otherwise)
+  Vec3 gravity = Vec3::Zero();         ///< m/s^2
   FemMaterial material = FemMaterial::ELASTIC;
-  double c10 = 0, c01 = 0, d1 = 0;      ///< hyperelastic constants (Pa, Pa, 1/Pa)
+  double c10 = 0, c01 = 0, d1 = 0;  ///< hyperelastic constants (Pa, Pa, 1/Pa)
   /// NLGEOM increments: 0 lets ccx choose them (from 5% of the step); n > 0: n fixed increments of 1/n (the
   /// reactions are then printed at each 1/n of the step)
   int fixed_increments = 0;
-  std::vector<Inclusion> inclusions;    ///< later ones win where they overlap
-  bool nlgeom = false;                  ///< geometrically nonlinear (*ELASTIC is then St. Venant-Kirchhoff)
-  bool reduced_integration = true;      ///< C3D20R, else C3D20
+  std::vector<Inclusion> inclusions;  ///< later ones win where they overlap
+  bool nlgeom = false;                ///< geometrically nonlinear (*ELASTIC is then St. Venant-Kirchhoff)
+  bool reduced_integration = true;    ///< C3D20R, else C3D20
 };
 
 /// The material card's constants for one of our materials: St. Venant-Kirchhoff as *ELASTIC (young,
@@ -101,7 +101,7 @@ struct Solution {
   Points displacement;  ///< (3 x n_nodes), m
   /// per Prescribed set, the reaction totals at every printed increment, in time order
   std::vector<std::vector<Reaction>> reactions;
-  double wall_s = 0;    ///< ccx run time, s
+  double wall_s = 0;  ///< ccx run time, s
   /// solve(..., partial = true) of a run ccx stopped (e.g. diverged): why, and the reactions are those of the
   /// increments it finished (displacements empty); empty for a complete run
   std::string failure;

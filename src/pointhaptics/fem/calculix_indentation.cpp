@@ -81,8 +81,9 @@ std::string write_indentation_inp(const IndentationProblem& p, int* node_count, 
     for (int i = 0; i < nr; ++i, ++element) {
       const std::size_t a = 2 * static_cast<std::size_t>(i), b = 2 * static_cast<std::size_t>(j);
       // CAX8: corners counter-clockwise in (r, y), then the mid-sides 1-2, 2-3, 3-4, 4-1
-      block_text += fmt::format("{}, {}, {}, {}, {}, {}, {}, {}, {}\n", element, at(a, b), at(a + 2, b), at(a + 2, b + 2),
-                                at(a, b + 2), at(a + 1, b), at(a + 2, b + 1), at(a + 1, b + 2), at(a, b + 1));
+      block_text +=
+          fmt::format("{}, {}, {}, {}, {}, {}, {}, {}, {}\n", element, at(a, b), at(a + 2, b), at(a + 2, b + 2),
+                      at(a, b + 2), at(a + 1, b), at(a + 2, b + 1), at(a + 1, b + 2), at(a, b + 1));
       if (j == ny - 1 && r[a] < fine_radius - 1e-9 * h) top_faces.push_back(element);  // face 3-4 is the top
     }
   // the sphere: one layer of thickness h from its lowest point up to the fine zone's radius, touching the top
@@ -105,17 +106,18 @@ std::string write_indentation_inp(const IndentationProblem& p, int* node_count, 
     }
   for (int k = 0; k < n_arc; ++k, ++element) {
     const int q = 2 * k;
-    sphere_text += fmt::format("{}, {}, {}, {}, {}, {}, {}, {}, {}\n", element, sat(0, q), sat(2, q), sat(2, q + 2), sat(0, q + 2),
-                               sat(1, q), sat(2, q + 1), sat(1, q + 2), sat(0, q + 1));
+    sphere_text += fmt::format("{}, {}, {}, {}, {}, {}, {}, {}, {}\n", element, sat(0, q), sat(2, q), sat(2, q + 2),
+                               sat(0, q + 2), sat(1, q), sat(2, q + 1), sat(1, q + 2), sat(0, q + 1));
     sphere_faces.push_back(element);  // face 2-3 is the outer surface
   }
   if (node_count) *node_count = next - 1;
   if (element_count) *element_count = element - 1;
 
   const double penalty = p.penalty > 0 ? p.penalty : 100 * p.material.young / h;
-  std::string out = fmt::format("** PointHaptics: a rigid sphere (R = {} m) pressed into a cylinder, axisymmetric\n*HEADING\n"
-                                "PointHaptics indentation\n*NODE, NSET=NALL\n{}",
-                                R, nodes_text);
+  std::string out = fmt::format(
+      "** PointHaptics: a rigid sphere (R = {} m) pressed into a cylinder, axisymmetric\n*HEADING\n"
+      "PointHaptics indentation\n*NODE, NSET=NALL\n{}",
+      R, nodes_text);
   out += "*ELEMENT, TYPE=CAX8, ELSET=BLOCK\n" + block_text + "*ELEMENT, TYPE=CAX8, ELSET=SPHERE\n" + sphere_text;
   out += "*NSET, NSET=NBOTTOM\n";
   write_ids(out, bottom);
@@ -131,13 +133,15 @@ std::string write_indentation_inp(const IndentationProblem& p, int* node_count, 
   out += fmt::format("*MATERIAL, NAME=RIGID\n*ELASTIC\n{:.13g}, 0.3\n", 1e4 * p.material.young);
   out += "*SOLID SECTION, ELSET=BLOCK, MATERIAL=TISSUE\n*SOLID SECTION, ELSET=SPHERE, MATERIAL=RIGID\n";
   // frictionless: no *FRICTION card
-  out += fmt::format("*SURFACE INTERACTION, NAME=FRICTIONLESS\n*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n{:.13g}\n"
-                     "*CONTACT PAIR, INTERACTION=FRICTIONLESS, TYPE=SURFACE TO SURFACE\nSTOP, SBALL\n",
-                     penalty);
+  out += fmt::format(
+      "*SURFACE INTERACTION, NAME=FRICTIONLESS\n*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n{:.13g}\n"
+      "*CONTACT PAIR, INTERACTION=FRICTIONLESS, TYPE=SURFACE TO SURFACE\nSTOP, SBALL\n",
+      penalty);
   out += "*BOUNDARY\nNBOTTOM, 1, 2, 0\nNAXIS, 1, 1, 0\n";
-  out += fmt::format("*STEP{}, INC=1000\n*STATIC, DIRECT\n{:.13g}, 1\n*BOUNDARY\nNMOVE, 1, 1, 0\nNMOVE, 2, 2, {:.13g}\n"
-                     "*NODE PRINT, NSET=NMOVE, TOTALS=ONLY\nRF\n*END STEP\n",
-                     p.nlgeom ? ", NLGEOM" : "", 1.0 / p.increments, -p.max_depth);
+  out += fmt::format(
+      "*STEP{}, INC=1000\n*STATIC, DIRECT\n{:.13g}, 1\n*BOUNDARY\nNMOVE, 1, 1, 0\nNMOVE, 2, 2, {:.13g}\n"
+      "*NODE PRINT, NSET=NMOVE, TOTALS=ONLY\nRF\n*END STEP\n",
+      p.nlgeom ? ", NLGEOM" : "", 1.0 / p.increments, -p.max_depth);
   return out;
 }
 

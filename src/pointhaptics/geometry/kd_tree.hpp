@@ -14,14 +14,16 @@ struct PointsAdaptor {
     return X(static_cast<Eigen::Index>(dim), static_cast<Eigen::Index>(i));
   }
   template <class BBox>
-  bool kdtree_get_bbox(BBox&) const { return false; }
+  bool kdtree_get_bbox(BBox&) const {
+    return false;
+  }
 };
 
 /// A k-d tree over the points, built on construction; `X` must outlive it.
 class KdTree {
  public:
-  using Index = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, PointsAdaptor>, PointsAdaptor, 3,
-                                                    index_t>;
+  using Index = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, PointsAdaptor>, PointsAdaptor,
+                                                    3, index_t>;
   explicit KdTree(const Points& X) : adaptor_{X}, index_(3, adaptor_, nanoflann::KDTreeSingleIndexAdaptorParams(16)) {}
   KdTree(const KdTree&) = delete;
   KdTree& operator=(const KdTree&) = delete;

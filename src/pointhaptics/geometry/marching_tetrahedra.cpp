@@ -17,10 +17,19 @@ TriangleMesh marching_tetrahedra(const GridField& field, double level) {
   std::vector<Vec3> vertices;
   // plain names, not a structured binding: clang 14 (the fuzz build) cannot capture one in a lambda
   const index_t nx = field.nodes[0], ny = field.nodes[1], nz = field.nodes[2];
-  auto node_index = [&](index_t i, index_t j, index_t k) { return static_cast<std::uint64_t>(i + nx * (j + ny * k)); };
+  // in 64 bits: a grid's node count may pass 2^31 where no index along one axis does
+  auto node_index = [&](index_t i, index_t j, index_t k) {
+    return static_cast<std::uint64_t>(i) +
+           static_cast<std::uint64_t>(nx) *
+               (static_cast<std::uint64_t>(j) + static_cast<std::uint64_t>(ny) * static_cast<std::uint64_t>(k));
+  };
   auto position = [&](std::uint64_t node) {
-    const auto n = static_cast<index_t>(node);
-    return Vec3(field.origin + field.cell * Vec3(static_cast<double>(n % nx), static_cast<double>((n / nx) % ny), static_cast<double>(n / (nx * ny))));
+    // the node's grid indices (integer division on purpose), then its place
+    const auto i = static_cast<index_t>(node % static_cast<std::uint64_t>(nx));
+    const auto j = static_cast<index_t>((node / static_cast<std::uint64_t>(nx)) % static_cast<std::uint64_t>(ny));
+    const auto k = static_cast<index_t>(node / (static_cast<std::uint64_t>(nx) * static_cast<std::uint64_t>(ny)));
+    return Vec3(field.origin +
+                field.cell * Vec3(static_cast<double>(i), static_cast<double>(j), static_cast<double>(k)));
   };
   auto value = [&](std::uint64_t node) { return field.values[node]; };
   // one vertex per crossed grid edge, shared by every tetrahedron around it
@@ -68,7 +77,8 @@ TriangleMesh marching_tetrahedra(const GridField& field, double level) {
             for (int a = 0; a < 3; ++a) v[a] = lone_inside ? crossing(in[0], out[a]) : crossing(in[a], out[0]);
             add(v[0], v[1], v[2], inside_point);
           } else {  // two and two: a quadrilateral, in order around it
-            const index_t a = crossing(in[0], out[0]), b = crossing(in[0], out[1]), c = crossing(in[1], out[1]), d = crossing(in[1], out[0]);
+            const index_t a = crossing(in[0], out[0]), b = crossing(in[0], out[1]), c = crossing(in[1], out[1]),
+                          d = crossing(in[1], out[0]);
             add(a, b, c, inside_point);
             add(a, c, d, inside_point);
           }

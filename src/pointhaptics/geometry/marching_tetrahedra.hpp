@@ -19,7 +19,10 @@ struct GridField {
   std::array<index_t, 3> nodes{0, 0, 0};
   std::vector<double> values;
 
-  double at(index_t i, index_t j, index_t k) const { return values[static_cast<std::size_t>(i + nodes[0] * (j + nodes[1] * k))]; }
+  double at(index_t i, index_t j, index_t k) const {
+    const auto nx = static_cast<std::size_t>(nodes[0]), ny = static_cast<std::size_t>(nodes[1]);
+    return values[static_cast<std::size_t>(i) + nx * (static_cast<std::size_t>(j) + ny * static_cast<std::size_t>(k))];
+  }
 };
 
 /// The surface {field = level} between the nodes above the level ("inside") and the rest, each triangle

@@ -34,9 +34,11 @@ double corner_angle(const std::array<Vec3, 3>& v, int k) {
   return std::acos(std::clamp(e1.dot(e2), -1.0, 1.0));
 }
 
-std::optional<SurfaceSide> nearest_surface_within(const Vec3& p, const Points& V, const std::vector<std::array<index_t, 3>>& F,
-                                                  double radius) {
-  const auto corners = [&](const std::array<index_t, 3>& f) { return std::array<Vec3, 3>{V.col(f[0]), V.col(f[1]), V.col(f[2])}; };
+std::optional<SurfaceSide> nearest_surface_within(const Vec3& p, const Points& V,
+                                                  const std::vector<std::array<index_t, 3>>& F, double radius) {
+  const auto corners = [&](const std::array<index_t, 3>& f) {
+    return std::array<Vec3, 3>{V.col(f[0]), V.col(f[1]), V.col(f[2])};
+  };
   double best = radius * radius;
   std::size_t nearest = F.size();
   int feature = 0;
@@ -69,7 +71,8 @@ std::optional<SurfaceSide> nearest_surface_within(const Vec3& p, const Points& V
     int shared = 0, corner = -1;
     for (int k = 0; k < 3; ++k) {
       const index_t v = f[static_cast<std::size_t>(k)];
-      if (feature >= 3 && feature < 6 && (v == near[static_cast<std::size_t>(feature - 3)] || v == near[static_cast<std::size_t>((feature - 2) % 3)]))
+      if (feature >= 3 && feature < 6 &&
+          (v == near[static_cast<std::size_t>(feature - 3)] || v == near[static_cast<std::size_t>((feature - 2) % 3)]))
         ++shared;
       if (feature < 3 && v == near[static_cast<std::size_t>(feature)]) corner = k;
     }
@@ -88,7 +91,8 @@ std::optional<SurfaceSide> nearest_surface_within(const Vec3& p, const Points& V
   if (feature < 3) {
     std::sort(around.begin(), around.begin() + static_cast<std::ptrdiff_t>(n_around));
     sure = n_around >= 6 && n_around == 2 * static_cast<std::size_t>(faces);
-    for (std::size_t k = 0; sure && k < n_around; k += 2) sure = around[k] == around[k + 1] && (k + 2 >= n_around || around[k + 2] != around[k]);
+    for (std::size_t k = 0; sure && k < n_around; k += 2)
+      sure = around[k] == around[k + 1] && (k + 2 >= n_around || around[k + 2] != around[k]);
   }
   const double distance = std::sqrt(best);
   return SurfaceSide{point, (p - point).dot(normal) < 0 ? -distance : distance, sure};
@@ -102,13 +106,15 @@ MeshDistance::MeshDistance(const TriangleMesh& mesh) : mesh_(mesh) {
   vertex_normal_.assign(static_cast<std::size_t>(mesh.V.cols()), Vec3::Zero());
   std::unordered_map<std::uint64_t, Vec3> edge_sum;  // undirected edge -> the sum of its faces' normals
   auto key = [](index_t a, index_t b) {
-    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(std::min(a, b))) << 32) | static_cast<std::uint32_t>(std::max(a, b));
+    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(std::min(a, b))) << 32) |
+           static_cast<std::uint32_t>(std::max(a, b));
   };
   for (std::size_t t = 0; t < n_faces; ++t) {
     const auto& f = mesh.F[t];
     const Vec3 v[3] = {mesh.V.col(f[0]), mesh.V.col(f[1]), mesh.V.col(f[2])};
     centroid_.col(static_cast<Eigen::Index>(t)) = (v[0] + v[1] + v[2]) / 3.0;
-    for (const Vec3& corner : v) reach_ = std::max(reach_, (corner - centroid_.col(static_cast<Eigen::Index>(t))).norm());
+    for (const Vec3& corner : v)
+      reach_ = std::max(reach_, (corner - centroid_.col(static_cast<Eigen::Index>(t))).norm());
     const Vec3 n = (v[1] - v[0]).cross(v[2] - v[0]).normalized();
     face_normal_[t] = n;
     for (int k = 0; k < 3; ++k) {
@@ -142,7 +148,7 @@ double MeshDistance::signed_distance(const Vec3& p) const {
     if (d >= best) continue;
     best = d;
     direction = p - q;
-    normal = feature < 3 ? vertex_normal_[static_cast<std::size_t>(f[feature])]
+    normal = feature < 3   ? vertex_normal_[static_cast<std::size_t>(f[feature])]
              : feature < 6 ? edge_normal_[static_cast<std::size_t>(t)][feature - 3]
                            : face_normal_[static_cast<std::size_t>(t)];
   }

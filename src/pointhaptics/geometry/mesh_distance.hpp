@@ -36,8 +36,8 @@ struct SurfaceSide {
 /// (a tool's contact carries it every step). Only the triangles within `radius` are seen, so a vertex's or an
 /// edge's pseudo-normal is exact when the nearest point is within it (and the surface closed around it: `sure`).
 /// nullopt: no triangle within `radius`.
-std::optional<SurfaceSide> nearest_surface_within(const Vec3& p, const Points& V, const std::vector<std::array<index_t, 3>>& F,
-                                                  double radius);
+std::optional<SurfaceSide> nearest_surface_within(const Vec3& p, const Points& V,
+                                                  const std::vector<std::array<index_t, 3>>& F, double radius);
 
 class MeshDistance {
  public:
@@ -48,12 +48,13 @@ class MeshDistance {
 
  private:
   const TriangleMesh& mesh_;
-  Points centroid_;                             ///< of each triangle (the closest one is searched by them)
-  std::unique_ptr<KdTree> tree_;                ///< over the centroids
-  double reach_ = 0;                            ///< the largest distance from a triangle's centroid to its corners
-  std::vector<Vec3> face_normal_;               ///< unit
-  std::vector<std::array<Vec3, 3>> edge_normal_;  ///< per triangle, edge k (corner k to k + 1): the sum of its two faces' normals
-  std::vector<Vec3> vertex_normal_;             ///< angle-weighted sum of the faces' normals around it
+  Points centroid_;                ///< of each triangle (the closest one is searched by them)
+  std::unique_ptr<KdTree> tree_;   ///< over the centroids
+  double reach_ = 0;               ///< the largest distance from a triangle's centroid to its corners
+  std::vector<Vec3> face_normal_;  ///< unit
+  std::vector<std::array<Vec3, 3>>
+      edge_normal_;                  ///< per triangle, edge k (corner k to k + 1): the sum of its two faces' normals
+  std::vector<Vec3> vertex_normal_;  ///< angle-weighted sum of the faces' normals around it
 };
 
 }  // namespace pointhaptics

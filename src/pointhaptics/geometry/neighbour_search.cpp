@@ -44,9 +44,11 @@ std::vector<std::vector<index_t>> search_rows(const Points& X, Radius&& radius) 
 }
 
 void sort_rows(std::vector<std::vector<index_t>>& rows) {
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows.size(), 256), [&](const tbb::blocked_range<std::size_t>& range) {
-    for (std::size_t i = range.begin(); i != range.end(); ++i) std::sort(rows[i].begin(), rows[i].end());
-  });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows.size(), 256),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t i = range.begin(); i != range.end(); ++i)
+                        std::sort(rows[i].begin(), rows[i].end());
+                    });
 }
 
 }  // namespace
@@ -94,7 +96,10 @@ std::vector<index_t> nearest_neighbour(const Points& X) {
       const Vec3 q = X.col(i);
       const size_t found = tree.index().knnSearch(q.data(), 2, idx, d2);
       for (size_t k = 0; k < found; ++k)
-        if (idx[k] != i) { nearest[i] = idx[k]; break; }
+        if (idx[k] != i) {
+          nearest[i] = idx[k];
+          break;
+        }
     }
   });
   return nearest;

@@ -75,12 +75,14 @@ void refine_region(PointCloud& cloud, const Refinement& refinement, const std::f
   hi.array() += coarse;
   std::vector<index_t> local;
   for (index_t i = 0; i < n; ++i)
-    if (((out.X.col(i).array() >= lo.array() - coarse) && (out.X.col(i).array() <= hi.array() + coarse)).all()) local.push_back(i);
+    if (((out.X.col(i).array() >= lo.array() - coarse) && (out.X.col(i).array() <= hi.array() + coarse)).all())
+      local.push_back(i);
   Points local_X(3, static_cast<index_t>(local.size()));
   for (std::size_t j = 0; j < local.size(); ++j) local_X.col(static_cast<index_t>(j)) = out.X.col(local[j]);
   const Eigen::VectorXd cells = clipped_cell_volumes(local_X, inside, lo, hi, fine, 1.0);
   std::vector<double> local_volume(static_cast<std::size_t>(n), 0.0);
-  for (std::size_t j = 0; j < local.size(); ++j) local_volume[static_cast<std::size_t>(local[j])] = cells[static_cast<index_t>(j)];
+  for (std::size_t j = 0; j < local.size(); ++j)
+    local_volume[static_cast<std::size_t>(local[j])] = cells[static_cast<index_t>(j)];
   double sum = 0;
   for (const index_t i : changed) sum += local_volume[static_cast<std::size_t>(i)];
   if (!(sum > 0)) throw Error("refine: the region's points own no volume of the object");

@@ -57,7 +57,8 @@ TriangleMesh cluster_vertices(const TriangleMesh& mesh, double cell) {
   std::vector<int> count;
   for (Eigen::Index v = 0; v < mesh.V.cols(); ++v) {
     const Eigen::Array3d c = ((mesh.V.col(v) - lo) / cell).array().floor();
-    const std::uint64_t key = (static_cast<std::uint64_t>(c.x()) << 42) | (static_cast<std::uint64_t>(c.y()) << 21) | static_cast<std::uint64_t>(c.z());
+    const std::uint64_t key = (static_cast<std::uint64_t>(c.x()) << 42) | (static_cast<std::uint64_t>(c.y()) << 21) |
+                              static_cast<std::uint64_t>(c.z());
     const auto [it, added] = cluster_of_cell.try_emplace(key, static_cast<index_t>(sum.size()));
     if (added) {
       sum.push_back(Vec3::Zero());
@@ -114,8 +115,8 @@ Remeshed adapt_to_edge(const TriangleMesh& mesh, double edge) {
       r.mesh = subdivide(r.mesh);
       ++splits;
     }
-    r.change = fmt::format("split {} time{} (mean edge {:.3g} -> {:.3g} mm, {} triangles{})", splits, splits == 1 ? "" : "s", 1e3 * before,
-                           1e3 * mean_edge_length(r.mesh), r.mesh.F.size(),
+    r.change = fmt::format("split {} time{} (mean edge {:.3g} -> {:.3g} mm, {} triangles{})", splits,
+                           splits == 1 ? "" : "s", 1e3 * before, 1e3 * mean_edge_length(r.mesh), r.mesh.F.size(),
                            mean_edge_length(r.mesh) > 2 * edge ? "; stopped at the limit of four million" : "");
   } else if (before < 0.25 * edge) {
     TriangleMesh simpler = cluster_vertices(mesh, edge);
@@ -131,12 +132,13 @@ Remeshed adapt_to_edge(const TriangleMesh& mesh, double edge) {
       why = e.what();
     }
     if (why.empty()) {
-      r.change = fmt::format("simplified by vertex clustering (mean edge {:.3g} -> {:.3g} mm, {} -> {} triangles)", 1e3 * before,
-                             1e3 * mean_edge_length(simpler), mesh.F.size(), simpler.F.size());
+      r.change = fmt::format("simplified by vertex clustering (mean edge {:.3g} -> {:.3g} mm, {} -> {} triangles)",
+                             1e3 * before, 1e3 * mean_edge_length(simpler), mesh.F.size(), simpler.F.size());
       r.mesh = std::move(simpler);
     } else {
-      r.change = fmt::format("kept as it is (mean edge {:.3g} mm, far finer than asked: simplifying it would not keep it faithful: {})",
-                             1e3 * before, why);
+      r.change = fmt::format(
+          "kept as it is (mean edge {:.3g} mm, far finer than asked: simplifying it would not keep it faithful: {})",
+          1e3 * before, why);
     }
   }
   return r;

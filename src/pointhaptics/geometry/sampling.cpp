@@ -18,16 +18,21 @@ namespace pointhaptics {
 namespace {
 
 void check_spacing(double spacing, double extent) {
-  if (!(spacing > 0) || !std::isfinite(spacing)) throw Error(fmt::format("sampling: spacing must be positive and finite, got {:.3g}", spacing));
+  if (!(spacing > 0) || !std::isfinite(spacing))
+    throw Error(fmt::format("sampling: spacing must be positive and finite, got {:.3g}", spacing));
   if (extent / spacing > 2000)
-    throw Error(fmt::format("sampling: spacing {:.3g} m is too fine for a body of {:.3g} m (more than 2000 points per axis)", spacing, extent));
+    throw Error(
+        fmt::format("sampling: spacing {:.3g} m is too fine for a body of {:.3g} m (more than 2000 points per axis)",
+                    spacing, extent));
   // coarser than the body itself: a handful of points, or points that coincide to round-off
   if (spacing > extent)
-    throw Error(fmt::format("sampling: spacing {:.3g} m is larger than the body ({:.3g} m): no interior to simulate", spacing, extent));
+    throw Error(fmt::format("sampling: spacing {:.3g} m is larger than the body ({:.3g} m): no interior to simulate",
+                            spacing, extent));
 }
 
 // grid points spacing apart, one at `centre`, for which inside() holds
-PointCloud grid_inside(const Vec3& centre, double radius, double spacing, const std::function<bool(const Vec3&)>& inside) {
+PointCloud grid_inside(const Vec3& centre, double radius, double spacing,
+                       const std::function<bool(const Vec3&)>& inside) {
   const Vec3 reach = Vec3::Constant(radius);
   return lattice_inside(centre, Vec3::Constant(spacing), centre - reach, centre + reach, inside);
 }
@@ -45,7 +50,8 @@ PointCloud lattice_inside(const Vec3& origin, const Vec3& step, const Vec3& lo, 
   for (long a = first[0]; a <= last[0]; ++a)
     for (long b = first[1]; b <= last[1]; ++b)
       for (long c = first[2]; c <= last[2]; ++c) {
-        const Vec3 p = origin + Vec3(static_cast<double>(a), static_cast<double>(b), static_cast<double>(c)).cwiseProduct(step);
+        const Vec3 p =
+            origin + Vec3(static_cast<double>(a), static_cast<double>(b), static_cast<double>(c)).cwiseProduct(step);
         if (inside(p)) kept.push_back(p);
       }
   PointCloud cloud;
@@ -117,7 +123,8 @@ Eigen::VectorXd clipped_cell_volumes(const Points& X, const std::function<bool(c
   const double cell_volume = fine * fine * fine;
   // cells counted per point: whole numbers, so the threads' partial counts sum to the same whatever their
   // order (summed volumes differed from run to run in the last digit)
-  tbb::combinable<std::vector<std::int64_t>> partial([n] { return std::vector<std::int64_t>(static_cast<std::size_t>(n), 0); });
+  tbb::combinable<std::vector<std::int64_t>> partial(
+      [n] { return std::vector<std::int64_t>(static_cast<std::size_t>(n), 0); });
   tbb::parallel_for(0, cells[2], [&](int k) {
     auto& local = partial.local();
     for (int j = 0; j < cells[1]; ++j)
@@ -141,7 +148,8 @@ Eigen::VectorXd clipped_cell_volumes(const Points& X, const std::function<bool(c
 }
 
 PointCloud sample_sphere(const Vec3& centre, double radius, double spacing) {
-  if (!(radius > 0) || !std::isfinite(radius) || !centre.allFinite()) throw Error("sampling: sphere radius must be positive and finite");
+  if (!(radius > 0) || !std::isfinite(radius) || !centre.allFinite())
+    throw Error("sampling: sphere radius must be positive and finite");
   check_spacing(spacing, 2 * radius);
   const double r2 = radius * radius * (1 + 1e-12);
   auto inside = [&](const Vec3& p) { return (p - centre).squaredNorm() <= r2; };
@@ -153,14 +161,16 @@ PointCloud sample_sphere(const Vec3& centre, double radius, double spacing) {
 }
 
 PointCloud sample_half_sphere(const Vec3& centre, double radius, double spacing) {
-  if (!(radius > 0) || !std::isfinite(radius) || !centre.allFinite()) throw Error("sampling: half-sphere radius must be positive and finite");
+  if (!(radius > 0) || !std::isfinite(radius) || !centre.allFinite())
+    throw Error("sampling: half-sphere radius must be positive and finite");
   check_spacing(spacing, 2 * radius);
   const double r2 = radius * radius * (1 + 1e-12);
   const double floor_y = centre.y() - 1e-12 * radius;
   auto inside = [&](const Vec3& p) { return p.y() >= floor_y && (p - centre).squaredNorm() <= r2; };
   PointCloud cloud = grid_inside(centre, radius, spacing, inside);
   const Vec3 lo = centre - Vec3(radius, 0, radius), hi = centre + Vec3::Constant(radius);
-  cloud.volume = clipped_cell_volumes(cloud.X, inside, lo, hi, spacing, 2.0 / 3.0 * std::numbers::pi * radius * radius * radius);
+  cloud.volume =
+      clipped_cell_volumes(cloud.X, inside, lo, hi, spacing, 2.0 / 3.0 * std::numbers::pi * radius * radius * radius);
   return cloud;
 }
 

@@ -30,8 +30,7 @@ PointCloud sample_half_sphere(const Vec3& centre, double radius, double spacing)
 /// Volume owned by each point: the body (inside(p) true) is sampled by a fine grid of `refinement`^3
 /// cells per spacing^3 inside [lo, hi], each fine cell is given to its nearest point (a clipped Voronoi
 /// cell), and the result is rescaled so that the volumes sum to exact_volume.
-Eigen::VectorXd clipped_cell_volumes(const Points& X, const std::function<bool(const Vec3&)>& inside,
-                                     const Vec3& lo, const Vec3& hi, double spacing, double exact_volume,
-                                     int refinement = 6);
+Eigen::VectorXd clipped_cell_volumes(const Points& X, const std::function<bool(const Vec3&)>& inside, const Vec3& lo,
+                                     const Vec3& hi, double spacing, double exact_volume, int refinement = 6);
 
 }  // namespace pointhaptics

@@ -12,7 +12,8 @@ namespace pointhaptics {
 /// once for all the segments it ends (a point's pairs).
 struct CrossingTriangle {
   Vec3 a, b, c, normal;
-  CrossingTriangle(const Vec3& a_, const Vec3& b_, const Vec3& c_) : a(a_), b(b_), c(c_), normal((b_ - a_).cross(c_ - a_)) {}
+  CrossingTriangle(const Vec3& a_, const Vec3& b_, const Vec3& c_)
+      : a(a_), b(b_), c(c_), normal((b_ - a_).cross(c_ - a_)) {}
   /// Sweeps nothing (a blade moved along its own edge here).
   bool degenerate() const { return normal.squaredNorm() == 0; }
   /// Which side of the plane p is on, scaled: a point on the plane counts as on the normal's side (>= 0).
@@ -24,7 +25,8 @@ struct CrossingTriangle {
     if ((sp >= 0) == (sq >= 0) || degenerate()) return std::nullopt;
     const Vec3 x = p + (sp / (sp - sq)) * (q - p);
     const double slack = -1e-9 * normal.squaredNorm();
-    if (normal.dot((b - a).cross(x - a)) >= slack && normal.dot((c - b).cross(x - b)) >= slack && normal.dot((a - c).cross(x - c)) >= slack)
+    if (normal.dot((b - a).cross(x - a)) >= slack && normal.dot((c - b).cross(x - b)) >= slack &&
+        normal.dot((a - c).cross(x - c)) >= slack)
       return x;
     return std::nullopt;
   }

@@ -21,7 +21,8 @@ TriangleMesh lattice_box_surface(const Lattice& n, const std::function<Vec3(cons
   std::unordered_map<std::uint64_t, index_t> vertex_of;
   std::vector<Vec3> vertices;
   auto vertex = [&](const Lattice& p) {
-    const std::uint64_t key = (static_cast<std::uint64_t>(p[0]) << 42) | (static_cast<std::uint64_t>(p[1]) << 21) | static_cast<std::uint64_t>(p[2]);
+    const std::uint64_t key = (static_cast<std::uint64_t>(p[0]) << 42) | (static_cast<std::uint64_t>(p[1]) << 21) |
+                              static_cast<std::uint64_t>(p[2]);
     const auto [it, added] = vertex_of.try_emplace(key, static_cast<index_t>(vertices.size()));
     if (added) vertices.push_back(position(p));
     return it->second;
@@ -53,18 +54,23 @@ TriangleMesh lattice_box_surface(const Lattice& n, const std::function<Vec3(cons
   return mesh;
 }
 
-index_t intervals(double length, double edge) { return std::max<index_t>(1, static_cast<index_t>(std::ceil(length / edge - 1e-9))); }
+index_t intervals(double length, double edge) {
+  return std::max<index_t>(1, static_cast<index_t>(std::ceil(length / edge - 1e-9)));
+}
 
 void check_edge(double edge, double extent, const char* what) {
-  if (!(edge > 0) || !std::isfinite(edge)) throw Error(fmt::format("{} surface: the edge length must be > 0 (m), got {}", what, edge));
+  if (!(edge > 0) || !std::isfinite(edge))
+    throw Error(fmt::format("{} surface: the edge length must be > 0 (m), got {}", what, edge));
   // a million faces per side is far past what anyone draws or touches
-  if (extent / edge > 1e6) throw Error(fmt::format("{} surface: an edge of {:.3g} m on a {:.3g} m object is too fine", what, edge, extent));
+  if (extent / edge > 1e6)
+    throw Error(fmt::format("{} surface: an edge of {:.3g} m on a {:.3g} m object is too fine", what, edge, extent));
 }
 
 /// The unit direction of a cube sphere's lattice point (n per side): equal angles, u -> tan(pi u / 4).
 Vec3 cube_sphere_direction(const Lattice& p, index_t n) {
   Vec3 d;
-  for (int a = 0; a < 3; ++a) d[a] = std::tan(std::numbers::pi / 4 * (2.0 * static_cast<double>(p[a]) / static_cast<double>(n) - 1));
+  for (int a = 0; a < 3; ++a)
+    d[a] = std::tan(std::numbers::pi / 4 * (2.0 * static_cast<double>(p[a]) / static_cast<double>(n) - 1));
   return d.normalized();
 }
 
@@ -76,7 +82,9 @@ TriangleMesh box_surface(const Vec3& origin, const Vec3& size, double edge) {
   return lattice_box_surface(n, [&](const Lattice& p) {
     Vec3 x;
     // the last vertex exactly on the far face
-    for (int a = 0; a < 3; ++a) x[a] = p[a] == n[a] ? origin[a] + size[a] : origin[a] + size[a] * static_cast<double>(p[a]) / static_cast<double>(n[a]);
+    for (int a = 0; a < 3; ++a)
+      x[a] = p[a] == n[a] ? origin[a] + size[a]
+                          : origin[a] + size[a] * static_cast<double>(p[a]) / static_cast<double>(n[a]);
     return x;
   });
 }
@@ -84,7 +92,8 @@ TriangleMesh box_surface(const Vec3& origin, const Vec3& size, double edge) {
 TriangleMesh sphere_surface(const Vec3& centre, double radius, double edge) {
   check_edge(edge, radius, "sphere");
   const index_t n = intervals(std::numbers::pi / 2 * radius, edge);
-  return lattice_box_surface({n, n, n}, [&](const Lattice& p) { return Vec3(centre + radius * cube_sphere_direction(p, n)); });
+  return lattice_box_surface({n, n, n},
+                             [&](const Lattice& p) { return Vec3(centre + radius * cube_sphere_direction(p, n)); });
 }
 
 TriangleMesh half_sphere_surface(const Vec3& centre, double radius, double edge) {

@@ -32,7 +32,8 @@ class SpatialGrid {
 template <class Visit>
 void SpatialGrid::for_each_within(const Points& x, const Vec3& centre, double radius, Visit&& visit) const {
   if (start_.empty() || !centre.allFinite() || !(radius >= 0)) return;
-  const Eigen::Array3d lo = ((centre.array() - radius) / cell_).floor(), hi = ((centre.array() + radius) / cell_).floor();
+  const Eigen::Array3d lo = ((centre.array() - radius) / cell_).floor(),
+                       hi = ((centre.array() + radius) / cell_).floor();
   const double r2 = radius * radius;
   for (long long cz = static_cast<long long>(lo.z()); cz <= static_cast<long long>(hi.z()); ++cz)
     for (long long cy = static_cast<long long>(lo.y()); cy <= static_cast<long long>(hi.y()); ++cy)

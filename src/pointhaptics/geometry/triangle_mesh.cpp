@@ -20,7 +20,9 @@ void check_closed_manifold(const TriangleMesh& mesh, const std::string& name) {
   // reverse once
   std::unordered_map<std::uint64_t, int> directed;
   directed.reserve(3 * mesh.F.size());
-  auto key = [](index_t a, index_t b) { return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b); };
+  auto key = [](index_t a, index_t b) {
+    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
+  };
   for (std::size_t t = 0; t < mesh.F.size(); ++t) {
     const auto& f = mesh.F[t];
     for (int k = 0; k < 3; ++k)
@@ -36,13 +38,15 @@ void check_closed_manifold(const TriangleMesh& mesh, const std::string& name) {
     const int back = reverse == directed.end() ? 0 : reverse->second;
     const Vec3 at = 0.5 * (mesh.V.col(a) + mesh.V.col(b));
     if (count > 1 || back > 1)
-      throw Error(fmt::format("{}: not manifold or not consistently oriented: the edge between vertices {} and {} at "
-                              "({:.4g}, {:.4g}, {:.4g}) is used {} times one way and {} the other",
-                              name, a, b, at.x(), at.y(), at.z(), count, back));
+      throw Error(
+          fmt::format("{}: not manifold or not consistently oriented: the edge between vertices {} and {} at "
+                      "({:.4g}, {:.4g}, {:.4g}) is used {} times one way and {} the other",
+                      name, a, b, at.x(), at.y(), at.z(), count, back));
     if (back == 0)
-      throw Error(fmt::format("{}: the mesh is open (the edge between vertices {} and {} at ({:.4g}, {:.4g}, {:.4g}) bounds one "
-                              "triangle): its inside is undefined",
-                              name, a, b, at.x(), at.y(), at.z()));
+      throw Error(fmt::format(
+          "{}: the mesh is open (the edge between vertices {} and {} at ({:.4g}, {:.4g}, {:.4g}) bounds one "
+          "triangle): its inside is undefined",
+          name, a, b, at.x(), at.y(), at.z()));
   }
 }
 
@@ -67,8 +71,10 @@ PointCloud sample_mesh_volume(const TriangleMesh& mesh, double spacing, const st
   const Eigen::Array3d cells = ((hi - lo).array() / spacing - 1e-9).ceil().max(1.0);
   const double total = cells.prod();
   if (!(total <= 8.0 * static_cast<double>(max_points)))
-    throw Error(fmt::format("{}: a {:.3g} m spacing gives {:.3g} lattice cells: too many (coarser spacing?)", name, spacing, total));
-  const index_t nx = static_cast<index_t>(cells.x()), ny = static_cast<index_t>(cells.y()), nz = static_cast<index_t>(cells.z());
+    throw Error(fmt::format("{}: a {:.3g} m spacing gives {:.3g} lattice cells: too many (coarser spacing?)", name,
+                            spacing, total));
+  const index_t nx = static_cast<index_t>(cells.x()), ny = static_cast<index_t>(cells.y()),
+                nz = static_cast<index_t>(cells.z());
   const index_t n_cells = nx * ny * nz;
   std::vector<unsigned char> inside(static_cast<std::size_t>(n_cells), 0);
   // centred in the bounding box, so that a box-shaped mesh is sampled symmetrically and no point lies on
@@ -79,10 +85,13 @@ PointCloud sample_mesh_volume(const TriangleMesh& mesh, double spacing, const st
     return Vec3(origin + spacing * Vec3(i, j, k));
   };
   tbb::parallel_for(tbb::blocked_range<index_t>(0, n_cells, 64), [&](const tbb::blocked_range<index_t>& range) {
-    for (index_t c = range.begin(); c != range.end(); ++c) inside[static_cast<std::size_t>(c)] = winding_number(mesh, position(c)) > 0.5;
+    for (index_t c = range.begin(); c != range.end(); ++c)
+      inside[static_cast<std::size_t>(c)] = winding_number(mesh, position(c)) > 0.5;
   });
   const auto n = static_cast<index_t>(std::count(inside.begin(), inside.end(), 1));
-  if (n == 0) throw Error(fmt::format("{}: no lattice point of spacing {:.3g} m lies inside the mesh (finer spacing?)", name, spacing));
+  if (n == 0)
+    throw Error(
+        fmt::format("{}: no lattice point of spacing {:.3g} m lies inside the mesh (finer spacing?)", name, spacing));
   if (n > max_points) throw Error(fmt::format("{}: {} points inside: too many (coarser spacing?)", name, n));
   PointCloud cloud;
   cloud.spacing = spacing;

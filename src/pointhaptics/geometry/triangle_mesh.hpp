@@ -10,8 +10,8 @@
 namespace pointhaptics {
 
 struct TriangleMesh {
-  Points V;                                  ///< vertices, m  (3 x n_vertices)
-  std::vector<std::array<index_t, 3>> F;     ///< triangles, counter-clockwise seen from outside
+  Points V;                               ///< vertices, m  (3 x n_vertices)
+  std::vector<std::array<index_t, 3>> F;  ///< triangles, counter-clockwise seen from outside
 };
 
 /// Throws Error (naming `name`) unless the mesh bounds a solid: at least 4 triangles, finite vertices,

@@ -17,11 +17,11 @@ namespace pointhaptics {
 enum class ProbeMode { PUSH, GRAB, PUSH_GRAB, CUT };
 
 struct ProbeParams {
-  double radius = 0.005;        ///< probe sphere, m
+  double radius = 0.005;  ///< probe sphere, m
   ProbeMode mode = ProbeMode::PUSH;
-  double point_radius = 0;      ///< point spheres, m (0: half the model's spacing)
-  double stiffness = 0;         ///< contact / grab spring per point, N/m (0: E x spacing, the object's own scale)
-  double friction = 0;          ///< Coulomb's coefficient on the surface (the point spheres are frictionless)
+  double point_radius = 0;  ///< point spheres, m (0: half the model's spacing)
+  double stiffness = 0;     ///< contact / grab spring per point, N/m (0: E x spacing, the object's own scale)
+  double friction = 0;      ///< Coulomb's coefficient on the surface (the point spheres are frictionless)
   /// On the surface: > 0 makes the tool a capsule, its axis segment this long (m) along the tool's local z,
   /// posed by `orientation` turned by the device's own (a device that reports none keeps `orientation`).
   double length = 0;
@@ -46,13 +46,13 @@ struct ProbeParams {
 /// K is symmetric negative semi-definite (the object pushes back), so the haptic side's coupling solve
 /// (k I - K) p = ... is always well posed.
 struct ContactModel {
-  double time = 0;              ///< simulation time it was made at, s
-  Vec3 p0 = Vec3::Zero();       ///< probe position it was made at, m
-  Vec3 f0 = Vec3::Zero();       ///< force on the probe at p0, N
-  Mat3 K = Mat3::Zero();        ///< dF/dp, N/m
-  int contacts = 0;             ///< touched or grabbed points
+  double time = 0;         ///< simulation time it was made at, s
+  Vec3 p0 = Vec3::Zero();  ///< probe position it was made at, m
+  Vec3 f0 = Vec3::Zero();  ///< force on the probe at p0, N
+  Mat3 K = Mat3::Zero();   ///< dF/dp, N/m
+  int contacts = 0;        ///< touched or grabbed points
   bool grabbing = false;
-  Vec3 torque = Vec3::Zero();   ///< torque on the tool about p0, N m (held between updates)
+  Vec3 torque = Vec3::Zero();  ///< torque on the tool about p0, N m (held between updates)
 };
 
 /// Contact between the probe and the object, for the simulation thread. Push: every point sphere that
@@ -83,7 +83,7 @@ class ProbeContact {
  private:
   ProbeParams params_;
   SpatialGrid grid_;
-  Points x_;                      // current positions
+  Points x_;  // current positions
   std::vector<index_t> grabbed_;
   std::vector<Vec3> offsets_;     // grabbed point minus probe at the press
   std::vector<index_t> touched_;  // points pushed by the last apply(), with their normals

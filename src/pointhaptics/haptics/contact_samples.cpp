@@ -62,7 +62,8 @@ ContactSamples contact_samples(const TriangleMesh& mesh, double max_edge) {
     // this level's splits, found first: a level that would pass the bound is not made
     std::vector<char> splits(out.triangles.size());
     std::size_t long_triangles = 0;
-    for (std::size_t k = 0; k < out.triangles.size(); ++k) long_triangles += splits[k] = longest_edge(position, out.triangles[k]) > max_edge;
+    for (std::size_t k = 0; k < out.triangles.size(); ++k)
+      long_triangles += splits[k] = longest_edge(position, out.triangles[k]) > max_edge;
     const auto points = static_cast<index_t>(position.size());
     if (long_triangles == 0 || points + static_cast<index_t>(3 * long_triangles) > max_contact_vertices) break;
     midpoint.reserve(midpoint.size() + 3 * long_triangles);
@@ -74,7 +75,8 @@ ContactSamples contact_samples(const TriangleMesh& mesh, double max_edge) {
       const auto [it, fresh] = midpoint.try_emplace(edge, static_cast<index_t>(position.size()));
       if (fresh) {
         position.push_back(0.5 * (position[static_cast<std::size_t>(a)] + position[static_cast<std::size_t>(b)]));
-        combination.push_back(midpoint_of(combination[static_cast<std::size_t>(a)], combination[static_cast<std::size_t>(b)]));
+        combination.push_back(
+            midpoint_of(combination[static_cast<std::size_t>(a)], combination[static_cast<std::size_t>(b)]));
         out.parents.push_back({low, high});
       }
       return it->second;

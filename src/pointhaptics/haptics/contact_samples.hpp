@@ -24,8 +24,8 @@ struct ContactSample {
 };
 
 struct ContactSamples {
-  Points Y;                                         ///< the samples' reference positions (3 x samples)
-  std::vector<ContactSample> samples;               ///< each over the surface's vertices
+  Points Y;                            ///< the samples' reference positions (3 x samples)
+  std::vector<ContactSample> samples;  ///< each over the surface's vertices
   /// For sample k: the two points it is the midpoint of, numbered the surface's vertices first, then the
   /// samples (both before it): its key (contact_sample_keys()).
   std::vector<std::array<index_t, 2>> parents;

@@ -20,11 +20,11 @@ class DeviceError : public Error {
 /// What a device can render, as CHAI3D's cHapticDeviceInfo describes it.
 struct DeviceSpecs {
   std::string name = "custom";
-  double max_force = 3.3;          ///< largest continuous force, N
-  double max_stiffness = 400.0;    ///< largest stiffness it renders stably at 1 kHz, N/m
-  double max_damping = 3.0;        ///< largest damping it renders stably, N s/m
-  double workspace_radius = 0.075; ///< radius of its usable workspace, m
-  double max_torque = 0;           ///< largest continuous torque, N m (0: it renders none)
+  double max_force = 3.3;           ///< largest continuous force, N
+  double max_stiffness = 400.0;     ///< largest stiffness it renders stably at 1 kHz, N/m
+  double max_damping = 3.0;         ///< largest damping it renders stably, N s/m
+  double workspace_radius = 0.075;  ///< radius of its usable workspace, m
+  double max_torque = 0;            ///< largest continuous torque, N m (0: it renders none)
 };
 
 /// Known devices: "touch" (3D Systems Touch: 3.3 N, 400 N/m, 0.075 m), "omni" (Phantom Omni: 3.3 N,
@@ -35,11 +35,11 @@ DeviceSpecs known_device_specs(std::string_view name);
 
 /// One reading of a device.
 struct DeviceState {
-  double time = 0;                                        ///< s, the device's clock
-  Vec3 position = Vec3::Zero();                           ///< m, in the device's frame
-  Vec3 velocity = Vec3::Zero();                           ///< m/s
+  double time = 0;               ///< s, the device's clock
+  Vec3 position = Vec3::Zero();  ///< m, in the device's frame
+  Vec3 velocity = Vec3::Zero();  ///< m/s
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
-  unsigned buttons = 0;                                   ///< bit k: button k held
+  unsigned buttons = 0;  ///< bit k: button k held
 };
 
 /// A haptic device (or a stand-in for one). Called from the haptic thread only, once per tick:

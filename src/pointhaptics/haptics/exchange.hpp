@@ -25,7 +25,9 @@ class TripleBuffer {
   /// Producer: the slot to fill (stays the producer's until publish()).
   T& back() { return slots_[back_].value; }
   /// Producer: make back() the latest value and take a free slot as the new back().
-  void publish() { back_ = middle_.exchange(static_cast<std::uint8_t>(back_ | fresh), std::memory_order_acq_rel) & index; }
+  void publish() {
+    back_ = middle_.exchange(static_cast<std::uint8_t>(back_ | fresh), std::memory_order_acq_rel) & index;
+  }
 
   /// Consumer: take the latest published value if there is a newer one than front(); true if taken.
   bool update() {
@@ -42,7 +44,7 @@ class TripleBuffer {
     T value;
   };
   std::array<Slot, 3> slots_;
-  std::uint8_t back_ = 0, front_ = 1;          // owned by one side each
+  std::uint8_t back_ = 0, front_ = 1;  // owned by one side each
   alignas(64) std::atomic<std::uint8_t> middle_{2};
 };
 

@@ -8,7 +8,8 @@
 namespace pointhaptics {
 
 CouplingGains coupling_budget(const DeviceSpecs& specs, double scale, double safety) {
-  if (!(scale > 0) || !std::isfinite(scale)) throw Error(fmt::format("coupling: workspace scale {} must be positive", scale));
+  if (!(scale > 0) || !std::isfinite(scale))
+    throw Error(fmt::format("coupling: workspace scale {} must be positive", scale));
   if (!(safety > 0 && safety <= 1)) throw Error(fmt::format("coupling: safety {} must lie in (0, 1]", safety));
   // felt at the device: k_device = k_scene * scale, b_device = b_scene * scale
   return {safety * specs.max_stiffness / scale, safety * specs.max_damping / scale};
@@ -39,7 +40,8 @@ Vec3 ForceRenderer::bounded(Vec3 v, double max, double max_change, const Vec3& l
 Vec3 ForceRenderer::render_torque(const Vec3& requested) {
   if (!(specs_.max_torque > 0) || !engaged_ || !requested.allFinite()) return last_torque_ = Vec3::Zero();
   // its change per tick bounded by the same share of its maximum as the force's
-  return last_torque_ = limited(requested, specs_.max_torque, rules_.max_change * specs_.max_torque / specs_.max_force, last_torque_);
+  return last_torque_ = limited(requested, specs_.max_torque, rules_.max_change * specs_.max_torque / specs_.max_force,
+                                last_torque_);
 }
 
 Vec3 ForceRenderer::render(const Vec3& requested, const Vec3& device_velocity, double dt) {

@@ -16,9 +16,9 @@ struct CouplingGains {
 CouplingGains coupling_budget(const DeviceSpecs& specs, double scale, double safety = 0.5);
 
 struct ForceRules {
-  double engage_below = 0.1;    ///< N: forces engage only once the requested force is below this (CHAI3D's start-up rule)
-  double ramp_time = 0.5;       ///< s: after engaging, forces ramp in linearly over this time
-  double max_change = 0.2;      ///< N per tick: bound on the change of the commanded force
+  double engage_below = 0.1;  ///< N: forces engage only once the requested force is below this (CHAI3D's start-up rule)
+  double ramp_time = 0.5;     ///< s: after engaging, forces ramp in linearly over this time
+  double max_change = 0.2;    ///< N per tick: bound on the change of the commanded force
   /// Passivity controller (Hannaford & Ryu 2002): a tick whose force would leave the observer below zero
   /// (the environment giving the hand more energy than it ever took) gets a damper against the device's
   /// velocity that dissipates the excess, its coefficient at most the force's own part along the velocity
@@ -48,9 +48,9 @@ class ForceRenderer {
   void reset();
 
   bool engaged() const { return engaged_; }
-  double observed_energy() const { return energy_; }      ///< J; negative: the environment gave energy
+  double observed_energy() const { return energy_; }  ///< J; negative: the environment gave energy
   double min_observed_energy() const { return min_energy_; }
-  double controller_dissipated() const { return dissipated_; }  ///< J the passivity controller took out
+  double controller_dissipated() const { return dissipated_; }      ///< J the passivity controller took out
   long long controller_ticks() const { return controlled_ticks_; }  ///< ticks the passivity controller damped
   const Vec3& last_force() const { return last_; }
 

@@ -11,9 +11,9 @@ namespace pointhaptics {
 
 /// m a = k (target - x) - b v + F.
 struct HandDynamics {
-  double mass = 0.1;        ///< kg, endpoint and hand
-  double stiffness = 300;   ///< N/m, the hand's grip
-  double damping = 6;       ///< N s/m (about 0.55 of critical for these values)
+  double mass = 0.1;       ///< kg, endpoint and hand
+  double stiffness = 300;  ///< N/m, the hand's grip
+  double damping = 6;      ///< N s/m (about 0.55 of critical for these values)
 };
 
 /// The device endpoint under HandDynamics.

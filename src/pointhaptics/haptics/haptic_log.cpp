@@ -16,9 +16,9 @@ namespace pointhaptics {
 void print_haptic_log_header(TextOutput& out) { out.print("t,x,y,z,vx,vy,vz,buttons,fx,fy,fz,tx,ty,tz\n"); }
 
 void print_haptic_log_row(TextOutput& out, const HapticLogRow& r) {
-  out.print("{:.6f},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}\n", r.t, r.position.x(),
-            r.position.y(), r.position.z(), r.velocity.x(), r.velocity.y(), r.velocity.z(), r.buttons, r.force.x(), r.force.y(), r.force.z(),
-            r.torque.x(), r.torque.y(), r.torque.z());
+  out.print("{:.6f},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}\n", r.t,
+            r.position.x(), r.position.y(), r.position.z(), r.velocity.x(), r.velocity.y(), r.velocity.z(), r.buttons,
+            r.force.x(), r.force.y(), r.force.z(), r.torque.x(), r.torque.y(), r.torque.z());
 }
 
 void write_haptic_log(const std::string& path, const std::vector<HapticLogRow>& rows) {
@@ -53,11 +53,17 @@ std::vector<HapticLogRow> read_haptic_log(const std::string& path) {
       v[n++] = x;
     }
     if (n != 11 && n != 14)
-      throw Error(fmt::format("{}:{}: expected 14 finite numbers (t,x,y,z,vx,vy,vz,buttons,fx,fy,fz,tx,ty,tz), or the first 11", path,
-                              line_no));
-    HapticLogRow r{v[0], Vec3(v[1], v[2], v[3]), Vec3(v[4], v[5], v[6]), static_cast<unsigned>(v[7]), Vec3(v[8], v[9], v[10]),
+      throw Error(
+          fmt::format("{}:{}: expected 14 finite numbers (t,x,y,z,vx,vy,vz,buttons,fx,fy,fz,tx,ty,tz), or the first 11",
+                      path, line_no));
+    HapticLogRow r{v[0],
+                   Vec3(v[1], v[2], v[3]),
+                   Vec3(v[4], v[5], v[6]),
+                   static_cast<unsigned>(v[7]),
+                   Vec3(v[8], v[9], v[10]),
                    Vec3(v[11], v[12], v[13])};
-    if (!rows.empty() && !(r.t > rows.back().t)) throw Error(fmt::format("{}:{}: time does not increase", path, line_no));
+    if (!rows.empty() && !(r.t > rows.back().t))
+      throw Error(fmt::format("{}:{}: time does not increase", path, line_no));
     rows.push_back(r);
   }
   if (rows.empty()) throw Error(fmt::format("{}: the haptic log has no rows", path));

@@ -84,8 +84,7 @@ bool HapticLoop::tick(double t, double dt) {
   renderer_.reset();
   try {
     device_.stop();  // zero force, whatever happened
-  } catch (...) {
-  }
+  } catch (...) {}
   return false;
 }
 
@@ -127,8 +126,7 @@ void HapticLoop::run() {
     if (late_us > spin_us - 50) spin_us = std::min(400, static_cast<int>(late_us) + 100);
     else if (spin_us > 60) --spin_us;
     spin_us_sum_ += spin_us;
-    while (clock::now() < deadline) {
-    }
+    while (clock::now() < deadline) {}
     const auto now = clock::now();
     const double t = std::chrono::duration<double>(now - start).count();
     const double dt = std::chrono::duration<double>(now - previous).count();
@@ -143,8 +141,7 @@ void HapticLoop::run() {
   wall_s_ = std::chrono::duration<double>(clock::now() - start).count();
   try {
     device_.stop();
-  } catch (...) {
-  }
+  } catch (...) {}
 }
 
 HapticStats HapticLoop::stats() const {

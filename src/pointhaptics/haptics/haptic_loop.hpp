@@ -23,13 +23,13 @@ struct WorkspaceMapping {
 /// What the haptic side publishes for the simulation every tick.
 struct HapticFrame {
   double time = 0;
-  Vec3 probe = Vec3::Constant(NAN);  ///< scene position of the probe (NaN until the first tick)
-  Vec3 device = Vec3::Constant(NAN); ///< scene position of the device point the coupling pulls toward
+  Vec3 probe = Vec3::Constant(NAN);   ///< scene position of the probe (NaN until the first tick)
+  Vec3 device = Vec3::Constant(NAN);  ///< scene position of the device point the coupling pulls toward
   bool button = false;
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  ///< the device's
-  Vec3 force = Vec3::Zero();         ///< force commanded to the device, N
-  Vec3 torque = Vec3::Zero();        ///< torque commanded to the device, N m
-  long long tick = 0;                ///< ticks so far, this one included (a reader's rate meter)
+  Vec3 force = Vec3::Zero();                                        ///< force commanded to the device, N
+  Vec3 torque = Vec3::Zero();                                       ///< torque commanded to the device, N m
+  long long tick = 0;  ///< ticks so far, this one included (a reader's rate meter)
 };
 
 /// One row of the haptic log (the format replay reads): time, device position and velocity, buttons, force.
@@ -43,17 +43,17 @@ struct HapticLogRow {
 
 struct HapticStats {
   long long ticks = 0;
-  double rate_hz = 0;                  ///< ticks per second of wall time (threaded) or of simulated time
+  double rate_hz = 0;  ///< ticks per second of wall time (threaded) or of simulated time
   double period_p50_us = 0, period_p99_us = 0, period_max_us = 0;  ///< |period - nominal| quantiles, us
-  double tick_max_us = 0;              ///< the longest tick's own work, us
-  double spin_mean_us = 0;             ///< mean busy-wait before a tick (threaded), us: CPU the loop burns
-  double max_force_n = 0;              ///< largest commanded force magnitude, N
-  double min_observed_energy = 0;      ///< passivity observer's minimum, J (negative: active at some point)
-  double passivity_dissipated = 0;     ///< J the passivity controller took out (ForceRules::passivity_control)
-  long long passivity_ticks = 0;       ///< ticks it damped
+  double tick_max_us = 0;                                          ///< the longest tick's own work, us
+  double spin_mean_us = 0;          ///< mean busy-wait before a tick (threaded), us: CPU the loop burns
+  double max_force_n = 0;           ///< largest commanded force magnitude, N
+  double min_observed_energy = 0;   ///< passivity observer's minimum, J (negative: active at some point)
+  double passivity_dissipated = 0;  ///< J the passivity controller took out (ForceRules::passivity_control)
+  long long passivity_ticks = 0;    ///< ticks it damped
   bool device_failed = false;
   std::string device_error;
-  bool realtime_priority = false;      ///< the thread got SCHED_FIFO (needs the privilege; else a normal thread)
+  bool realtime_priority = false;  ///< the thread got SCHED_FIFO (needs the privilege; else a normal thread)
 };
 
 class HapticLoop {

@@ -9,14 +9,19 @@ namespace pointhaptics {
 
 ProbeTool::ProbeTool(const Model& model, const ProbeParams& params, double coupling_stiffness, double max_force,
                      std::optional<SurfaceContact> surface)
-    : contact_(model, params), surface_(std::move(surface)), k_(coupling_stiffness), max_force_(max_force),
-      scratch_(Points::Zero(3, model.n_points)), compliance_solver_(model) {
+    : contact_(model, params),
+      surface_(std::move(surface)),
+      k_(coupling_stiffness),
+      max_force_(max_force),
+      scratch_(Points::Zero(3, model.n_points)),
+      compliance_solver_(model) {
   trail_.reserve(blade_trail_steps);
 }
 
 bool ProbeTool::pushing_surface() const {
   const ProbeMode mode = contact_.params().mode;
-  return surface_ && (mode == ProbeMode::PUSH || ((mode == ProbeMode::PUSH_GRAB || mode == ProbeMode::CUT) && !button_));
+  return surface_ &&
+         (mode == ProbeMode::PUSH || ((mode == ProbeMode::PUSH_GRAB || mode == ProbeMode::CUT) && !button_));
 }
 
 std::array<Vec3, 2> ProbeTool::blade_edge() const {
@@ -32,7 +37,8 @@ void ProbeTool::resist_cut(const Model& model, const CutReport& report, double d
     const Vec3 move = 0.5 * ((edge[0] - last[0]) + (edge[1] - last[1]));
     // the new area per distance over the last spacing of travel (the oldest step dropped once the rest cover it)
     // a blade held still adds nothing, and the history keeps at most cut_history_steps (bounded memory)
-    if (move.norm() > 1e-12 || report.severed_pairs > 0) cut_history_.push_back({move.norm(), cut_area(model, report.severed_pairs)});
+    if (move.norm() > 1e-12 || report.severed_pairs > 0)
+      cut_history_.push_back({move.norm(), cut_area(model, report.severed_pairs)});
     if (cut_history_.size() > cut_history_steps) cut_history_.erase(cut_history_.begin());
     double travel = 0, area = 0;
     for (const auto& [d, a] : cut_history_) {
@@ -47,7 +53,8 @@ void ProbeTool::resist_cut(const Model& model, const CutReport& report, double d
     // the work G dA done over the move: a force G dA / ds against it; over at least a spacing, so that as the
     // blade enters, the force builds over its first spacing (a first plane of pairs over a shorter travel
     // asked for 8 N where 1.2 N was due, which the per-tick bound then had to cut)
-    if (move.norm() > 1e-12) target = -contact_.params().cut_resistance * area / std::max(travel, model.spacing) * move.normalized();
+    if (move.norm() > 1e-12)
+      target = -contact_.params().cut_resistance * area / std::max(travel, model.spacing) * move.normalized();
   }
   cut_force_ += std::min(1.0, dt / cut_smoothing) * (target - cut_force_);
   if (!report.cut_points.empty()) cut_points_ = report.cut_points;
@@ -83,11 +90,15 @@ Vec3 ProbeTool::stop_at_surface(const Model& model, const State& state, const Ve
   // hand's speed): its local model knows only the vertices it touches where it is, and a longer jump could
   // pass the surface and push it out from within
   const double longest = 0.25 * contact_.params().radius;
-  const auto limited = [&](const Vec3& move) { return move.norm() > longest ? Vec3(move * (longest / move.norm())) : move; };
+  const auto limited = [&](const Vec3& move) {
+    return move.norm() > longest ? Vec3(move * (longest / move.norm())) : move;
+  };
   // load_at() carries the surface to the state: enters() sees it as the step found it
   const ToolLoad here = load_at(model, state, from);
   const double allowed = std::max(allowed_penetration * contact_.params().radius, here.penetration);
-  const auto refused = [&](const Vec3& p) { return load_at(model, state, p).penetration > allowed || surface_->enters(from, p); };
+  const auto refused = [&](const Vec3& p) {
+    return load_at(model, state, p).penetration > allowed || surface_->enters(from, p);
+  };
   // each try once (a try costs a pass over the surface's vertices and one over its triangles)
   const auto furthest = [&](const Vec3& move) -> std::optional<Vec3> {
     Vec3 target = from + limited(move);
@@ -119,7 +130,8 @@ Vec3 ProbeTool::back_on_surface(const Vec3& p) const {
   return side->point + (side->point - p) * (1e-3 * shape.radius / -side->distance);
 }
 
-void ProbeTool::place(const Model& model, const State& state, const Vec3& device, bool button, const Eigen::Quaterniond& orientation) {
+void ProbeTool::place(const Model& model, const State& state, const Vec3& device, bool button,
+                      const Eigen::Quaterniond& orientation) {
   device_ = device;
   button_ = button;
   step_start_ = state.time;
@@ -146,8 +158,9 @@ void ProbeTool::place(const Model& model, const State& state, const Vec3& device
   for (int it = 0; it < 8; ++it) {
     scratch_.setZero();
     // the state is the same at every iteration: the positions (and their grid) are made once
-    const ContactModel local = pushing_surface() ? surface_model(model, state, p, true)
-                                                 : contact_.apply(model, state.u, p, button, state.time, scratch_, it > 0);
+    const ContactModel local = pushing_surface()
+                                   ? surface_model(model, state, p, true)
+                                   : contact_.apply(model, state.u, p, button, state.time, scratch_, it > 0);
     Vec3 next = coupled_probe(local, device, k_, max_force_);
     if (pushing_surface()) next = stop_at_surface(model, state, p, next);
     const bool settled = (next - p).norm() < 1e-9 + 1e-6 * contact_.params().radius;
@@ -227,8 +240,8 @@ Mat3 ProbeTool::compliance_stiffness(const Model& model, const State& state, con
   const int turn = static_cast<int>(compliance_turn_++ % 3);
   compliance_load_.setZero();
   const Mat3 sum = surface_->add_tool_load(Vec3::Unit(turn), compliance_load_);
-  const int iterations = compliance_solver_.solve_linearised(model, problem, compliance_load_, compliance_[turn], compliance_tolerance,
-                                                              compliance_budget, *compliance_ws_);
+  const int iterations = compliance_solver_.solve_linearised(model, problem, compliance_load_, compliance_[turn],
+                                                             compliance_tolerance, compliance_budget, *compliance_ws_);
   if (iterations < 0 || !compliance_[turn].allFinite()) {
     for (Points& x : compliance_) x.setZero();
     return held;
@@ -247,7 +260,8 @@ Mat3 ProbeTool::compliance_stiffness(const Model& model, const State& state, con
 // (linearly implicit, as the point spheres' springs): the full contact term in Newton (as the static solver
 // has it) failed its line search when a probe started deep in the object (a new session under a held mouse),
 // where vertices cross the probe's centre and their normals flip.
-bool ProbeTool::add_stiffness(const Model& model, const State& state, Eigen::Matrix<double, 9, Eigen::Dynamic>& springs) {
+bool ProbeTool::add_stiffness(const Model& model, const State& state,
+                              Eigen::Matrix<double, 9, Eigen::Dynamic>& springs) {
   if (pushing_surface() && probe_.allFinite()) {
     surface_->linearise(model, state.u, TangentMode::PROJECTED);
     surface_->add_diagonal_blocks(springs);
@@ -257,7 +271,8 @@ bool ProbeTool::add_stiffness(const Model& model, const State& state, Eigen::Mat
   return last_.contacts > 0;
 }
 
-void ProbeTool::remap(const Model& model, const std::vector<index_t>& new_index, std::optional<SurfaceContact> surface) {
+void ProbeTool::remap(const Model& model, const std::vector<index_t>& new_index,
+                      std::optional<SurfaceContact> surface) {
   contact_.remap(model, new_index);
   // the proxy's multipliers carry over to the vertices the new contact has (without them the probe would sink
   // by the penalty's give at every re-selection)

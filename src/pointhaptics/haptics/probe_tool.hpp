@@ -133,10 +133,11 @@ class ProbeTool final : public DynamicForces {
   ProbeContact contact_;
   std::optional<SurfaceContact> surface_;
   Eigen::Quaterniond orientation_ = Eigen::Quaterniond::Identity();  ///< the tool's, the device's turn included
-  std::vector<std::array<Vec3, 2>> trail_;  ///< blade_trail()
-  Vec3 cut_force_ = Vec3::Zero();        ///< on the blade, N
-  std::vector<index_t> cut_points_;      ///< the points that take its opposite
-  std::vector<std::array<double, 2>> cut_history_;  ///< per step of this cut: the edge's travel, m, and the new area, m^2
+  std::vector<std::array<Vec3, 2>> trail_;                           ///< blade_trail()
+  Vec3 cut_force_ = Vec3::Zero();                                    ///< on the blade, N
+  std::vector<index_t> cut_points_;                                  ///< the points that take its opposite
+  std::vector<std::array<double, 2>>
+      cut_history_;  ///< per step of this cut: the edge's travel, m, and the new area, m^2
   double k_, max_force_;
   Vec3 device_ = Vec3::Constant(NAN);
   double step_start_ = 0;  // the time at which the step being taken began (place())
@@ -155,9 +156,9 @@ class ProbeTool final : public DynamicForces {
   static constexpr int compliance_relinearise = 48;
   NewtonSolver compliance_solver_;
   std::unique_ptr<Workspace> compliance_ws_;  // its own: the step's keeps what the solver carries to the next step
-  Points compliance_load_;                   // B e, one direction at a time
-  std::array<Points, 3> compliance_;         // H^-1 B e_a: the warm starts of the next step
-  int compliance_contacts_ = 0;              // contacts at the last step (0: the next contact is new)
+  Points compliance_load_;                    // B e, one direction at a time
+  std::array<Points, 3> compliance_;          // H^-1 B e_a: the warm starts of the next step
+  int compliance_contacts_ = 0;               // contacts at the last step (0: the next contact is new)
   long long compliance_turn_ = 0;
 };
 

@@ -30,7 +30,8 @@ std::vector<std::uint64_t> identity_ids(index_t n) {
 SurfaceContact::SurfaceContact(const Model& model, const TriangleMesh& mesh, SurfaceMap map, const ToolShape& shape,
                                const SurfaceContactParams& params)
     : SurfaceContact(model, mesh, contact_map(mesh, std::move(map), params),
-                     contact_samples(mesh, params.sample_spacing != 0 ? params.sample_spacing : default_sample_spacing * shape.radius),
+                     contact_samples(mesh, params.sample_spacing != 0 ? params.sample_spacing
+                                                                      : default_sample_spacing * shape.radius),
                      shape, params) {}
 
 SurfaceContact::SurfaceContact(const Model& model, const TriangleMesh& surface, SurfaceMap map, ContactSamples samples,
@@ -63,7 +64,8 @@ SurfaceContact::SurfaceContact(const Model& model, const TriangleMesh& surface, 
   lambda_.assign(area.size(), 0.0);
   if (!(params.friction >= 0) || !std::isfinite(params.friction)) throw Error("tool: friction must be >= 0");
   friction_ = params.friction;
-  if (!(params.tangential_share > 0) || !(params.tangential_share <= 1)) throw Error("tool: the friction's penalty share must be in (0, 1]");
+  if (!(params.tangential_share > 0) || !(params.tangential_share <= 1))
+    throw Error("tool: the friction's penalty share must be in (0, 1]");
   tangential_share_ = params.tangential_share;
   if (friction_ > 0) anchors_.assign(area.size(), Anchor{});
   tolerance_ = params.tolerance > 0 ? params.tolerance : 1e-4 * shape.radius;
@@ -89,7 +91,8 @@ void SurfaceContact::for_each_surface_vertex(index_t v, const Fn& fn) const {
 template <class Fn>
 void SurfaceContact::for_each_weight(index_t v, const Fn& fn) const {
   for_each_surface_vertex(v, [&](index_t vertex, double b) {
-    for (index_t e = map_.points.begin(vertex); e < map_.points.end(vertex); ++e) fn(map_.points.index[e], b * map_.weight[e]);
+    for (index_t e = map_.points.begin(vertex); e < map_.points.end(vertex); ++e)
+      fn(map_.points.index[e], b * map_.weight[e]);
   });
 }
 
@@ -104,7 +107,9 @@ void SurfaceContact::for_each_squared_weight(index_t v, const Fn& fn) const {
 std::vector<double> SurfaceContact::point_stiffness(index_t n_points) const {
   std::vector<double> stiffness(static_cast<std::size_t>(n_points), 0.0);
   for (index_t v = 0; v < static_cast<index_t>(Y_.cols()); ++v)
-    for_each_squared_weight(v, [&](index_t j, double w2) { stiffness[static_cast<std::size_t>(j)] += penalty_[static_cast<std::size_t>(v)] * w2; });
+    for_each_squared_weight(v, [&](index_t j, double w2) {
+      stiffness[static_cast<std::size_t>(j)] += penalty_[static_cast<std::size_t>(v)] * w2;
+    });
   return stiffness;
 }
 
@@ -131,7 +136,8 @@ void SurfaceContact::evaluate(const Points& u) {
   carry_surface_into(map_, Y_, u, y_.leftCols(n_surface_));
   for (std::size_t k = 0; k < samples_.size(); ++k) {
     const ContactSample& s = samples_[k];
-    y_.col(n_surface_ + static_cast<index_t>(k)) = s.weight[0] * y_.col(s.vertex[0]) + s.weight[1] * y_.col(s.vertex[1]) + s.weight[2] * y_.col(s.vertex[2]);
+    y_.col(n_surface_ + static_cast<index_t>(k)) =
+        s.weight[0] * y_.col(s.vertex[0]) + s.weight[1] * y_.col(s.vertex[1]) + s.weight[2] * y_.col(s.vertex[2]);
   }
 }
 
@@ -167,7 +173,9 @@ Vec3 SurfaceContact::friction_trial(index_t v) const {
   return a.tau + tangential_penalty(v) * slip;
 }
 
-double SurfaceContact::tangential_penalty(index_t v) const { return tangential_share_ * penalty_[static_cast<std::size_t>(v)]; }
+double SurfaceContact::tangential_penalty(index_t v) const {
+  return tangential_share_ * penalty_[static_cast<std::size_t>(v)];
+}
 
 double SurfaceContact::friction_cone(index_t v) const { return friction_ * lambda_[static_cast<std::size_t>(v)]; }
 
@@ -239,7 +247,8 @@ void SurfaceContact::linearise(const Model&, const Points& u, TangentMode mode) 
       const Mat3 along = Mat3::Identity() - d.axis * d.axis.transpose();
       hessian -= (pressure / d.from_core) * off_normal * along;
     }
-    active_.push_back({v, d.normal, pressure, hessian, penalty_[static_cast<std::size_t>(v)] * d.normal * d.normal.transpose()});
+    active_.push_back(
+        {v, d.normal, pressure, hessian, penalty_[static_cast<std::size_t>(v)] * d.normal * d.normal.transpose()});
   });
   for (index_t v = 0; v < static_cast<index_t>(anchors_.size()); ++v) {
     if (!anchors_[static_cast<std::size_t>(v)].held) continue;
@@ -281,7 +290,8 @@ void SurfaceContact::add_diagonal_blocks(Eigen::Matrix<double, 9, Eigen::Dynamic
   // the positive parts only (the normal and the friction's stiffness): the preconditioner wants positive blocks
   // (at a sample a bound of its squared weights: for_each_squared_weight)
   for (const Active& a : active_)
-    for_each_squared_weight(a.vertex, [&](index_t j, double w2) { Eigen::Map<Mat3>(blocks.col(j).data()) += w2 * a.preconditioner; });
+    for_each_squared_weight(
+        a.vertex, [&](index_t j, double w2) { Eigen::Map<Mat3>(blocks.col(j).data()) += w2 * a.preconditioner; });
 }
 
 bool SurfaceContact::add_to_matrix(TangentMatrix& K) const {
@@ -289,7 +299,8 @@ bool SurfaceContact::add_to_matrix(TangentMatrix& K) const {
     for_each_surface_vertex(a.vertex, [&](index_t vertex, double b) {
       for (index_t e = map_.points.begin(vertex); e < map_.points.end(vertex); ++e)
         for (index_t f = e; f < map_.points.end(vertex); ++f)
-          add_coupling(K, map_.points.index[e], map_.points.index[f], b * map_.weight[e] * map_.weight[f], a.preconditioner);
+          add_coupling(K, map_.points.index[e], map_.points.index[f], b * map_.weight[e] * map_.weight[f],
+                       a.preconditioner);
     });
   return true;
 }
@@ -300,7 +311,8 @@ bool SurfaceContact::update_multipliers(const Model& model, const Points& u) {
     Anchor& a = anchors_[static_cast<std::size_t>(v)];
     if (!a.held) {
       // pressing without an anchor (a multiplier, or only the penalty at the contact's rim): anchor it first
-      met = met && lambda_[static_cast<std::size_t>(v)] == 0 && !(tool_distance(shape_, pose_, y_.col(v)).penetration(shape_) > 0);
+      met = met && lambda_[static_cast<std::size_t>(v)] == 0 &&
+            !(tool_distance(shape_, pose_, y_.col(v)).penetration(shape_) > 0);
       continue;
     }
     const double k = tangential_penalty(v);
@@ -354,7 +366,9 @@ bool SurfaceContact::enters(const Vec3& from, const Vec3& to) const {
   for (const auto& t : triangles_) {
     const Vec3 a = y_.col(t[0]), b = y_.col(t[1]), c = y_.col(t[2]);
     // most triangles are far from a move of a fraction of the tool's radius: their boxes miss the move's
-    if ((a.cwiseMax(b).cwiseMax(c).array() < low.array()).any() || (a.cwiseMin(b).cwiseMin(c).array() > high.array()).any()) continue;
+    if ((a.cwiseMax(b).cwiseMax(c).array() < low.array()).any() ||
+        (a.cwiseMin(b).cwiseMin(c).array() > high.array()).any())
+      continue;
     const CrossingTriangle triangle(a, b, c);
     const double side_from = triangle.side(from), side_to = triangle.side(to);
     if (side_from >= 0 && side_to < 0 && triangle.crossing(from, to, side_from, side_to)) return true;
@@ -407,7 +421,8 @@ void SurfaceContact::take_multipliers(const SurfaceContact& other) {
     const auto found = of_key.find(keys_[v]);
     const index_t o = found == of_key.end() ? -1 : found->second;
     lambda_[v] = o < 0 ? 0.0 : other.lambda_[static_cast<std::size_t>(o)];
-    if (!anchors_.empty()) anchors_[v] = o < 0 || other.anchors_.empty() ? Anchor{} : other.anchors_[static_cast<std::size_t>(o)];
+    if (!anchors_.empty())
+      anchors_[v] = o < 0 || other.anchors_.empty() ? Anchor{} : other.anchors_[static_cast<std::size_t>(o)];
   }
 }
 

@@ -85,11 +85,11 @@ inline constexpr double default_sample_spacing = 1.2;
 
 /// What the object does to the tool.
 struct ToolLoad {
-  Vec3 force = Vec3::Zero();   ///< N, on the tool, scene axes
+  Vec3 force = Vec3::Zero();     ///< N, on the tool, scene axes
   Vec3 friction = Vec3::Zero();  ///< N: the part of `force` friction makes (the rest is the normal pressure's)
-  Vec3 torque = Vec3::Zero();  ///< N m, about the tool's position
-  int contacts = 0;            ///< vertices (and samples, SurfaceContactParams::sample_spacing) pressing on it
-  double penetration = 0;      ///< deepest vertex inside the tool, m (0: none)
+  Vec3 torque = Vec3::Zero();    ///< N m, about the tool's position
+  int contacts = 0;              ///< vertices (and samples, SurfaceContactParams::sample_spacing) pressing on it
+  double penetration = 0;        ///< deepest vertex inside the tool, m (0: none)
   /// d force / d tool position with the object held still, N/m: -sum_v k_v n_v n_v^T over the pressing
   /// vertices (negative semi-definite; the tool's curvature term, which would make it indefinite, left out)
   Mat3 stiffness = Mat3::Zero();
@@ -176,7 +176,9 @@ class SurfaceContact final : public EnergyTerm {
   /// pushed a coarse surface's vertices aside can hold none inside it, and so pass through unseen.
   bool enters(const Vec3& from, const Vec3& to) const;
   /// Where p is seen from the surface as the last evaluation carried it (nearest_surface_within()).
-  std::optional<SurfaceSide> side_of(const Vec3& p, double radius) const { return nearest_surface_within(p, y_, triangles_, radius); }
+  std::optional<SurfaceSide> side_of(const Vec3& p, double radius) const {
+    return nearest_surface_within(p, y_, triangles_, radius);
+  }
   /// The contact's map of the surface's vertices: the surface's, or without its negative weights
   /// (SurfaceContactParams::non_negative_weights). The samples are carried through it by their vertices.
   const SurfaceMap& map() const { return map_; }
@@ -185,8 +187,8 @@ class SurfaceContact final : public EnergyTerm {
   struct Active {
     index_t vertex;
     Vec3 normal;
-    double pressure;  // <lambda + k g>, N
-    Mat3 hessian;     // d2E/dy2 at the vertex
+    double pressure;      // <lambda + k g>, N
+    Mat3 hessian;         // d2E/dy2 at the vertex
     Mat3 preconditioner;  // its positive part
   };
   /// A vertex stuck to the tool (friction): where, in the tool's frame, the projection off the normal frozen
@@ -217,8 +219,8 @@ class SurfaceContact final : public EnergyTerm {
   template <class Pressing>
   ToolLoad for_each_pressing(const Pressing& pressing) const;
 
-  SurfaceContact(const Model& model, const TriangleMesh& surface, SurfaceMap map, ContactSamples samples, const ToolShape& shape,
-                 const SurfaceContactParams& params);
+  SurfaceContact(const Model& model, const TriangleMesh& surface, SurfaceMap map, ContactSamples samples,
+                 const ToolShape& shape, const SurfaceContactParams& params);
   /// fn(vertex, b) for the surface's vertices that make vertex or sample v: v itself with b = 1, or the
   /// sample's vertices with their weights.
   template <class Fn>

@@ -29,9 +29,9 @@ struct ToolPose {
 
 /// Where a point is seen from the tool.
 struct ToolDistance {
-  Vec3 core = Vec3::Zero();    ///< the nearest point of the tool's core
-  Vec3 normal = Vec3::UnitZ(); ///< unit, from `core` toward the point: the tool's outward normal there
-  double from_core = 0;        ///< |point - core|, m
+  Vec3 core = Vec3::Zero();     ///< the nearest point of the tool's core
+  Vec3 normal = Vec3::UnitZ();  ///< unit, from `core` toward the point: the tool's outward normal there
+  double from_core = 0;         ///< |point - core|, m
   /// d normal / d point = (I - n n^T) J / from_core: J = I when the nearest core point is the centre or a
   /// segment's end, the projection off the axis when it is inside the segment (moving the point along the
   /// axis moves the core point with it). `axis` is that axis (zero for J = I).

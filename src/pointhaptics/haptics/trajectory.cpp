@@ -68,7 +68,8 @@ std::size_t Trajectory::segment(double t) const {
 Vec3 Trajectory::position(double t) const {
   if (keyframes_.empty()) return Vec3::Zero();
   const std::size_t k = segment(t);
-  if (t <= keyframes_.front().t || k + 1 >= keyframes_.size()) return keyframes_[t <= keyframes_.front().t ? 0 : k].position;
+  if (t <= keyframes_.front().t || k + 1 >= keyframes_.size())
+    return keyframes_[t <= keyframes_.front().t ? 0 : k].position;
   const Keyframe &a = keyframes_[k], &b = keyframes_[k + 1];
   const double s = (t - a.t) / (b.t - a.t);
   return (1 - s) * a.position + s * b.position;

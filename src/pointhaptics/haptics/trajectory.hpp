@@ -8,9 +8,9 @@
 namespace pointhaptics {
 
 struct Keyframe {
-  double t = 0;                   ///< s
-  Vec3 position = Vec3::Zero();   ///< m, in the device frame
-  bool button = false;            ///< held from this keyframe to the next
+  double t = 0;                  ///< s
+  Vec3 position = Vec3::Zero();  ///< m, in the device frame
+  bool button = false;           ///< held from this keyframe to the next
 };
 
 class Trajectory {

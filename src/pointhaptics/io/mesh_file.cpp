@@ -61,35 +61,40 @@ TriangleMesh read_mesh(const std::string& path) {
 void write_mesh(const std::string& path, const TriangleMesh& mesh, std::string_view what) {
   const std::string ext = file_extension(path);
   const char* format = ext == ".stl" ? "stlb" : ext == ".ply" ? "plyb" : ext == ".obj" ? "objnomtl" : nullptr;
-  if (!format) throw Error(fmt::format("{} {}: '{}' is not a mesh format this writes (.stl, .ply or .obj)", what, path, ext));
+  if (!format)
+    throw Error(fmt::format("{} {}: '{}' is not a mesh format this writes (.stl, .ply or .obj)", what, path, ext));
   // one mesh under the root node; aiScene's destructor frees what is given to it
   aiScene scene;
   scene.mRootNode = new aiNode();
   scene.mRootNode->mNumMeshes = 1;
   scene.mRootNode->mMeshes = new unsigned[1]{0};
   scene.mNumMaterials = 1;
-  scene.mMaterials = new aiMaterial*[1]{new aiMaterial()};
+  scene.mMaterials = new aiMaterial* [1] { new aiMaterial() };
   scene.mNumMeshes = 1;
-  scene.mMeshes = new aiMesh*[1]{new aiMesh()};
+  scene.mMeshes = new aiMesh* [1] { new aiMesh() };
   aiMesh& out = *scene.mMeshes[0];
   out.mMaterialIndex = 0;
   out.mPrimitiveTypes = aiPrimitiveType_TRIANGLE;
   out.mNumVertices = static_cast<unsigned>(mesh.V.cols());
   out.mVertices = new aiVector3D[out.mNumVertices];
   for (unsigned v = 0; v < out.mNumVertices; ++v)
-    out.mVertices[v] = aiVector3D(static_cast<ai_real>(mesh.V(0, v)), static_cast<ai_real>(mesh.V(1, v)), static_cast<ai_real>(mesh.V(2, v)));
+    out.mVertices[v] = aiVector3D(static_cast<ai_real>(mesh.V(0, v)), static_cast<ai_real>(mesh.V(1, v)),
+                                  static_cast<ai_real>(mesh.V(2, v)));
   out.mNumFaces = static_cast<unsigned>(mesh.F.size());
   out.mFaces = new aiFace[out.mNumFaces];
   for (unsigned f = 0; f < out.mNumFaces; ++f) {
     out.mFaces[f].mNumIndices = 3;
     out.mFaces[f].mIndices = new unsigned[3];
-    for (int k = 0; k < 3; ++k) out.mFaces[f].mIndices[k] = static_cast<unsigned>(mesh.F[f][static_cast<std::size_t>(k)]);
+    for (int k = 0; k < 3; ++k)
+      out.mFaces[f].mIndices[k] = static_cast<unsigned>(mesh.F[f][static_cast<std::size_t>(k)]);
   }
   Assimp::Exporter exporter;
   const aiExportDataBlob* blob = exporter.ExportToBlob(&scene, format);
   if (!blob) throw Error(fmt::format("{} {}: cannot write the mesh: {}", what, path, exporter.GetErrorString()));
   // through the output file that renames into place, so that a full disk leaves no half mesh
-  write_text_file(path, what, [&](TextOutput& file) { file.print("{}", std::string_view(static_cast<const char*>(blob->data), blob->size)); });
+  write_text_file(path, what, [&](TextOutput& file) {
+    file.print("{}", std::string_view(static_cast<const char*>(blob->data), blob->size));
+  });
 }
 
 bool ply_has_faces(const std::string& path) {

@@ -27,7 +27,8 @@ void check_output_path(const std::string& path, std::string_view what) {
     return;
   }
   const fs::path parent = fs::path(path).parent_path().empty() ? fs::path(".") : fs::path(path).parent_path();
-  if (!fs::is_directory(parent, ec)) throw Error(fmt::format("{} {}: the folder {} does not exist", what, path, parent.string()));
+  if (!fs::is_directory(parent, ec))
+    throw Error(fmt::format("{} {}: the folder {} does not exist", what, path, parent.string()));
   if (::access(parent.c_str(), W_OK) != 0)
     throw Error(fmt::format("{} {}: the folder {} cannot be written", what, path, parent.string()));
 }

@@ -35,7 +35,8 @@ struct RawCloud {
 
 std::string lower(std::string_view s) {
   std::string out(s);
-  std::transform(out.begin(), out.end(), out.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(out.begin(), out.end(), out.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return out;
 }
 
@@ -97,13 +98,15 @@ RawCloud parse_text(std::string_view data, bool csv, const std::string& name) {
     if (n_fields < 0) {
       n_fields = static_cast<int>(fields.size());
       if (n_fields < 3 || n_fields > 5)
-        throw Error(fmt::format("{}:{}: expected x y z [fixed [volume]] (3 to 5 numbers), got {} fields", name, line_no, n_fields));
+        throw Error(fmt::format("{}:{}: expected x y z [fixed [volume]] (3 to 5 numbers), got {} fields", name, line_no,
+                                n_fields));
       if (!have_header) {
         col = {0, 1, 2, n_fields > 3 ? 3 : -1, n_fields > 4 ? 4 : -1};
       }
     }
     if (static_cast<int>(fields.size()) != n_fields)
-      throw Error(fmt::format("{}:{}: expected {} fields like the lines before, got {}", name, line_no, n_fields, fields.size()));
+      throw Error(fmt::format("{}:{}: expected {} fields like the lines before, got {}", name, line_no, n_fields,
+                              fields.size()));
     auto number = [&](int c, const char* what) {
       const std::string& f = fields[static_cast<std::size_t>(c)];
       double v = 0;
@@ -117,7 +120,8 @@ RawCloud parse_text(std::string_view data, bool csv, const std::string& name) {
     if (col[3] >= 0) {
       const double held = number(col[3], "fixed");
       if (held != 0 && held != 1)
-        throw Error(fmt::format("{}:{}: fixed = {} must be 0 or 1", name, line_no, fields[static_cast<std::size_t>(col[3])]));
+        throw Error(
+            fmt::format("{}:{}: fixed = {} must be 0 or 1", name, line_no, fields[static_cast<std::size_t>(col[3])]));
       raw.held.push_back(held == 1 ? 1 : 0);
     }
     if (col[4] >= 0) raw.volume.push_back(number(col[4], "volume"));
@@ -133,10 +137,10 @@ enum class PlyType { I8, U8, I16, U16, I32, U32, F32, F64 };
 
 std::optional<PlyType> ply_type(std::string_view t) {
   static const std::pair<std::string_view, PlyType> names[] = {
-      {"char", PlyType::I8},    {"int8", PlyType::I8},     {"uchar", PlyType::U8},   {"uint8", PlyType::U8},
-      {"short", PlyType::I16},  {"int16", PlyType::I16},   {"ushort", PlyType::U16}, {"uint16", PlyType::U16},
-      {"int", PlyType::I32},    {"int32", PlyType::I32},   {"uint", PlyType::U32},   {"uint32", PlyType::U32},
-      {"float", PlyType::F32},  {"float32", PlyType::F32}, {"double", PlyType::F64}, {"float64", PlyType::F64}};
+      {"char", PlyType::I8},   {"int8", PlyType::I8},     {"uchar", PlyType::U8},   {"uint8", PlyType::U8},
+      {"short", PlyType::I16}, {"int16", PlyType::I16},   {"ushort", PlyType::U16}, {"uint16", PlyType::U16},
+      {"int", PlyType::I32},   {"int32", PlyType::I32},   {"uint", PlyType::U32},   {"uint32", PlyType::U32},
+      {"float", PlyType::F32}, {"float32", PlyType::F32}, {"double", PlyType::F64}, {"float64", PlyType::F64}};
   for (const auto& [n, type] : names)
     if (n == t) return type;
   return std::nullopt;
@@ -144,9 +148,13 @@ std::optional<PlyType> ply_type(std::string_view t) {
 
 std::size_t ply_size(PlyType t) {
   switch (t) {
-    case PlyType::I8: case PlyType::U8: return 1;
-    case PlyType::I16: case PlyType::U16: return 2;
-    case PlyType::I32: case PlyType::U32: case PlyType::F32: return 4;
+    case PlyType::I8:
+    case PlyType::U8: return 1;
+    case PlyType::I16:
+    case PlyType::U16: return 2;
+    case PlyType::I32:
+    case PlyType::U32:
+    case PlyType::F32: return 4;
     case PlyType::F64: return 8;
   }
   return 0;
@@ -204,7 +212,8 @@ RawCloud parse_ply(std::string_view data, const std::string& name) {
     return line;
   };
   auto magic = next_line();
-  if (!magic || *magic != "ply") throw Error(fmt::format("{}: not a PLY file (it must start with the line \"ply\")", name));
+  if (!magic || *magic != "ply")
+    throw Error(fmt::format("{}: not a PLY file (it must start with the line \"ply\")", name));
   enum class Format { ASCII, LITTLE, BIG } format = Format::ASCII;
   bool have_format = false;
   std::vector<PlyElement> elements;
@@ -241,14 +250,16 @@ RawCloud parse_ply(std::string_view data, const std::string& name) {
         std::string count_type, item_type;
         words >> count_type >> item_type >> p.name;
         auto ct = ply_type(count_type), it = ply_type(item_type);
-        if (!ct || !it || p.name.empty()) throw Error(fmt::format("{}:{}: malformed list property \"{}\"", name, line_no, *line));
+        if (!ct || !it || p.name.empty())
+          throw Error(fmt::format("{}:{}: malformed list property \"{}\"", name, line_no, *line));
         p.list = true;
         p.count_type = *ct;
         p.type = *it;
       } else {
         words >> p.name;
         auto t = ply_type(type);
-        if (!t || p.name.empty()) throw Error(fmt::format("{}:{}: unknown property type in \"{}\"", name, line_no, *line));
+        if (!t || p.name.empty())
+          throw Error(fmt::format("{}:{}: unknown property type in \"{}\"", name, line_no, *line));
         p.type = *t;
       }
       elements.back().properties.push_back(p);
@@ -261,14 +272,15 @@ RawCloud parse_ply(std::string_view data, const std::string& name) {
   std::size_t vertex_index = elements.size();
   for (std::size_t e = 0; e < elements.size(); ++e)
     if (elements[e].name == "vertex") {
-      if (vertex_index != elements.size()) throw Error(fmt::format("{}: the PLY header declares two vertex elements", name));
+      if (vertex_index != elements.size())
+        throw Error(fmt::format("{}: the PLY header declares two vertex elements", name));
       vertex_index = e;
     }
   if (vertex_index == elements.size()) throw Error(fmt::format("{}: the PLY file has no vertex element", name));
   for (const PlyElement& e : elements)
     if (e.name == "face" && e.count > 0)
-      throw Error(fmt::format("{}: a surface mesh ({} faces), not a point cloud (a scene volume-samples it as a mesh)", name,
-                              e.count));
+      throw Error(fmt::format("{}: a surface mesh ({} faces), not a point cloud (a scene volume-samples it as a mesh)",
+                              name, e.count));
   const PlyElement& vertex = elements[vertex_index];
   int ix = -1, iy = -1, iz = -1, ifixed = -1, ivolume = -1;
   for (std::size_t p = 0; p < vertex.properties.size(); ++p) {
@@ -286,7 +298,8 @@ RawCloud parse_ply(std::string_view data, const std::string& name) {
   RawCloud raw;
   std::vector<double> values(vertex.properties.size());
   auto store = [&](std::uint64_t v) {
-    const Vec3 x(values[static_cast<std::size_t>(ix)], values[static_cast<std::size_t>(iy)], values[static_cast<std::size_t>(iz)]);
+    const Vec3 x(values[static_cast<std::size_t>(ix)], values[static_cast<std::size_t>(iy)],
+                 values[static_cast<std::size_t>(iz)]);
     raw.X[v] = x;
     if (ifixed >= 0) {
       const double held = values[static_cast<std::size_t>(ifixed)];
@@ -307,7 +320,8 @@ RawCloud parse_ply(std::string_view data, const std::string& name) {
         if (!next_line()) throw Error(fmt::format("{}: truncated in element \"{}\"", name, elements[e].name));
     // a vertex line holds at least 2 characters per property: a count beyond that is a lie
     if (vertex.count > remaining / (2 * vertex.properties.size()) + 1)
-      throw Error(fmt::format("{}: declares {} vertices but holds only {} bytes of data", name, vertex.count, remaining));
+      throw Error(
+          fmt::format("{}: declares {} vertices but holds only {} bytes of data", name, vertex.count, remaining));
     reserve(vertex.count);
     for (std::uint64_t v = 0; v < vertex.count; ++v) {
       auto line = next_line();
@@ -316,9 +330,11 @@ RawCloud parse_ply(std::string_view data, const std::string& name) {
       const char* end = p + line->size();
       for (std::size_t k = 0; k < vertex.properties.size(); ++k) {
         while (p < end && std::isspace(static_cast<unsigned char>(*p))) ++p;
-        if (vertex.properties[k].list) throw Error(fmt::format("{}: list properties in vertices are not supported", name));
+        if (vertex.properties[k].list)
+          throw Error(fmt::format("{}: list properties in vertices are not supported", name));
         auto [next, ec] = std::from_chars(p, end, values[k]);
-        if (ec != std::errc()) throw Error(fmt::format("{}:{}: vertex {}: expected {} numbers", name, line_no, v, vertex.properties.size()));
+        if (ec != std::errc())
+          throw Error(fmt::format("{}:{}: vertex {}: expected {} numbers", name, line_no, v, vertex.properties.size()));
         p = next;
       }
       store(v);
@@ -331,8 +347,8 @@ RawCloud parse_ply(std::string_view data, const std::string& name) {
     while (auto line = next_line())
       if (line->find_first_not_of(" \t") != std::string::npos) ++extra;
     if (extra > later)
-      throw Error(fmt::format("{}: holds {} more data lines than its header declares ({} vertices)", name, extra - later,
-                              vertex.count));
+      throw Error(fmt::format("{}: holds {} more data lines than its header declares ({} vertices)", name,
+                              extra - later, vertex.count));
     return raw;
   }
   // binary: fixed-size items (list properties only outside the vertices, skipped item by item)
@@ -350,7 +366,8 @@ RawCloud parse_ply(std::string_view data, const std::string& name) {
     }
     if (!has_list) {
       if (item > 0 && elements[e].count > (data.size() - at) / item)
-        throw Error(fmt::format("{}: truncated in element \"{}\" ({} items declared)", name, elements[e].name, elements[e].count));
+        throw Error(fmt::format("{}: truncated in element \"{}\" ({} items declared)", name, elements[e].name,
+                                elements[e].count));
       at += static_cast<std::size_t>(elements[e].count * item);
       continue;
     }
@@ -358,13 +375,15 @@ RawCloud parse_ply(std::string_view data, const std::string& name) {
       for (const PlyProperty& p : elements[e].properties) {
         std::uint64_t n = 1;
         if (p.list) {
-          if (at + ply_size(p.count_type) > data.size()) throw Error(fmt::format("{}: truncated in element \"{}\"", name, elements[e].name));
+          if (at + ply_size(p.count_type) > data.size())
+            throw Error(fmt::format("{}: truncated in element \"{}\"", name, elements[e].name));
           const double c = load_binary(p.count_type, bytes + at, swap);
           if (!(c >= 0)) throw Error(fmt::format("{}: negative list length in element \"{}\"", name, elements[e].name));
           n = static_cast<std::uint64_t>(c);
           at += ply_size(p.count_type);
         }
-        if (n > (data.size() - at) / ply_size(p.type)) throw Error(fmt::format("{}: truncated in element \"{}\"", name, elements[e].name));
+        if (n > (data.size() - at) / ply_size(p.type))
+          throw Error(fmt::format("{}: truncated in element \"{}\"", name, elements[e].name));
         at += n * ply_size(p.type);
       }
   }
@@ -374,8 +393,9 @@ RawCloud parse_ply(std::string_view data, const std::string& name) {
     stride += ply_size(p.type);
   }
   if (stride == 0 || vertex.count > (data.size() - at) / stride)
-    throw Error(fmt::format("{}: declares {} vertices of {} bytes but holds only {} bytes (truncated, or a wrong count)", name,
-                            vertex.count, stride, data.size() - at));
+    throw Error(
+        fmt::format("{}: declares {} vertices of {} bytes but holds only {} bytes (truncated, or a wrong count)", name,
+                    vertex.count, stride, data.size() - at));
   reserve(vertex.count);
   for (std::uint64_t v = 0; v < vertex.count; ++v) {
     for (std::size_t k = 0; k < vertex.properties.size(); ++k) {
@@ -392,7 +412,8 @@ RawCloud parse_ply(std::string_view data, const std::string& name) {
 PointCloud checked(RawCloud raw, const std::string& name, double spacing) {
   const std::size_t n = raw.X.size();
   if (n == 0) throw Error(fmt::format("{}: the file holds no points", name));
-  if (n > static_cast<std::size_t>(std::numeric_limits<index_t>::max() / 2)) throw Error(fmt::format("{}: too many points", name));
+  if (n > static_cast<std::size_t>(std::numeric_limits<index_t>::max() / 2))
+    throw Error(fmt::format("{}: too many points", name));
   for (std::size_t i = 0; i < n; ++i) {
     if (!raw.X[i].allFinite()) throw Error(fmt::format("{}: point {}: a coordinate is not finite", name, i));
     if (raw.X[i].cwiseAbs().maxCoeff() > implausible)
@@ -401,7 +422,8 @@ PointCloud checked(RawCloud raw, const std::string& name, double spacing) {
     if (!raw.volume.empty() && !(raw.volume[i] > 0 && std::isfinite(raw.volume[i])))
       throw Error(fmt::format("{}: point {}: volume {} must be a positive number (m^3)", name, i, raw.volume[i]));
   }
-  if (n < 4) throw Error(fmt::format("{}: {} points are no solid (4 or more, not all on a plane, are needed)", name, n));
+  if (n < 4)
+    throw Error(fmt::format("{}: {} points are no solid (4 or more, not all on a plane, are needed)", name, n));
   PointCloud cloud;
   cloud.spacing = spacing;
   cloud.X.resize(3, static_cast<Eigen::Index>(n));
@@ -420,16 +442,19 @@ PointCloud checked(RawCloud raw, const std::string& name, double spacing) {
   std::size_t duplicates = 0;
   index_t first = -1;
   for (index_t i = 0; i < static_cast<index_t>(n); ++i)
-    if (nearest[static_cast<std::size_t>(i)] >= 0 && (cloud.X.col(i) - cloud.X.col(nearest[static_cast<std::size_t>(i)])).norm() <= tiny) {
+    if (nearest[static_cast<std::size_t>(i)] >= 0 &&
+        (cloud.X.col(i) - cloud.X.col(nearest[static_cast<std::size_t>(i)])).norm() <= tiny) {
       ++duplicates;
       if (first < 0) first = i;
     }
   if (duplicates > 0)
-    throw Error(fmt::format("{}: {} points coincide with another (first: point {} and point {} at ({:.6g}, {:.6g}, {:.6g}) m)", name,
-                            duplicates, first, nearest[static_cast<std::size_t>(first)], cloud.X(0, first), cloud.X(1, first),
-                            cloud.X(2, first)));
+    throw Error(
+        fmt::format("{}: {} points coincide with another (first: point {} and point {} at ({:.6g}, {:.6g}, {:.6g}) m)",
+                    name, duplicates, first, nearest[static_cast<std::size_t>(first)], cloud.X(0, first),
+                    cloud.X(1, first), cloud.X(2, first)));
   cloud.volume = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(n), spacing * spacing * spacing);
-  if (!raw.volume.empty()) cloud.volume = Eigen::Map<const Eigen::VectorXd>(raw.volume.data(), static_cast<Eigen::Index>(n));
+  if (!raw.volume.empty())
+    cloud.volume = Eigen::Map<const Eigen::VectorXd>(raw.volume.data(), static_cast<Eigen::Index>(n));
   cloud.surface.assign(n, 0);
   cloud.held = std::move(raw.held);
   return cloud;
@@ -444,7 +469,8 @@ PointCloud parse_point_cloud(std::string_view data, std::string_view format, con
   else if (ext == ".xyz" || ext == ".txt") raw = parse_text(data, false, name);
   else if (ext == ".csv") raw = parse_text(data, true, name);
   else
-    throw Error(fmt::format("{}: format \"{}\" is not a point cloud this version reads (.ply .xyz .csv .txt)", name, format));
+    throw Error(
+        fmt::format("{}: format \"{}\" is not a point cloud this version reads (.ply .xyz .csv .txt)", name, format));
   return checked(std::move(raw), name, spacing);
 }
 

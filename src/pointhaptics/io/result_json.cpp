@@ -31,10 +31,12 @@ std::string result_json(const Model& model, const State& state, const RunSummary
     fixed.push_back(model.fixed[i] != 0);
     active.push_back(!s.lod.enabled || (i < static_cast<index_t>(s.lod.active.size()) && s.lod.active[i]));
   }
-  doc["points"] = {{"reference", columns(model.X)}, {"displacement", columns(state.u)}, {"fixed", fixed}, {"active", active}};
-  doc["solver"] = {{"kind", s.solver_kind},     {"converged", s.converged}, {"iterations", s.iterations},
-                   {"residual", s.residual},    {"steps", s.steps},         {"substeps", s.substeps},
-                   {"stable_dt", s.stable_dt}, {"cg_iterations", s.cg_iterations}};
+  doc["points"] = {
+      {"reference", columns(model.X)}, {"displacement", columns(state.u)}, {"fixed", fixed}, {"active", active}};
+  doc["solver"] = {{"kind", s.solver_kind},      {"converged", s.converged},
+                   {"iterations", s.iterations}, {"residual", s.residual},
+                   {"steps", s.steps},           {"substeps", s.substeps},
+                   {"stable_dt", s.stable_dt},   {"cg_iterations", s.cg_iterations}};
   if (!s.failure.empty()) doc["solver"]["failure"] = s.failure;
   doc["solver"]["inverted"] = s.inverted;
   doc["solver"]["inverted_steps"] = s.inverted_steps;
@@ -71,18 +73,23 @@ std::string result_json(const Model& model, const State& state, const RunSummary
                    {"min_observed_energy_j", s.haptic_min_observed_energy},
                    {"passivity_dissipated_j", s.haptic_passivity_dissipated},
                    {"passivity_ticks", s.haptic_passivity_ticks},
-                   {"local_model", {{"updates", m.updates},
-                                    {"force_mean_n", m.force_mean_n},
-                                    {"stray_mean_n", m.rendered_mean_n},
-                                    {"stray_max_n", m.rendered_max_n},
-                                    {"hold_stray_mean_n", m.hold_mean_n},
-                                    {"hold_stray_max_n", m.hold_max_n},
-                                    {"held_object_stray_mean_n", m.held_object_mean_n},
-                                    {"held_object_stray_max_n", m.held_object_max_n}}}};
+                   {"local_model",
+                    {{"updates", m.updates},
+                     {"force_mean_n", m.force_mean_n},
+                     {"stray_mean_n", m.rendered_mean_n},
+                     {"stray_max_n", m.rendered_max_n},
+                     {"hold_stray_mean_n", m.hold_mean_n},
+                     {"hold_stray_max_n", m.hold_max_n},
+                     {"held_object_stray_mean_n", m.held_object_mean_n},
+                     {"held_object_stray_max_n", m.held_object_max_n}}}};
   if (s.tool.present) {
     const ToolSummary& t = s.tool;
-    doc["tool"] = {{"kind", t.kind},         {"position", vec(t.position)}, {"force", vec(t.force)},
-                   {"torque", vec(t.torque)}, {"contacts", t.contacts},       {"penetration", t.penetration},
+    doc["tool"] = {{"kind", t.kind},
+                   {"position", vec(t.position)},
+                   {"force", vec(t.force)},
+                   {"torque", vec(t.torque)},
+                   {"contacts", t.contacts},
+                   {"penetration", t.penetration},
                    {"friction", vec(t.friction)}};
   }
   if (s.cut.present) {

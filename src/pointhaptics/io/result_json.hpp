@@ -10,51 +10,51 @@ namespace pointhaptics {
 /// Levels of detail in a run (all zero and empty without).
 struct LodSummary {
   bool enabled = false;
-  index_t selected = 0;                 ///< points simulated at the end
-  index_t frozen = 0;                   ///< points held around them (the frozen ring)
-  index_t widened = 0;                  ///< selected points with a widened support
-  std::vector<index_t> band_count;      ///< points per band (T_r1, T_r2, levels), selected or not
-  std::vector<index_t> band_selected;   ///< selected points per band
-  std::vector<char> active;             ///< per point of the object: simulated at the end
-  long long selections = 0;             ///< selections made (the first and the re-selections)
-  double selection_ms = 0;              ///< the last selection, ms
-  double build_ms = 0;                  ///< the last active model's build (neighbours, M_i, stable step), ms
-  double max_reselect_ms = 0;           ///< the longest a re-selection held the simulation thread, ms (the whole
-                                        ///< build when made in place, the take-over when built on a worker)
+  index_t selected = 0;                ///< points simulated at the end
+  index_t frozen = 0;                  ///< points held around them (the frozen ring)
+  index_t widened = 0;                 ///< selected points with a widened support
+  std::vector<index_t> band_count;     ///< points per band (T_r1, T_r2, levels), selected or not
+  std::vector<index_t> band_selected;  ///< selected points per band
+  std::vector<char> active;            ///< per point of the object: simulated at the end
+  long long selections = 0;            ///< selections made (the first and the re-selections)
+  double selection_ms = 0;             ///< the last selection, ms
+  double build_ms = 0;                 ///< the last active model's build (neighbours, M_i, stable step), ms
+  double max_reselect_ms = 0;          ///< the longest a re-selection held the simulation thread, ms (the whole
+                                       ///< build when made in place, the take-over when built on a worker)
 };
 
 /// Cuts in a run (issue 18): absent without.
 struct CutSummary {
   bool present = false;
-  long long sweeps = 0;              ///< cut updates: the steps a blade cut in (a step's strips are one)
-  long long cut_pairs = 0;           ///< neighbour pairs severed in all
-  double max_update_ms = 0;          ///< the longest update (refits, stable step, solver), ms
-  double mean_update_ms = 0;         ///< the updates' mean, ms
-  std::vector<index_t> piece_points; ///< points per connected piece, in the order of their lowest point
-  long long sheet_triangles = 0;     ///< the cuts' sheets (reference configuration) the surface splits along
-  long long surface_splits = 0;      ///< a probe's surface split along them (once per blade stroke)
-  double max_split_ms = 0;           ///< the longest split, ms (on a worker in real time)
+  long long sweeps = 0;               ///< cut updates: the steps a blade cut in (a step's strips are one)
+  long long cut_pairs = 0;            ///< neighbour pairs severed in all
+  double max_update_ms = 0;           ///< the longest update (refits, stable step, solver), ms
+  double mean_update_ms = 0;          ///< the updates' mean, ms
+  std::vector<index_t> piece_points;  ///< points per connected piece, in the order of their lowest point
+  long long sheet_triangles = 0;      ///< the cuts' sheets (reference configuration) the surface splits along
+  long long surface_splits = 0;       ///< a probe's surface split along them (once per blade stroke)
+  double max_split_ms = 0;            ///< the longest split, ms (on a worker in real time)
 };
 
 /// What a run reports besides the points: solver outcome, energies, timing, support reactions.
 /// A run's tool (issue 16): what the object does to it at the end.
 struct ToolSummary {
   bool present = false;
-  std::string kind;                          ///< "sphere" or "capsule"
-  Vec3 position = Vec3::Zero();              ///< m, scene axes
-  Vec3 force = Vec3::Zero();                 ///< N, the force the object exerts on the tool
-  Vec3 torque = Vec3::Zero();                ///< N m, about its position
-  int contacts = 0;                          ///< surface vertices (probe on points: points) pressing on it
-  double penetration = 0;                    ///< deepest surface vertex inside the tool, m (held tools)
-  Vec3 friction = Vec3::Zero();              ///< N, the part of `force` friction makes (held tools with friction)
+  std::string kind;              ///< "sphere" or "capsule"
+  Vec3 position = Vec3::Zero();  ///< m, scene axes
+  Vec3 force = Vec3::Zero();     ///< N, the force the object exerts on the tool
+  Vec3 torque = Vec3::Zero();    ///< N m, about its position
+  int contacts = 0;              ///< surface vertices (probe on points: points) pressing on it
+  double penetration = 0;        ///< deepest surface vertex inside the tool, m (held tools)
+  Vec3 friction = Vec3::Zero();  ///< N, the part of `force` friction makes (held tools with friction)
 };
 
 /// How far the haptic side's local model F(p) = f0 + K (p - p0) strays from the next update's force f0' at
 /// its p0' (issue 16, item 4): |f0 + K (p0' - p0) - f0'| over the updates made in contact, N, for the K
 /// rendered, for none (the force held between updates) and for the held object's (the contact's own stiffness).
 struct LocalModelSummary {
-  long long updates = 0;       ///< updates compared (both in contact)
-  double force_mean_n = 0;     ///< mean |f0'|, N
+  long long updates = 0;    ///< updates compared (both in contact)
+  double force_mean_n = 0;  ///< mean |f0'|, N
   double rendered_mean_n = 0, rendered_max_n = 0;
   double hold_mean_n = 0, hold_max_n = 0;
   double held_object_mean_n = 0, held_object_max_n = 0;
@@ -63,20 +63,20 @@ struct LocalModelSummary {
 struct RunSummary {
   std::string solver_kind;
   bool converged = false;
-  long long iterations = 0;     ///< Newton iterations (static, implicit) or force evaluations (explicit)
-  double residual = 0;          ///< relative out-of-balance force of the free points at the end
-  long long steps = 0;          ///< solver steps of dt
+  long long iterations = 0;  ///< Newton iterations (static, implicit) or force evaluations (explicit)
+  double residual = 0;       ///< relative out-of-balance force of the free points at the end
+  long long steps = 0;       ///< solver steps of dt
   double strain_energy = 0, kinetic_energy = 0;  ///< J
   double wall_s = 0, step_ms_mean = 0, steps_per_s = 0;
-  double step_ms_max = 0;       ///< the longest step, ms
+  double step_ms_max = 0;  ///< the longest step, ms
   /// wall time in the step pipeline's stages, s: following the contact (levels of detail), placing the
   /// tools, the solver
   double active_set_s = 0, tools_s = 0, solve_s = 0;
-  double stable_dt = 0;         ///< explicit: the stable sub-step, s
-  long long substeps = 0;       ///< explicit: sub-steps taken in all; static: load increments
-  long long cg_iterations = 0;  ///< static, implicit: conjugate-gradient iterations in all
-  std::string preconditioner;   ///< static, implicit: "block_jacobi", "cholesky" or "two_level"
-  long long factorisations = 0; ///< cholesky: numeric factorisations of the tangent
+  double stable_dt = 0;                     ///< explicit: the stable sub-step, s
+  long long substeps = 0;                   ///< explicit: sub-steps taken in all; static: load increments
+  long long cg_iterations = 0;              ///< static, implicit: conjugate-gradient iterations in all
+  std::string preconditioner;               ///< static, implicit: "block_jacobi", "cholesky" or "two_level"
+  long long factorisations = 0;             ///< cholesky: numeric factorisations of the tangent
   long long background_factorisations = 0;  ///< ... of them, made on a worker thread
   double factor_bytes = 0;      ///< cholesky: the largest factor's size (with the worker's copy when it refactorised
                                 ///< in the background), bytes; two_level: the coarse factor's

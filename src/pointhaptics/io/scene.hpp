@@ -19,23 +19,25 @@ struct Aabb {
 enum class ShapeKind { BOX, SPHERE, HALF_SPHERE, FILE };
 template <>
 struct EnumNames<ShapeKind> {
-  static constexpr std::array<std::pair<ShapeKind, std::string_view>, 4> table{
-      {{ShapeKind::BOX, "box"}, {ShapeKind::SPHERE, "sphere"}, {ShapeKind::HALF_SPHERE, "half_sphere"}, {ShapeKind::FILE, "file"}}};
+  static constexpr std::array<std::pair<ShapeKind, std::string_view>, 4> table{{{ShapeKind::BOX, "box"},
+                                                                                {ShapeKind::SPHERE, "sphere"},
+                                                                                {ShapeKind::HALF_SPHERE, "half_sphere"},
+                                                                                {ShapeKind::FILE, "file"}}};
 };
 
 struct ObjectSpec {
   ShapeKind shape = ShapeKind::BOX;
-  Vec3 size = Vec3(0.15, 0.03, 0.03);  ///< box edge lengths, m
-  Vec3 origin = Vec3::Zero();          ///< box: min corner; sphere, half_sphere: centre, m
-  double radius = 0.05;                ///< sphere, half_sphere, m
-  double spacing = 0.0075;             ///< sample spacing, m
-  double surface_edge = 0;             ///< the surface's edge length, m (0: half the spacing)
-  std::string file;                    ///< shape = file: path, resolved against the scene file's folder
+  Vec3 size = Vec3(0.15, 0.03, 0.03);                ///< box edge lengths, m
+  Vec3 origin = Vec3::Zero();                        ///< box: min corner; sphere, half_sphere: centre, m
+  double radius = 0.05;                              ///< sphere, half_sphere, m
+  double spacing = 0.0075;                           ///< sample spacing, m
+  double surface_edge = 0;                           ///< the surface's edge length, m (0: half the spacing)
+  std::string file;                                  ///< shape = file: path, resolved against the scene file's folder
   double threshold_low = NAN, threshold_high = NAN;  ///< volume images: the intensity window sampled
   /// volume images: [intensity, young (Pa)] rows, intensities increasing; each point's Young's modulus is
   /// interpolated linearly at its voxel's intensity (held at the end values beyond them); empty: none
   std::vector<std::array<double, 2>> stiffness_map;
-  int line = 0;                        ///< of the [object] table, for messages
+  int line = 0;  ///< of the [object] table, for messages
 };
 
 /// A ball of points: |X - centre| <= radius.
@@ -46,7 +48,7 @@ struct SphereRegion {
 /// A solid cylinder of points: |a| <= half_length and |d - a axis| <= radius, d = X - centre, a = d . axis.
 struct CylinderRegion {
   Vec3 centre = Vec3::Zero();
-  Vec3 axis = Vec3::UnitY();  ///< unit
+  Vec3 axis = Vec3::UnitY();           ///< unit
   double radius = 0, half_length = 0;  ///< m
 };
 
@@ -65,7 +67,8 @@ struct PointSelector {
     if (cylinder) {
       const Vec3 d = x - cylinder->centre;
       const double along = d.dot(cylinder->axis);
-      return std::abs(along) <= cylinder->half_length + tol && (d - along * cylinder->axis).norm() <= cylinder->radius + tol;
+      return std::abs(along) <= cylinder->half_length + tol &&
+             (d - along * cylinder->axis).norm() <= cylinder->radius + tol;
     }
     return (x.array() >= box.min.array() - tol).all() && (x.array() <= box.max.array() + tol).all();
   }
@@ -81,9 +84,9 @@ struct PointSelector {
 };
 
 struct FixedSpec : PointSelector {
-  Vec3 displacement = Vec3::Zero();        ///< prescribed displacement, m
-  double ramp = 0;                         ///< ramp-in time, s
-  int line = 0;                            ///< line of the [[fixed]] table, for messages
+  Vec3 displacement = Vec3::Zero();  ///< prescribed displacement, m
+  double ramp = 0;                   ///< ramp-in time, s
+  int line = 0;                      ///< line of the [[fixed]] table, for messages
 };
 
 /// [[region]]: a part of the object with its own material (a stiff nodule in soft tissue); the keys it
@@ -110,26 +113,26 @@ struct EnumNames<LoadKind> {
 
 struct LoadSpec {
   LoadKind kind = LoadKind::TRACTION;
-  Aabb box;                     ///< traction: the loaded points
-  Vec3 total = Vec3::Zero();    ///< traction: total force, N
-  Vec3 g = Vec3(0, -9.81, 0);   ///< gravity, m/s^2
-  long long point = 0;          ///< point load: point index
-  Vec3 force = Vec3::Zero();    ///< point load: force, N
+  Aabb box;                    ///< traction: the loaded points
+  Vec3 total = Vec3::Zero();   ///< traction: total force, N
+  Vec3 g = Vec3(0, -9.81, 0);  ///< gravity, m/s^2
+  long long point = 0;         ///< point load: point index
+  Vec3 force = Vec3::Zero();   ///< point load: force, N
   int line = 0;
 };
 
 /// [probe]: a spherical probe driven by a device (design.md, "Haptics").
 struct ProbeSpec {
   bool present = false;
-  double radius = 0.005;                   ///< m
-  bool grab = false;                       ///< mode = "grab" (else push)
-  bool cut = false;                        ///< mode = "cut": a blade, its capsule axis the edge (ProbeMode::CUT)
-  double cut_resistance = 0;               ///< J/m^2: the work of cutting per unit of new cut area
-  std::string trajectory;                  ///< virtual device: CSV of t, x, y, z[, button] (resolved path)
+  double radius = 0.005;                         ///< m
+  bool grab = false;                             ///< mode = "grab" (else push)
+  bool cut = false;                              ///< mode = "cut": a blade, its capsule axis the edge (ProbeMode::CUT)
+  double cut_resistance = 0;                     ///< J/m^2: the work of cutting per unit of new cut area
+  std::string trajectory;                        ///< virtual device: CSV of t, x, y, z[, button] (resolved path)
   std::vector<std::array<double, 5>> keyframes;  ///< or keyframes t, x, y, z, button
-  Vec3 origin = Vec3::Constant(NAN);       ///< scene position of the device origin, m (NaN: above the object's centre)
-  double scale = 1.0;                      ///< scene metres per device metre
-  double stiffness = 0;                    ///< contact spring per point, N/m (0: E x spacing)
+  Vec3 origin = Vec3::Constant(NAN);  ///< scene position of the device origin, m (NaN: above the object's centre)
+  double scale = 1.0;                 ///< scene metres per device metre
+  double stiffness = 0;               ///< contact spring per point, N/m (0: E x spacing)
   /// A tool held there, m (scene axes; NaN: driven by the device). With solver.kind = "static" the
   /// equilibrium with the tool there; its contact is on the object's surface (issue 16).
   Vec3 position = Vec3::Constant(NAN);
@@ -137,25 +140,26 @@ struct ProbeSpec {
   /// tool at zero depth, and reads the force against it)
   Vec3 direction = -Vec3::UnitY();
   std::array<double, 4> orientation{1, 0, 0, 0};  ///< unit quaternion w, x, y, z: tool to scene axes
-  bool capsule = false;                    ///< shape = "capsule" (else "sphere")
-  double length = 0;                       ///< capsule: its axis segment, m, along the tool's local z
-  double friction = 0;                     ///< Coulomb's coefficient on the surface
-  bool object_stiffness = false;           ///< local_stiffness = "object" (else "contact"): ProbeParams::object_stiffness
-  bool non_negative_surface_map = false;   ///< surface_map = "non_negative" (else "exact"): ProbeParams::non_negative_surface_map
-  double sample_spacing = 0;               ///< m (0: 1.2 x the tool's radius): ProbeParams::sample_spacing
+  bool capsule = false;                           ///< shape = "capsule" (else "sphere")
+  double length = 0;                              ///< capsule: its axis segment, m, along the tool's local z
+  double friction = 0;                            ///< Coulomb's coefficient on the surface
+  bool object_stiffness = false;  ///< local_stiffness = "object" (else "contact"): ProbeParams::object_stiffness
+  bool non_negative_surface_map =
+      false;                  ///< surface_map = "non_negative" (else "exact"): ProbeParams::non_negative_surface_map
+  double sample_spacing = 0;  ///< m (0: 1.2 x the tool's radius): ProbeParams::sample_spacing
   int line = 0;
   bool held() const { return present && position.allFinite(); }
 };
 
 /// [device]: which device drives the probe.
 struct DeviceSpec {
-  std::string kind = "virtual";            ///< virtual | replay | openhaptics
-  std::string specs = "touch";             ///< touch | omni | falcon | custom
+  std::string kind = "virtual";                                                    ///< virtual | replay | openhaptics
+  std::string specs = "touch";                                                     ///< touch | omni | falcon | custom
   double max_force = 0, max_stiffness = 0, max_damping = 0, workspace_radius = 0;  ///< custom specs
-  double max_torque = 0;  ///< custom specs: the largest torque it renders, N m (0: none)
-  std::string log;                         ///< replay: a recorded session (resolved path)
-  std::string library = "libHD.so";        ///< openhaptics: the HD library to load
-  bool passivity_control = true;           ///< ForceRules::passivity_control
+  double max_torque = 0;             ///< custom specs: the largest torque it renders, N m (0: none)
+  std::string log;                   ///< replay: a recorded session (resolved path)
+  std::string library = "libHD.so";  ///< openhaptics: the HD library to load
+  bool passivity_control = true;     ///< ForceRules::passivity_control
 };
 
 /// [lod]: levels of detail around the contact point (design.md, "Levels of detail").
@@ -171,8 +175,8 @@ struct LodSpec {
 struct CutSpec {
   std::array<Vec3, 2> edge{Vec3::Zero(), Vec3::Zero()};  ///< m, scene axes
   std::array<Vec3, 2> to{Vec3::Zero(), Vec3::Zero()};    ///< m, scene axes
-  double start = 0;     ///< s
-  double duration = 0;  ///< s (0: the whole sweep at once, at `start`)
+  double start = 0;                                      ///< s
+  double duration = 0;                                   ///< s (0: the whole sweep at once, at `start`)
   int line = 0;
 };
 

@@ -60,7 +60,8 @@ void check_key_nesting(std::string_view text, const std::string& name) {
     if (c == '.') {
       if (dots++ == 0) chain_line = line;
       if (dots > max_levels)
-        throw Error(fmt::format("{}:{}: a key or table header nested more than {} levels deep", name, chain_line, max_levels));
+        throw Error(
+            fmt::format("{}:{}: a key or table header nested more than {} levels deep", name, chain_line, max_levels));
       continue;
     }
     if (bare(c) || c == ' ' || c == '\t') continue;
@@ -72,7 +73,8 @@ void check_key_nesting(std::string_view text, const std::string& name) {
 // the source name of the values a SceneSetting puts into a scene (their line is the setting's own)
 constexpr std::string_view setting_source = "<scene setting>";
 
-[[noreturn]] void fail(const Context& ctx, const toml::source_region& where, std::string_view key, std::string_view what) {
+[[noreturn]] void fail(const Context& ctx, const toml::source_region& where, std::string_view key,
+                       std::string_view what) {
   // a key set from outside the file has no line in it: its message names the setting instead
   const bool set = where.begin.line == 0 || (where.path && *where.path == setting_source);
   if (set && ctx.settings) {
@@ -93,14 +95,14 @@ constexpr std::string_view setting_source = "<scene setting>";
 toml::table setting_value(const SceneSetting& s, const std::string& file) {
   try {
     return toml::parse("value = " + s.value, setting_source);
-  } catch (const toml::parse_error&) {
-  }
+  } catch (const toml::parse_error&) {}
   const bool word = !s.value.empty() && std::all_of(s.value.begin(), s.value.end(), [](char c) {
     return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.' || c == '/';
   });
   if (!word)
-    throw Error(fmt::format("{}: {} (set to {}): not a TOML value (a number, true or false, [x, y, z], or a \"string\")", file,
-                            s.key, s.value));
+    throw Error(
+        fmt::format("{}: {} (set to {}): not a TOML value (a number, true or false, [x, y, z], or a \"string\")", file,
+                    s.key, s.value));
   toml::table t;
   t.insert("value", s.value);
   return t;
@@ -139,7 +141,8 @@ void apply_setting(toml::table& root, const SceneSetting& s, const std::string& 
       if (error != std::errc() || end != part.data() + part.size() || index >= array->size())
         throw bad(fmt::format("\"{}\" is not an index of the array (it has {} entries)", part, array->size()));
       if (last) {
-        value.get("value")->visit([&](auto&& v) { array->replace(array->cbegin() + static_cast<std::ptrdiff_t>(index), std::move(v)); });
+        value.get("value")->visit(
+            [&](auto&& v) { array->replace(array->cbegin() + static_cast<std::ptrdiff_t>(index), std::move(v)); });
         return;
       }
       at = array->get(index);
@@ -155,7 +158,9 @@ class TableReader {
   TableReader(const Context& ctx, const toml::table& table, std::string section)
       : ctx_(ctx), table_(table), section_(std::move(section)) {}
 
-  std::string name(std::string_view key) const { return section_.empty() ? std::string(key) : section_ + "." + std::string(key); }
+  std::string name(std::string_view key) const {
+    return section_.empty() ? std::string(key) : section_ + "." + std::string(key);
+  }
   const toml::node* find(std::string_view key) {
     seen_.insert(std::string(key));
     return table_.get(key);
@@ -163,7 +168,9 @@ class TableReader {
   [[noreturn]] void fail_at(const toml::node& node, std::string_view key, std::string_view what) const {
     fail(ctx_, node.source(), name(key), what);
   }
-  [[noreturn]] void fail_table(std::string_view key, std::string_view what) const { fail(ctx_, table_.source(), name(key), what); }
+  [[noreturn]] void fail_table(std::string_view key, std::string_view what) const {
+    fail(ctx_, table_.source(), name(key), what);
+  }
 
   double number(std::string_view key, double fallback) {
     const toml::node* node = find(key);
@@ -251,7 +258,8 @@ class TableReader {
     b.min = r.vec3("min", Vec3::Zero());
     b.max = r.vec3("max", Vec3::Zero());
     r.finish();
-    if (!(b.min.array() <= b.max.array()).all()) fail(ctx_, t->source(), name(key), "min must not exceed max in any component");
+    if (!(b.min.array() <= b.max.array()).all())
+      fail(ctx_, t->source(), name(key), "min must not exceed max in any component");
     return b;
   }
   // every key not read is unknown
@@ -288,8 +296,9 @@ auto non_negative = [](double x) { return x >= 0; };
 void read_object(TableReader& r, ObjectSpec& o, const Context& ctx) {
   o.shape = r.enumeration("shape", o.shape);
   o.spacing = r.number("spacing", o.spacing, positive, "must be > 0 (m)");
-  o.surface_edge = r.number("surface_edge", o.surface_edge, [&](double e) { return e > 0 && e >= 1e-3 * o.spacing; },
-                            "must be > 0 (m) and at least a thousandth of the spacing");
+  o.surface_edge = r.number(
+      "surface_edge", o.surface_edge, [&](double e) { return e > 0 && e >= 1e-3 * o.spacing; },
+      "must be > 0 (m) and at least a thousandth of the spacing");
   if (o.shape == ShapeKind::BOX) {
     if (!r.find("size")) r.fail_table("size", "a box needs size = [lx, ly, lz] (m)");
     o.size = r.vec3("size", o.size);
@@ -318,12 +327,14 @@ void read_object(TableReader& r, ObjectSpec& o, const Context& ctx) {
   // any shape: the scene builder says when there is no volume image to map
   if (const toml::node* node = r.find("stiffness_map")) {
     const toml::array* rows = node->as_array();
-    const char* form = "expected [[intensity, young], ...] with at least two rows, intensities increasing, young in (0, 1e13] Pa";
+    const char* form =
+        "expected [[intensity, young], ...] with at least two rows, intensities increasing, young in (0, 1e13] Pa";
     if (!rows || rows->size() < 2) r.fail_at(*node, "stiffness_map", form);
     for (const toml::node& row : *rows) {
       const toml::array* pair = row.as_array();
       if (!pair || pair->size() != 2) r.fail_at(row, "stiffness_map", form);
-      const double intensity = r.as_number(*pair->get(0), "stiffness_map"), young = r.as_number(*pair->get(1), "stiffness_map");
+      const double intensity = r.as_number(*pair->get(0), "stiffness_map"),
+                   young = r.as_number(*pair->get(1), "stiffness_map");
       if (!(young > 0 && young <= 1e13) || (!o.stiffness_map.empty() && !(intensity > o.stiffness_map.back()[0])))
         r.fail_at(row, "stiffness_map", form);
       o.stiffness_map.push_back({intensity, young});
@@ -335,13 +346,16 @@ void read_object(TableReader& r, ObjectSpec& o, const Context& ctx) {
 // the material keys a [material] table and a [[region]] share, with their ranges
 double read_young(TableReader& r, double fallback) {
   // beyond any solid (steel is 2e11 Pa, air 1.2 kg/m^3): 1e300 Pa or 1e-320 kg/m^3 made the solver "diverge"
-  return r.number("young", fallback, [](double x) { return x > 0 && x <= 1e13; }, "must lie in (0, 1e13] (Pa)");
+  return r.number(
+      "young", fallback, [](double x) { return x > 0 && x <= 1e13; }, "must lie in (0, 1e13] (Pa)");
 }
 double read_poisson(TableReader& r, double fallback) {
-  return r.number("poisson", fallback, [](double x) { return x > -1 && x < 0.5; }, "must lie in (-1, 0.5)");
+  return r.number(
+      "poisson", fallback, [](double x) { return x > -1 && x < 0.5; }, "must lie in (-1, 0.5)");
 }
 double read_density(TableReader& r, double fallback) {
-  return r.number("density", fallback, [](double x) { return x >= 1e-3 && x <= 1e5; }, "must lie in [1e-3, 1e5] (kg/m^3)");
+  return r.number(
+      "density", fallback, [](double x) { return x >= 1e-3 && x <= 1e5; }, "must lie in [1e-3, 1e5] (kg/m^3)");
 }
 
 // Mooney-Rivlin's c10, c01 and bulk (Pa), all three, instead of young and poisson, which are set from them
@@ -351,8 +365,10 @@ void read_mooney_rivlin(TableReader& r, MaterialParams& m) {
   if (!any) return;
   const char* first = r.find("c10") ? "c10" : r.find("c01") ? "c01" : "bulk";
   if (m.model != MaterialModel::MOONEY_RIVLIN)
-    r.fail_at(*r.find(first), first, "c10, c01 and bulk are Mooney-Rivlin's: set model = \"mooney_rivlin\" (or give young and poisson)");
-  if (!r.find("c10") || !r.find("c01") || !r.find("bulk")) r.fail_table(first, "give all of c10, c01 and bulk (Pa), or young and poisson");
+    r.fail_at(*r.find(first), first,
+              "c10, c01 and bulk are Mooney-Rivlin's: set model = \"mooney_rivlin\" (or give young and poisson)");
+  if (!r.find("c10") || !r.find("c01") || !r.find("bulk"))
+    r.fail_table(first, "give all of c10, c01 and bulk (Pa), or young and poisson");
   if (r.find("young") || r.find("poisson"))
     r.fail_at(*r.find(r.find("young") ? "young" : "poisson"), r.find("young") ? "young" : "poisson",
               "give either young and poisson or c10, c01 and bulk, not both");
@@ -386,10 +402,12 @@ void read_material(TableReader& r, MaterialParams& m) {
   m.poisson = read_poisson(r, m.poisson);
   m.density = read_density(r, m.density);
   read_mooney_rivlin(r, m);
-  m.volume_stiffness =
-      r.number("volume_stiffness", m.volume_stiffness, [](double x) { return x >= 0 && x <= 1e13; }, "must lie in [0, 1e13] (Pa)");
+  m.volume_stiffness = r.number(
+      "volume_stiffness", m.volume_stiffness, [](double x) { return x >= 0 && x <= 1e13; },
+      "must lie in [0, 1e13] (Pa)");
   m.damping = r.number("damping", m.damping, non_negative, "must be >= 0 (1/s)");
-  m.hourglass = r.number("hourglass", m.hourglass, [](double x) { return x >= 0 && x <= 10; }, "must lie in [0, 10]");
+  m.hourglass = r.number(
+      "hourglass", m.hourglass, [](double x) { return x >= 0 && x <= 10; }, "must lie in [0, 10]");
   m.volume = r.enumeration("volume", m.volume);
   read_prony(r, m);
 }
@@ -398,15 +416,19 @@ void read_kernel(TableReader& r, KernelParams& k) {
   k.type = r.enumeration("type", k.type);
   if (r.find("support_factor") && r.find("support"))
     r.fail_at(*r.find("support"), "support", "give either support (m) or support_factor, not both");
-  k.support_factor = r.number("support_factor", k.support_factor, [](double x) { return x > 1 && x <= 20; }, "must lie in (1, 20]");
+  k.support_factor = r.number(
+      "support_factor", k.support_factor, [](double x) { return x > 1 && x <= 20; }, "must lie in (1, 20]");
   k.support = r.number("support", 0.0, positive, "must be > 0 (m)");
 }
 
 void read_solver(TableReader& r, SolverSpec& s) {
   s.kind = r.enumeration("kind", s.kind);
-  s.dt = r.number("dt", s.dt, [](double x) { return x >= 1e-9 && x <= 1; }, "must lie in [1e-9, 1] (s)");
-  s.duration = r.number("duration", s.duration, [](double x) { return x >= 0 && x <= 1e6; }, "must lie in [0, 1e6] (s)");
-  s.tolerance = r.number("tolerance", s.tolerance, [](double x) { return x > 0 && x < 1; }, "must lie in (0, 1)");
+  s.dt = r.number(
+      "dt", s.dt, [](double x) { return x >= 1e-9 && x <= 1; }, "must lie in [1e-9, 1] (s)");
+  s.duration = r.number(
+      "duration", s.duration, [](double x) { return x >= 0 && x <= 1e6; }, "must lie in [0, 1e6] (s)");
+  s.tolerance = r.number(
+      "tolerance", s.tolerance, [](double x) { return x > 0 && x < 1; }, "must lie in (0, 1)");
   auto count = [&](std::string_view key, int fallback, int lo, int hi) {
     const auto node = r.find(key);
     const long long v = r.integer(key, fallback);
@@ -425,12 +447,14 @@ void read_solver(TableReader& r, SolverSpec& s) {
 void read_selector(TableReader& r, PointSelector& f) {
   const int selectors = (r.find("box") != nullptr) + (r.find("sphere") != nullptr) + (r.find("cylinder") != nullptr);
   if (selectors != 1)
-    r.fail_table("box", "give exactly one of box = { min, max }, sphere = { centre, radius } or "
-                        "cylinder = { centre, axis, radius, half_length } (m)");
+    r.fail_table("box",
+                 "give exactly one of box = { min, max }, sphere = { centre, radius } or "
+                 "cylinder = { centre, axis, radius, half_length } (m)");
   if (r.find("box")) f.box = r.box("box", true);
   if (const toml::table* t = r.subtable("sphere")) {
     TableReader s(r.context(), *t, r.name("sphere"));
-    if (!t->get("centre") || !t->get("radius")) s.fail_table("centre", "a sphere needs centre = [x, y, z] and radius (m)");
+    if (!t->get("centre") || !t->get("radius"))
+      s.fail_table("centre", "a sphere needs centre = [x, y, z] and radius (m)");
     f.sphere = SphereRegion{s.vec3("centre", Vec3::Zero()), s.number("radius", 0.0, positive, "must be > 0 (m)")};
     s.finish();
   }
@@ -475,9 +499,11 @@ RefineSpec read_refine(TableReader& r, const ObjectSpec& object) {
   f.line = r.line();
   read_selector(r, f);
   if (!r.find("spacing")) r.fail_table("spacing", "a [[refine]] table needs spacing = s (m), finer than the object's");
-  f.spacing = r.number("spacing", 0.0, [&](double s) { return s > 0 && s < object.spacing && s >= 0.05 * object.spacing; },
-                       "must be finer than the object's spacing, and at least a twentieth of it (m)");
-  if (object.shape == ShapeKind::FILE) r.fail_table("spacing", "[[refine]] is for box, sphere and half_sphere objects (not files)");
+  f.spacing = r.number(
+      "spacing", 0.0, [&](double s) { return s > 0 && s < object.spacing && s >= 0.05 * object.spacing; },
+      "must be finer than the object's spacing, and at least a twentieth of it (m)");
+  if (object.shape == ShapeKind::FILE)
+    r.fail_table("spacing", "[[refine]] is for box, sphere and half_sphere objects (not files)");
   return f;
 }
 
@@ -488,15 +514,19 @@ CutSpec read_cut(TableReader& r) {
     const toml::node* node = r.find(key);
     const toml::array* ends = node ? node->as_array() : nullptr;
     if (!ends || ends->size() != 2)
-      r.fail_table(key, "a [[cut]] needs edge = [[x, y, z], [x, y, z]] (the blade's edge, m) and to = [[x, y, z], [x, y, z]] (where it ends)");
+      r.fail_table(
+          key,
+          "a [[cut]] needs edge = [[x, y, z], [x, y, z]] (the blade's edge, m) and to = [[x, y, z], [x, y, z]] (where it ends)");
     return std::array<Vec3, 2>{r.as_vec3(*ends->get(0), key), r.as_vec3(*ends->get(1), key)};
   };
   c.edge = segment("edge");
   c.to = segment("to");
   if ((c.edge[1] - c.edge[0]).norm() == 0 || (c.to[1] - c.to[0]).norm() == 0)
     r.fail_table("edge", "the blade's edge has zero length (its two ends coincide)");
-  c.start = r.number("start", c.start, [](double t) { return t >= 0; }, "must be >= 0 (s)");
-  c.duration = r.number("duration", c.duration, [](double t) { return t >= 0; }, "must be >= 0 (s)");
+  c.start = r.number(
+      "start", c.start, [](double t) { return t >= 0; }, "must be >= 0 (s)");
+  c.duration = r.number(
+      "duration", c.duration, [](double t) { return t >= 0; }, "must be >= 0 (s)");
   return c;
 }
 
@@ -541,7 +571,8 @@ void read_probe(TableReader& r, ProbeSpec& p, const Context& ctx) {
   if (r.find("trajectory")) p.trajectory = resolve(ctx, r.string("trajectory", ""));
   if (const toml::node* node = r.find("keyframes")) {
     const toml::array* rows = node->as_array();
-    if (!rows || rows->empty()) r.fail_at(*node, "keyframes", "expected [[t, x, y, z], ...] (a 5th value 1 holds the button)");
+    if (!rows || rows->empty())
+      r.fail_at(*node, "keyframes", "expected [[t, x, y, z], ...] (a 5th value 1 holds the button)");
     for (const toml::node& row : *rows) {
       const toml::array* a = row.as_array();
       if (!a || (a->size() != 4 && a->size() != 5))
@@ -558,19 +589,26 @@ void read_probe(TableReader& r, ProbeSpec& p, const Context& ctx) {
   p.capsule = r.choice("shape", "sphere", {"sphere", "capsule"}) == "capsule";
   p.length = r.number("length", p.length, non_negative, "must be >= 0 (m)");
   if (p.capsule && !(p.length > 0)) r.fail_table("length", "a capsule needs length > 0 (m): its axis segment");
-  if (!p.capsule && r.find("length")) r.fail_at(*r.find("length"), "length", "only a capsule has a length (shape = \"capsule\")");
-  if (p.cut && !p.capsule) r.fail_table("shape", "a blade (mode = \"cut\") is a capsule whose axis is its edge: give shape = \"capsule\" and length");
-  p.friction = r.number("friction", p.friction, [](double m) { return m >= 0 && m <= 10; }, "must be in [0, 10]");
+  if (!p.capsule && r.find("length"))
+    r.fail_at(*r.find("length"), "length", "only a capsule has a length (shape = \"capsule\")");
+  if (p.cut && !p.capsule)
+    r.fail_table("shape",
+                 "a blade (mode = \"cut\") is a capsule whose axis is its edge: give shape = \"capsule\" and length");
+  p.friction = r.number(
+      "friction", p.friction, [](double m) { return m >= 0 && m <= 10; }, "must be in [0, 10]");
   p.object_stiffness = r.choice("local_stiffness", "contact", {"contact", "object"}) == "object";
   p.non_negative_surface_map = r.choice("surface_map", "exact", {"exact", "non_negative"}) == "non_negative";
-  p.sample_spacing = r.number("sample_spacing", p.sample_spacing, positive, "must be > 0 (m: the contact's samples along the surface's edges)");
+  p.sample_spacing = r.number("sample_spacing", p.sample_spacing, positive,
+                              "must be > 0 (m: the contact's samples along the surface's edges)");
   if (r.find("position")) {
     p.position = r.vec3("position", p.position);
     if (r.find("trajectory") || r.find("keyframes"))
-      r.fail_at(*r.find("position"), "position", "a tool held at a position has no trajectory or keyframes: give one or the other");
+      r.fail_at(*r.find("position"), "position",
+                "a tool held at a position has no trajectory or keyframes: give one or the other");
   }
   if (const toml::node* node = r.find("direction")) {
-    if (!r.find("position")) r.fail_at(*node, "direction", "only a tool held at a position (position = [x, y, z]) presses along a direction");
+    if (!r.find("position"))
+      r.fail_at(*node, "direction", "only a tool held at a position (position = [x, y, z]) presses along a direction");
     const Vec3 d = r.as_vec3(*node, "direction");
     if (!(d.norm() > 1e-12)) r.fail_at(*node, "direction", "must not be zero (the direction the tool presses in)");
     p.direction = d.normalized();
@@ -580,7 +618,8 @@ void read_probe(TableReader& r, ProbeSpec& p, const Context& ctx) {
     if (!a || a->size() != 4) r.fail_at(*node, "orientation", "expected a unit quaternion [w, x, y, z]");
     double norm = 0;
     for (std::size_t c = 0; c < 4; ++c) norm += std::pow(p.orientation[c] = r.as_number(*a->get(c), "orientation"), 2);
-    if (!(std::abs(std::sqrt(norm) - 1) < 1e-6)) r.fail_at(*node, "orientation", fmt::format("the quaternion's norm is {:.6g}, not 1", std::sqrt(norm)));
+    if (!(std::abs(std::sqrt(norm) - 1) < 1e-6))
+      r.fail_at(*node, "orientation", fmt::format("the quaternion's norm is {:.6g}, not 1", std::sqrt(norm)));
   }
 }
 
@@ -593,11 +632,16 @@ void read_device(TableReader& r, DeviceSpec& d, const Context& ctx) {
     for (const char* key : {"max_force", "max_stiffness", "workspace_radius"})
       if (!r.find(key)) r.fail_table(key, "custom specs need max_force, max_stiffness and workspace_radius");
     // bounds well beyond any haptic device: specs of 1e300 were accepted and rendered 0 N all session
-    d.max_force = r.number("max_force", 0.0, [](double x) { return x > 0 && x <= 1e3; }, "must lie in (0, 1000] (N)");
-    d.max_stiffness = r.number("max_stiffness", 0.0, [](double x) { return x > 0 && x <= 1e6; }, "must lie in (0, 1e6] (N/m)");
-    d.max_damping = r.number("max_damping", 0.0, [](double x) { return x >= 0 && x <= 1e4; }, "must lie in [0, 1e4] (N s/m)");
-    d.workspace_radius = r.number("workspace_radius", 0.0, [](double x) { return x > 0 && x <= 10; }, "must lie in (0, 10] (m)");
-    d.max_torque = r.number("max_torque", 0.0, [](double x) { return x >= 0 && x <= 100; }, "must lie in [0, 100] (N m)");
+    d.max_force = r.number(
+        "max_force", 0.0, [](double x) { return x > 0 && x <= 1e3; }, "must lie in (0, 1000] (N)");
+    d.max_stiffness = r.number(
+        "max_stiffness", 0.0, [](double x) { return x > 0 && x <= 1e6; }, "must lie in (0, 1e6] (N/m)");
+    d.max_damping = r.number(
+        "max_damping", 0.0, [](double x) { return x >= 0 && x <= 1e4; }, "must lie in [0, 1e4] (N s/m)");
+    d.workspace_radius = r.number(
+        "workspace_radius", 0.0, [](double x) { return x > 0 && x <= 10; }, "must lie in (0, 10] (m)");
+    d.max_torque = r.number(
+        "max_torque", 0.0, [](double x) { return x >= 0 && x <= 100; }, "must lie in [0, 100] (N m)");
   }
   if (d.kind == "replay") {
     if (!r.find("log")) r.fail_table("log", "a replay device needs log = \"session.csv\" (a recorded force log)");
@@ -610,7 +654,8 @@ void read_lod(TableReader& r, LodSpec& l) {
   l.line = r.line();
   LodParams& p = l.params;
   p.k1 = r.number("k1", p.k1, non_negative, "must be >= 0 (units of h)");
-  p.k2 = r.number("k2", p.k2, [&](double x) { return x >= p.k1; }, "must be >= k1 (units of h)");
+  p.k2 = r.number(
+      "k2", p.k2, [&](double x) { return x >= p.k1; }, "must be >= k1 (units of h)");
   if (const toml::node* node = r.find("levels")) {
     const toml::array* rows = node->as_array();
     if (!rows) r.fail_at(*node, "levels", "expected [ { distance = <h>, K = <0..10> }, ... ]");
@@ -622,11 +667,13 @@ void read_lod(TableReader& r, LodSpec& l) {
       TableReader level(r.context(), *t, r.name("levels"));
       if (!t->get("distance") || !t->get("K")) level.fail_table("distance", "each level needs both distance and K");
       LodLevel lv;
-      lv.distance = level.number("distance", 0.0, [&](double x) { return x > previous; },
-                                 fmt::format("must exceed {} (k2 or the previous level's distance)", previous));
+      lv.distance = level.number(
+          "distance", 0.0, [&](double x) { return x > previous; },
+          fmt::format("must exceed {} (k2 or the previous level's distance)", previous));
       const long long k = level.integer("K", 0);
       if (k < 0 || k > 10 || k < previous_k)
-        level.fail_at(*t->get("K"), "K", fmt::format("{} must be an integer in [{}, 10] (non-decreasing)", k, previous_k));
+        level.fail_at(*t->get("K"), "K",
+                      fmt::format("{} must be an integer in [{}, 10] (non-decreasing)", k, previous_k));
       lv.K = static_cast<int>(k);
       level.finish();
       previous = lv.distance;
@@ -640,13 +687,15 @@ void read_lod(TableReader& r, LodSpec& l) {
   p.seed = static_cast<std::uint64_t>(seed_value);
   p.scheme = r.enumeration("scheme", p.scheme);
   p.reselect = r.number("reselect", p.reselect, positive, "must be > 0 (units of h)");
-  p.reselect_interval = r.number("reselect_interval", p.reselect_interval, [](double x) { return x >= 0 && x <= 1e3; },
-                                 "must lie in [0, 1000] (s)");
+  p.reselect_interval = r.number(
+      "reselect_interval", p.reselect_interval, [](double x) { return x >= 0 && x <= 1e3; },
+      "must lie in [0, 1000] (s)");
   const toml::node* mn = r.find("min_neighbours");
   const long long min_neighbours = r.integer("min_neighbours", p.min_neighbours);
   if (min_neighbours < 1 || min_neighbours > 1000) r.fail_at(*mn, "min_neighbours", "must lie in [1, 1000]");
   p.min_neighbours = static_cast<int>(min_neighbours);
-  p.max_widening = r.number("max_widening", p.max_widening, [](double x) { return x >= 1 && x <= 10; }, "must lie in [1, 10]");
+  p.max_widening = r.number(
+      "max_widening", p.max_widening, [](double x) { return x >= 1 && x <= 10; }, "must lie in [1, 10]");
   if (r.find("contact")) l.contact = r.vec3("contact", l.contact);
 }
 
@@ -706,37 +755,45 @@ Scene parse_scene(std::string_view text, const std::string& name, const std::str
   section("lod", [&](TableReader& r) { read_lod(r, scene.lod); });
   if (scene.probe.present && !scene.probe.held() && scene.device.kind == "virtual" && scene.probe.trajectory.empty() &&
       scene.probe.keyframes.empty())
-    throw Error(fmt::format("{}:{}: probe: a virtual device needs trajectory = \"probe.csv\" or keyframes = [[t, x, y, z], ...] "
-                            "(or position = [x, y, z] for a tool held there)",
-                            name, scene.probe.line));
+    throw Error(fmt::format(
+        "{}:{}: probe: a virtual device needs trajectory = \"probe.csv\" or keyframes = [[t, x, y, z], ...] "
+        "(or position = [x, y, z] for a tool held there)",
+        name, scene.probe.line));
   if (scene.probe.present && !scene.probe.held() && scene.probe.friction > 0 && scene.lod.present)
-    throw Error(fmt::format("{}:{}: probe.friction: a device's probe with levels of detail touches the point spheres, which "
-                            "are frictionless",
-                            name, scene.probe.line));
+    throw Error(
+        fmt::format("{}:{}: probe.friction: a device's probe with levels of detail touches the point spheres, which "
+                    "are frictionless",
+                    name, scene.probe.line));
   if (scene.probe.held() && root.get("device"))
-    throw Error(fmt::format("{}:{}: probe: a tool held at a position is not driven by a [device]", name, scene.probe.line));
+    throw Error(
+        fmt::format("{}:{}: probe: a tool held at a position is not driven by a [device]", name, scene.probe.line));
   if (root.get("device") && !scene.probe.present)
     throw Error(fmt::format("{}: device: a [device] needs a [probe] to drive", name));
   if (scene.probe.present && !scene.probe.held() && scene.solver.kind == SolverKind::STATIC)
-    throw Error(fmt::format("{}:{}: probe: a static solve holds the tool at a position: give position = [x, y, z] (a probe "
-                            "driven by a device needs solver.kind = \"explicit\" or \"implicit\")",
-                            name, scene.probe.line));
+    throw Error(
+        fmt::format("{}:{}: probe: a static solve holds the tool at a position: give position = [x, y, z] (a probe "
+                    "driven by a device needs solver.kind = \"explicit\" or \"implicit\")",
+                    name, scene.probe.line));
   read_array_of_tables(top, "fixed", [&](TableReader& r) { scene.fixed.push_back(read_fixed(r)); });
   read_array_of_tables(top, "region", [&](TableReader& r) { scene.regions.push_back(read_region(r)); });
   read_array_of_tables(top, "load", [&](TableReader& r) { scene.loads.push_back(read_load(r)); });
   read_array_of_tables(top, "cut", [&](TableReader& r) { scene.cuts.push_back(read_cut(r)); });
   if (scene.probe.cut && scene.probe.held())
-    throw Error(fmt::format("{}:{}: probe.mode: a blade cuts as the device moves it, not held at a position", name, scene.probe.line));
+    throw Error(fmt::format("{}:{}: probe.mode: a blade cuts as the device moves it, not held at a position", name,
+                            scene.probe.line));
   read_array_of_tables(top, "refine", [&](TableReader& r) { scene.refine.push_back(read_refine(r, scene.object)); });
   if (!scene.refine.empty() && scene.lod.present)
-    throw Error(fmt::format("{}:{}: refine: not yet with levels of detail ([lod] thins a uniform sampling)", name, scene.refine.front().line));
+    throw Error(fmt::format("{}:{}: refine: not yet with levels of detail ([lod] thins a uniform sampling)", name,
+                            scene.refine.front().line));
   top.finish();
   if (scene.lod.present && !scene.probe.present && !scene.lod.contact.allFinite()) {
     int point_loads = 0;
     for (const LoadSpec& l : scene.loads) point_loads += l.kind == LoadKind::POINT;
     if (point_loads != 1)
-      throw Error(fmt::format("{}:{}: lod.contact: missing; without a [probe] or exactly one point load, give the "
-                              "contact point as contact = [x, y, z] (m)", name, scene.lod.line));
+      throw Error(
+          fmt::format("{}:{}: lod.contact: missing; without a [probe] or exactly one point load, give the "
+                      "contact point as contact = [x, y, z] (m)",
+                      name, scene.lod.line));
   }
   return scene;
 }

@@ -38,13 +38,17 @@ VolumeImage read_nifti(const std::string& path) {
   // the header first: sizes are checked before the data is allocated
   std::unique_ptr<nifti_image, void (*)(nifti_image*)> header(nifti_image_read(path.c_str(), 0), nifti_image_free);
   if (!header) throw Error(fmt::format("{}: not a readable NIfTI file", path));
-  if (header->nx < 1 || header->ny < 1 || header->nz < 1 || header->nt > 1 || header->nu > 1 || header->nv > 1 || header->nw > 1)
-    throw Error(fmt::format("{}: a 3-D image is needed, this one is {}x{}x{}x{}", path, header->nx, header->ny, header->nz, header->nt));
+  if (header->nx < 1 || header->ny < 1 || header->nz < 1 || header->nt > 1 || header->nu > 1 || header->nv > 1 ||
+      header->nw > 1)
+    throw Error(fmt::format("{}: a 3-D image is needed, this one is {}x{}x{}x{}", path, header->nx, header->ny,
+                            header->nz, header->nt));
   if (static_cast<double>(header->nx) * static_cast<double>(header->ny) * static_cast<double>(header->nz) > max_voxels)
-    throw Error(fmt::format("{}: {}x{}x{} voxels is more than this reader takes", path, header->nx, header->ny, header->nz));
+    throw Error(
+        fmt::format("{}: {}x{}x{} voxels is more than this reader takes", path, header->nx, header->ny, header->nz));
   // an uncompressed single file must hold what its header promises before that much memory is taken
   if (ends_with(path, ".nii") && header->iname && std::string(header->iname) == path) {
-    const double needed = static_cast<double>(header->iname_offset) + static_cast<double>(header->nvox) * header->nbyper;
+    const double needed =
+        static_cast<double>(header->iname_offset) + static_cast<double>(header->nvox) * header->nbyper;
     if (static_cast<double>(std::filesystem::file_size(path)) < needed)
       throw Error(fmt::format("{}: truncated: the header promises {:.0f} bytes, the file has {}", path, needed,
                               std::filesystem::file_size(path)));
@@ -72,7 +76,8 @@ VolumeImage read_nifti(const std::string& path) {
   auto fill = [&](auto tag) {
     using T = decltype(tag);
     const T* data = static_cast<const T*>(nim->data);
-    for (std::size_t v = 0; v < n; ++v) image.values[v] = static_cast<float>(slope * static_cast<double>(data[v]) + inter);
+    for (std::size_t v = 0; v < n; ++v)
+      image.values[v] = static_cast<float>(slope * static_cast<double>(data[v]) + inter);
   };
   switch (nim->datatype) {
     case DT_UINT8: fill(std::uint8_t{}); break;
@@ -83,7 +88,9 @@ VolumeImage read_nifti(const std::string& path) {
     case DT_UINT32: fill(std::uint32_t{}); break;
     case DT_FLOAT32: fill(float{}); break;
     case DT_FLOAT64: fill(double{}); break;
-    default: throw Error(fmt::format("{}: NIfTI data type {} is not supported (integers and floats are)", path, nim->datatype));
+    default:
+      throw Error(
+          fmt::format("{}: NIfTI data type {} is not supported (integers and floats are)", path, nim->datatype));
   }
   return image;
 }
@@ -98,15 +105,17 @@ void check_nrrd_header(const std::string& path) {
   double voxels = 1;
   for (unsigned a = 0; a < header->dim; ++a) voxels *= static_cast<double>(header->axis[a].size);
   if (voxels > max_voxels)
-    throw Error(fmt::format("{}: the header declares {:.3g} voxels, more than this reader takes ({:.3g})", path, voxels, max_voxels));
+    throw Error(fmt::format("{}: the header declares {:.3g} voxels, more than this reader takes ({:.3g})", path, voxels,
+                            max_voxels));
   // raw data in the same file must be there before that much memory is taken
   const bool attached = io->dataFNArr->len == 0;
   if (attached && io->encoding == nrrdEncodingRaw && header->type != nrrdTypeBlock) {
     const double needed = voxels * static_cast<double>(nrrdTypeSize[header->type]);
     const double size = static_cast<double>(std::filesystem::file_size(path));
     if (size < needed)
-      throw Error(fmt::format("{}: truncated: the header declares {:.0f} bytes of raw data, the file has {:.0f} bytes in all", path,
-                              needed, size));
+      throw Error(
+          fmt::format("{}: truncated: the header declares {:.0f} bytes of raw data, the file has {:.0f} bytes in all",
+                      path, needed, size));
   }
 }
 
@@ -121,7 +130,8 @@ VolumeImage read_nrrd(const std::string& path) {
     std::replace(message.begin(), message.end(), '\n', ' ');
     throw Error(fmt::format("{}: not a readable NRRD file: {}", path, message));
   }
-  if (nrrd->dim != 3) throw Error(fmt::format("{}: a 3-D image is needed, this one has {} dimensions", path, nrrd->dim));
+  if (nrrd->dim != 3)
+    throw Error(fmt::format("{}: a 3-D image is needed, this one has {} dimensions", path, nrrd->dim));
   if (nrrd->type == nrrdTypeBlock) throw Error(fmt::format("{}: block-typed NRRD data is not supported", path));
   VolumeImage image;
   image.nx = static_cast<index_t>(nrrd->axis[0].size);
@@ -139,9 +149,11 @@ VolumeImage read_nrrd(const std::string& path) {
     }
   }
   if (nrrd->spaceDim == 3)
-    for (int r = 0; r < 3; ++r) image.voxel_to_world(r, 3) = std::isfinite(nrrd->spaceOrigin[r]) ? unit * nrrd->spaceOrigin[r] : 0.0;
+    for (int r = 0; r < 3; ++r)
+      image.voxel_to_world(r, 3) = std::isfinite(nrrd->spaceOrigin[r]) ? unit * nrrd->spaceOrigin[r] : 0.0;
   check_affine(image.voxel_to_world, path);
-  const std::size_t n = static_cast<std::size_t>(image.nx) * static_cast<std::size_t>(image.ny) * static_cast<std::size_t>(image.nz);
+  const std::size_t n =
+      static_cast<std::size_t>(image.nx) * static_cast<std::size_t>(image.ny) * static_cast<std::size_t>(image.nz);
   image.values.resize(n);
   for (std::size_t v = 0; v < n; ++v) image.values[v] = static_cast<float>(nrrdDLookup[nrrd->type](nrrd->data, v));
   return image;
@@ -187,13 +199,15 @@ PointCloud sample_volume(const VolumeImage& image, double low, double high, doub
   hi += half;
   const Eigen::Array3d cells = ((hi - lo).array() / spacing - 1e-9).ceil().max(1.0);
   if (!(cells.prod() <= 8.0 * static_cast<double>(max_points)))
-    throw Error(fmt::format("{}: a {:.3g} m spacing gives {:.3g} lattice cells: too many (coarser spacing?)", name, spacing, cells.prod()));
+    throw Error(fmt::format("{}: a {:.3g} m spacing gives {:.3g} lattice cells: too many (coarser spacing?)", name,
+                            spacing, cells.prod()));
   const Vec3 origin = 0.5 * (lo + hi) - 0.5 * (cells.matrix() - Vec3::Ones()) * spacing;
   const Eigen::Matrix3d to_voxel = A.inverse();
   std::vector<Vec3> points;
   std::vector<double> intensities;
   for (index_t c = 0; c < static_cast<index_t>(cells.prod()); ++c) {
-    const index_t ci = c % static_cast<index_t>(cells.x()), cj = (c / static_cast<index_t>(cells.x())) % static_cast<index_t>(cells.y()),
+    const index_t ci = c % static_cast<index_t>(cells.x()),
+                  cj = (c / static_cast<index_t>(cells.x())) % static_cast<index_t>(cells.y()),
                   ck = c / static_cast<index_t>(cells.x() * cells.y());
     const Vec3 x = origin + spacing * Vec3(ci, cj, ck);
     const Vec3 v = to_voxel * (x - b);
@@ -205,15 +219,19 @@ PointCloud sample_volume(const VolumeImage& image, double low, double high, doub
       intensities.push_back(image.at(i, j, k));
     }
   }
-  if (points.empty()) throw Error(fmt::format("{}: no lattice point of spacing {:.3g} m falls in the window (finer spacing?)", name, spacing));
-  if (static_cast<index_t>(points.size()) > max_points) throw Error(fmt::format("{}: {} points: too many (coarser spacing?)", name, points.size()));
+  if (points.empty())
+    throw Error(
+        fmt::format("{}: no lattice point of spacing {:.3g} m falls in the window (finer spacing?)", name, spacing));
+  if (static_cast<index_t>(points.size()) > max_points)
+    throw Error(fmt::format("{}: {} points: too many (coarser spacing?)", name, points.size()));
   PointCloud cloud;
   cloud.spacing = spacing;
   cloud.X.resize(3, static_cast<Eigen::Index>(points.size()));
   for (std::size_t p = 0; p < points.size(); ++p) cloud.X.col(static_cast<Eigen::Index>(p)) = points[p];
   cloud.volume = Eigen::VectorXd::Constant(cloud.X.cols(), spacing * spacing * spacing);
   cloud.surface.assign(points.size(), 0);
-  cloud.intensity = Eigen::Map<const Eigen::VectorXd>(intensities.data(), static_cast<Eigen::Index>(intensities.size()));
+  cloud.intensity =
+      Eigen::Map<const Eigen::VectorXd>(intensities.data(), static_cast<Eigen::Index>(intensities.size()));
   return cloud;
 }
 

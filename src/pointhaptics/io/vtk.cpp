@@ -10,17 +10,20 @@
 
 namespace pointhaptics {
 
-void write_vtp(const std::string& path, const Points& points, const std::vector<VtkArray>& arrays, const VtkTriangles& triangles) {
+void write_vtp(const std::string& path, const Points& points, const std::vector<VtkArray>& arrays,
+               const VtkTriangles& triangles) {
   const Eigen::Index n = points.cols();
   for (const VtkArray& a : arrays)
     if (a.components < 1 || static_cast<Eigen::Index>(a.values.size()) != a.components * n)
-      throw Error(fmt::format("{}: array \"{}\" has {} values for {} points of {} components", path, a.name, a.values.size(), n,
-                              a.components));
+      throw Error(fmt::format("{}: array \"{}\" has {} values for {} points of {} components", path, a.name,
+                              a.values.size(), n, a.components));
   write_text_file(path, "VTK frame", [&](TextOutput& out) {
-    out.print("<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\">\n<PolyData>\n");
+    out.print(
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\">\n<PolyData>\n");
     const bool surface = !triangles.empty();
-    out.print("<Piece NumberOfPoints=\"{}\" NumberOfVerts=\"{}\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"{}\">\n", n,
-              surface ? 0 : n, triangles.size());
+    out.print(
+        "<Piece NumberOfPoints=\"{}\" NumberOfVerts=\"{}\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"{}\">\n",
+        n, surface ? 0 : n, triangles.size());
     out.print("<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n");
     for (Eigen::Index i = 0; i < n; ++i) out.print("{:.9g} {:.9g} {:.9g}\n", points(0, i), points(1, i), points(2, i));
     out.print("</DataArray>\n</Points>\n");
@@ -39,8 +42,8 @@ void write_vtp(const std::string& path, const Points& points, const std::vector<
       out.print("</DataArray>\n</Verts>\n<PointData>\n");
     }
     for (const VtkArray& a : arrays) {
-      out.print("<DataArray type=\"{}\" Name=\"{}\" NumberOfComponents=\"{}\" format=\"ascii\">\n", a.integer ? "UInt8" : "Float64",
-                a.name, a.components);
+      out.print("<DataArray type=\"{}\" Name=\"{}\" NumberOfComponents=\"{}\" format=\"ascii\">\n",
+                a.integer ? "UInt8" : "Float64", a.name, a.components);
       for (Eigen::Index i = 0; i < n; ++i) {
         for (int c = 0; c < a.components; ++c) {
           const double v = a.values[static_cast<std::size_t>(i * a.components + c)];
@@ -73,7 +76,8 @@ std::string VtkSeries::add(double time, const Points& points, const std::vector<
   return path;
 }
 
-std::string VtkSeries::add_surface(const Points& vertices, const VtkTriangles& triangles, const std::vector<VtkArray>& arrays) {
+std::string VtkSeries::add_surface(const Points& vertices, const VtkTriangles& triangles,
+                                   const std::vector<VtkArray>& arrays) {
   if (frames_ == 0) throw Error(fmt::format("{}: a surface needs its frame first", pvd_));
   const std::string name = fmt::format("{}_surface_{:06d}.vtp", base_, frames_ - 1);
   const std::string path = (std::filesystem::path(folder_) / name).string();
@@ -85,8 +89,10 @@ std::string VtkSeries::add_surface(const Points& vertices, const VtkTriangles& t
 
 void VtkSeries::write_collection() const {
   write_text_file(pvd_, "VTK collection", [&](TextOutput& out) {
-    out.print("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"1.0\" byte_order=\"LittleEndian\">\n<Collection>\n");
-    for (const Entry& e : entries_) out.print("<DataSet timestep=\"{:.9g}\" group=\"\" part=\"{}\" file=\"{}\"/>\n", e.time, e.part, e.file);
+    out.print(
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"1.0\" byte_order=\"LittleEndian\">\n<Collection>\n");
+    for (const Entry& e : entries_)
+      out.print("<DataSet timestep=\"{:.9g}\" group=\"\" part=\"{}\" file=\"{}\"/>\n", e.time, e.part, e.file);
     out.print("</Collection>\n</VTKFile>\n");
   });
 }

@@ -22,7 +22,8 @@ using VtkTriangles = std::vector<std::array<index_t, 3>>;
 /// Write one frame: the points (3 x n, m) as vertices, or with `triangles` as the polygons of a surface, with
 /// the arrays as point data (ASCII, so that any VTK reader opens it). Throws Error naming the file if it
 /// cannot be written or an array has the wrong size.
-void write_vtp(const std::string& path, const Points& points, const std::vector<VtkArray>& arrays, const VtkTriangles& triangles = {});
+void write_vtp(const std::string& path, const Points& points, const std::vector<VtkArray>& arrays,
+               const VtkTriangles& triangles = {});
 
 /// A time series in a folder: frame files `<base>_<k>.vtp` and the collection `<base>.pvd` that ParaView
 /// opens as one animated data set (rewritten after every frame, so a run that stops early leaves a valid

@@ -43,7 +43,8 @@ constexpr int followed_count = 5;
 // bands it is absorbed by the nearest and follows the nearest few (ActiveSet::followed); beyond them, within
 // the widest support, it is a candidate for the frozen ring. Returns, per object point, the selected point
 // that absorbs it (-1: none).
-std::vector<index_t> absorb_and_find_ring(const Model& full, const Selection& selection, const LodParams& params, ActiveSet& a) {
+std::vector<index_t> absorb_and_find_ring(const Model& full, const Selection& selection, const LodParams& params,
+                                          ActiveSet& a) {
   const index_t n_full = full.n_points;
   const double reach = params.max_widening * full.h;
   const double candidate_radius = selection.outer_radius + reach;
@@ -58,11 +59,12 @@ std::vector<index_t> absorb_and_find_ring(const Model& full, const Selection& se
   tbb::parallel_for(tbb::blocked_range<index_t>(0, n_full, 1024), [&](const tbb::blocked_range<index_t>& range) {
     for (index_t j = range.begin(); j != range.end(); ++j) {
       if (a.active_of[j] >= 0) continue;
-      if (selection.band[j] < 0 && (full.X.col(j) - selection.centre).squaredNorm() > candidate_radius * candidate_radius)
+      if (selection.band[j] < 0 &&
+          (full.X.col(j) - selection.centre).squaredNorm() > candidate_radius * candidate_radius)
         continue;  // beyond the reach of any selected point
       const std::size_t at = m * static_cast<std::size_t>(j);
-      found[j] = static_cast<unsigned char>(
-          tree.index().knnSearch(full.X.col(j).data(), selection.band[j] >= 0 ? m : 1, &nearest_of[at], &nearest_d2[at]));
+      found[j] = static_cast<unsigned char>(tree.index().knnSearch(full.X.col(j).data(), selection.band[j] >= 0 ? m : 1,
+                                                                   &nearest_of[at], &nearest_d2[at]));
     }
   });
   std::vector<index_t> absorbed_by(n_full, -1);
@@ -150,7 +152,8 @@ std::vector<char> widen_supports(const Model& full, const LodParams& params, Act
     // needs more neighbours than it had in the full model (surface points have fewer)
     const std::size_t needed =
         static_cast<std::size_t>(std::min<index_t>(params.min_neighbours, full.neighbours.row_size(a.full_of[k]))) + 1;
-    const std::size_t got = active_tree.index().knnSearch(c.cloud.X.col(k).data(), needed, knn_index.data(), knn_d2.data());
+    const std::size_t got =
+        active_tree.index().knnSearch(c.cloud.X.col(k).data(), needed, knn_index.data(), knn_d2.data());
     if (got < needed || knn_d2[needed - 1] >= reach * reach) {
       c.support[k] = reach;
     } else {
@@ -216,7 +219,8 @@ void build_model_of(const Model& full, ActiveCloud& c, index_t n_passive, Active
   c.cloud.support = c.support;
   if (full.stiffness_scale.size()) {  // the object's stiffness map, for the active points
     c.cloud.stiffness_scale.resize(static_cast<Eigen::Index>(a.full_of.size()));
-    for (std::size_t k = 0; k < a.full_of.size(); ++k) c.cloud.stiffness_scale[static_cast<Eigen::Index>(k)] = full.stiffness_scale[a.full_of[k]];
+    for (std::size_t k = 0; k < a.full_of.size(); ++k)
+      c.cloud.stiffness_scale[static_cast<Eigen::Index>(k)] = full.stiffness_scale[a.full_of[k]];
   }
   KernelParams kernel = full.kernel;
   kernel.support = full.h;
@@ -244,7 +248,8 @@ void build_model_of(const Model& full, ActiveCloud& c, index_t n_passive, Active
 ActiveSet build_active_set(const Model& full, const Selection& selection, const LodParams& params) {
   const auto start = std::chrono::steady_clock::now();
   if (selection.selected.empty()) throw Error("lod: the selection is empty");
-  if (static_cast<index_t>(selection.band.size()) != full.n_points) throw Error("lod: the selection is for another model");
+  if (static_cast<index_t>(selection.band.size()) != full.n_points)
+    throw Error("lod: the selection is for another model");
   ActiveSet a;
   a.active_of.assign(full.n_points, -1);
   a.centre = selection.centre;
@@ -259,7 +264,8 @@ ActiveSet build_active_set(const Model& full, const Selection& selection, const 
   return a;
 }
 
-CutReport cut_as_object(ActiveSet& a, const Model& full, std::span<const std::array<Vec3, 3>> sheets, bool keep_hourglass_diagonal) {
+CutReport cut_as_object(ActiveSet& a, const Model& full, std::span<const std::array<Vec3, 3>> sheets,
+                        bool keep_hourglass_diagonal) {
   std::vector<index_t> pairs = pairs_crossing_triangles(a.model, a.model.X, sheets);
   if (!full.severed.empty()) {
     // the object's points that lost a pair; an active pair between two of them is looked up in the object
@@ -306,7 +312,8 @@ void ActiveSet::prolong_state(const State& active, State& full) const {
   for (index_t k = 0; k < static_cast<index_t>(full_of.size()); ++k) {
     full.u.col(full_of[k]) = active.u.col(k);
     full.velocity.col(full_of[k]) = active.velocity.col(k);
-    if (full.viscous.rows() && full.viscous.rows() == active.viscous.rows()) full.viscous.col(full_of[k]) = active.viscous.col(k);
+    if (full.viscous.rows() && full.viscous.rows() == active.viscous.rows())
+      full.viscous.col(full_of[k]) = active.viscous.col(k);
   }
   // first-order MLS from each followed point, blended: exact for any affine field. Each selected point's gradients
   // once (a point has several followers), into buffers kept for the next call

@@ -21,16 +21,16 @@ namespace pointhaptics {
 /// - a selected point whose neighbourhood became sparse gets a wider support (per-point h_i, up to
 ///   max_widening h), symmetric neighbourhoods by max(h_i, h_j); the dense core keeps h.
 struct ActiveSet {
-  Model model;                        ///< active points first (selected), then the frozen ring
-  index_t n_selected = 0;             ///< simulated points: the selected ones inside the bands
-  std::vector<index_t> full_of;       ///< active index -> full index
-  std::vector<index_t> active_of;     ///< full index -> active index, or -1
-  Csr followed;                       ///< full index -> the selected points an absorbed point follows (empty: none)
+  Model model;                          ///< active points first (selected), then the frozen ring
+  index_t n_selected = 0;               ///< simulated points: the selected ones inside the bands
+  std::vector<index_t> full_of;         ///< active index -> full index
+  std::vector<index_t> active_of;       ///< full index -> active index, or -1
+  Csr followed;                         ///< full index -> the selected points an absorbed point follows (empty: none)
   std::vector<double> followed_weight;  ///< per entry of followed: its weight (a row sums to 1)
   std::vector<Vec3> followed_offset;    ///< per entry of followed: X_j - X_followed
-  index_t widened = 0;                ///< selected points whose support was widened
-  Vec3 centre = Vec3::Zero();         ///< the selection's contact point (reference configuration, m)
-  double core_radius = 0;             ///< the selection's T_r2, m
+  index_t widened = 0;                  ///< selected points whose support was widened
+  Vec3 centre = Vec3::Zero();           ///< the selection's contact point (reference configuration, m)
+  double core_radius = 0;               ///< the selection's T_r2, m
   double build_ms = 0;
 
   /// The active state from the full one (selected and frozen points copy theirs).

@@ -17,7 +17,8 @@ ActiveSurface restrict_surface(const TriangleMesh& mesh, const SurfaceMap& map, 
     // a simulated one (left out, the absorbed points of a thinned band made holes in the part a few
     // millimetres from the contact, through which the probe's centre passed unseen)
     const auto first = map.weight.begin() + map.points.begin(v), last = map.weight.begin() + map.points.end(v);
-    const index_t nearest = map.points.index[static_cast<std::size_t>(std::max_element(first, last) - map.weight.begin())];
+    const index_t nearest =
+        map.points.index[static_cast<std::size_t>(std::max_element(first, last) - map.weight.begin())];
     if (active.active_of[static_cast<std::size_t>(nearest)] < 0 && active.followed.row_size(nearest) == 0) continue;
     kept[static_cast<std::size_t>(v)] = static_cast<index_t>(out.vertex_of.size());
     out.vertex_of.push_back(v);
@@ -25,7 +26,8 @@ ActiveSurface restrict_surface(const TriangleMesh& mesh, const SurfaceMap& map, 
   // carried by the active model's points: a vertex at the active region's rim may find too few of them
   // (a thinned band, one side of the frozen ring), and is left out as the others are
   Points Y(3, static_cast<Eigen::Index>(out.vertex_of.size()));
-  for (std::size_t k = 0; k < out.vertex_of.size(); ++k) Y.col(static_cast<Eigen::Index>(k)) = mesh.V.col(out.vertex_of[k]);
+  for (std::size_t k = 0; k < out.vertex_of.size(); ++k)
+    Y.col(static_cast<Eigen::Index>(k)) = mesh.V.col(out.vertex_of[k]);
   std::vector<char> uncarried;
   const SurfaceMap map_all = build_surface_map(active.model, Y, &uncarried);
   std::vector<index_t> vertex_of;
@@ -44,9 +46,11 @@ ActiveSurface restrict_surface(const TriangleMesh& mesh, const SurfaceMap& map, 
   }
   out.vertex_of = std::move(vertex_of);
   out.mesh.V.resize(3, static_cast<Eigen::Index>(out.vertex_of.size()));
-  for (std::size_t k = 0; k < out.vertex_of.size(); ++k) out.mesh.V.col(static_cast<Eigen::Index>(k)) = mesh.V.col(out.vertex_of[k]);
+  for (std::size_t k = 0; k < out.vertex_of.size(); ++k)
+    out.mesh.V.col(static_cast<Eigen::Index>(k)) = mesh.V.col(out.vertex_of[k]);
   for (const auto& t : mesh.F) {
-    const std::array<index_t, 3> r{kept[static_cast<std::size_t>(t[0])], kept[static_cast<std::size_t>(t[1])], kept[static_cast<std::size_t>(t[2])]};
+    const std::array<index_t, 3> r{kept[static_cast<std::size_t>(t[0])], kept[static_cast<std::size_t>(t[1])],
+                                   kept[static_cast<std::size_t>(t[2])]};
     if (r[0] >= 0 && r[1] >= 0 && r[2] >= 0) out.mesh.F.push_back(r);
   }
   return out;

@@ -25,7 +25,8 @@ void validate(const LodParams& p) {
     previous_distance = l.distance;
     previous_k = l.K;
   }
-  if (!(p.reselect > 0) || !std::isfinite(p.reselect)) throw Error(fmt::format("lod.reselect = {} must be > 0 (units of h)", p.reselect));
+  if (!(p.reselect > 0) || !std::isfinite(p.reselect))
+    throw Error(fmt::format("lod.reselect = {} must be > 0 (units of h)", p.reselect));
   if (!(p.reselect_interval >= 0) || !std::isfinite(p.reselect_interval))
     throw Error(fmt::format("lod.reselect_interval = {} must be >= 0 (s)", p.reselect_interval));
   if (p.min_neighbours < 1) throw Error(fmt::format("lod.min_neighbours = {} must be >= 1", p.min_neighbours));

@@ -18,14 +18,14 @@ double dither_threshold(const Vec3& X, double spacing);
 
 /// The band of each point: 0 within T_r1, 1 within T_r2, 1 + i within level i, -1 beyond the last level.
 struct Selection {
-  std::vector<index_t> selected;          ///< sorted point indices (fixed points always included)
-  std::vector<std::int8_t> band;          ///< per point
-  std::vector<index_t> band_count;        ///< points per band (0, 1, 1 + i), selected or not
-  std::vector<index_t> band_selected;     ///< selected points per band
-  double milliseconds = 0;                ///< time the selection took
-  Vec3 centre = Vec3::Zero();             ///< the contact point it was made around, m
-  double outer_radius = 0;                ///< of the last band, m (no point beyond it is in a band)
-  double core_radius = 0;                 ///< T_r2, m: every point within it is simulated or absorbed by one that is
+  std::vector<index_t> selected;       ///< sorted point indices (fixed points always included)
+  std::vector<std::int8_t> band;       ///< per point
+  std::vector<index_t> band_count;     ///< points per band (0, 1, 1 + i), selected or not
+  std::vector<index_t> band_selected;  ///< selected points per band
+  double milliseconds = 0;             ///< time the selection took
+  Vec3 centre = Vec3::Zero();          ///< the contact point it was made around, m
+  double outer_radius = 0;             ///< of the last band, m (no point beyond it is in a band)
+  double core_radius = 0;              ///< T_r2, m: every point within it is simulated or absorbed by one that is
 };
 
 /// Select the points around the contact point c (reference configuration, m) as the seed does: for each

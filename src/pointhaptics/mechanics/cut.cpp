@@ -25,7 +25,6 @@ index_t row_of(const Csr& nbr, index_t e) {
   return static_cast<index_t>(std::upper_bound(nbr.offset.begin(), nbr.offset.end(), e) - nbr.offset.begin()) - 1;
 }
 
-
 }  // namespace
 
 std::vector<index_t> pairs_crossing(const Model& model, const Points& x, const BladeSweep& sweep) {
@@ -35,7 +34,8 @@ std::vector<index_t> pairs_crossing(const Model& model, const Points& x, const B
   // which only those near the edge can cut)
   const double reach = 2.0 * (model.support.size() ? model.support.maxCoeff() : model.h);
   const bool near_edge = sweep.edge_reach != std::numeric_limits<double>::infinity();
-  const std::array<Vec3, 4> corners{near_edge ? sweep.a1 : sweep.a0, near_edge ? sweep.b1 : sweep.b0, sweep.a1, sweep.b1};
+  const std::array<Vec3, 4> corners{near_edge ? sweep.a1 : sweep.a0, near_edge ? sweep.b1 : sweep.b0, sweep.a1,
+                                    sweep.b1};
   Vec3 lo = corners[0], hi = corners[0];
   for (const Vec3& c : corners) {
     lo = lo.cwiseMin(c);
@@ -43,9 +43,12 @@ std::vector<index_t> pairs_crossing(const Model& model, const Points& x, const B
   }
   lo.array() -= reach + (near_edge ? sweep.edge_reach : 0.0);
   hi.array() += reach + (near_edge ? sweep.edge_reach : 0.0);
-  auto inside = [&](index_t i) { return (x.col(i).array() >= lo.array()).all() && (x.col(i).array() <= hi.array()).all(); };
+  auto inside = [&](index_t i) {
+    return (x.col(i).array() >= lo.array()).all() && (x.col(i).array() <= hi.array()).all();
+  };
   const Csr& nbr = model.neighbours;
-  const std::array<CrossingTriangle, 2> swept{CrossingTriangle(sweep.a0, sweep.b0, sweep.b1), CrossingTriangle(sweep.a0, sweep.b1, sweep.a1)};
+  const std::array<CrossingTriangle, 2> swept{CrossingTriangle(sweep.a0, sweep.b0, sweep.b1),
+                                              CrossingTriangle(sweep.a0, sweep.b1, sweep.a1)};
   std::vector<index_t> crossing;
   for (index_t i = 0; i < model.n_points; ++i) {
     if (!inside(i)) continue;
@@ -65,7 +68,8 @@ std::vector<index_t> pairs_crossing(const Model& model, const Points& x, const B
   return crossing;
 }
 
-std::vector<index_t> pairs_crossing_triangles(const Model& model, const Points& x, std::span<const std::array<Vec3, 3>> triangles) {
+std::vector<index_t> pairs_crossing_triangles(const Model& model, const Points& x,
+                                              std::span<const std::array<Vec3, 3>> triangles) {
   // a crossing pair has both ends within its length of the triangle: in the reference configuration no pair
   // is longer than the largest support
   const double reach = model.support.size() ? model.support.maxCoeff() : model.h;
@@ -73,7 +77,8 @@ std::vector<index_t> pairs_crossing_triangles(const Model& model, const Points& 
   std::vector<index_t> crossing;
   for (const std::array<Vec3, 3>& t : triangles) {
     const CrossingTriangle sheet(t[0], t[1], t[2]);
-    const Vec3 lo = t[0].cwiseMin(t[1]).cwiseMin(t[2]).array() - reach, hi = t[0].cwiseMax(t[1]).cwiseMax(t[2]).array() + reach;
+    const Vec3 lo = t[0].cwiseMin(t[1]).cwiseMin(t[2]).array() - reach,
+               hi = t[0].cwiseMax(t[1]).cwiseMax(t[2]).array() + reach;
     for (index_t i = 0; i < model.n_points; ++i) {
       if (!((x.col(i).array() >= lo.array()).all() && (x.col(i).array() <= hi.array()).all())) continue;
       const Vec3 p = x.col(i);
@@ -97,7 +102,8 @@ CutReport sever_pairs(Model& model, const std::vector<index_t>& pairs, bool keep
   // the pairs to sever (both directions) and the stencils that lose them
   std::vector<index_t> newly, stencils;
   for (const index_t e : pairs) {
-    if (e < 0 || e >= model.n_pairs()) throw Error(fmt::format("cut: pair {} does not exist (the model has {})", e, model.n_pairs()));
+    if (e < 0 || e >= model.n_pairs())
+      throw Error(fmt::format("cut: pair {} does not exist (the model has {})", e, model.n_pairs()));
     if (model.severed[e]) continue;
     const index_t i = row_of(nbr, e), j = nbr.index[e];
     report.severed.push_back({std::min(i, j), std::max(i, j)});
@@ -154,14 +160,18 @@ CutReport sever_pairs(Model& model, const std::vector<index_t>& pairs, bool keep
   std::vector<std::pair<index_t, double>> weight_sum;
   for (const auto& [i, e] : changed) weight_sum.emplace_back(i, 0.0);
   std::sort(weight_sum.begin(), weight_sum.end());
-  weight_sum.erase(std::unique(weight_sum.begin(), weight_sum.end(), [](const auto& a, const auto& b) { return a.first == b.first; }),
+  weight_sum.erase(std::unique(weight_sum.begin(), weight_sum.end(),
+                               [](const auto& a, const auto& b) { return a.first == b.first; }),
                    weight_sum.end());
   for (auto& [i, sum] : weight_sum)
     for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) sum += pair_weight(model, i, e);
   auto sum_of = [&](index_t i) {
-    return std::lower_bound(weight_sum.begin(), weight_sum.end(), i, [](const auto& a, index_t b) { return a.first < b; })->second;
+    return std::lower_bound(weight_sum.begin(), weight_sum.end(), i,
+                            [](const auto& a, index_t b) { return a.first < b; })
+        ->second;
   };
-  for (const auto& [i, e] : changed) model.hg_coef[e] = hourglass_coefficient(model, i, e, sum_of(i), sum_of(nbr.index[e]));
+  for (const auto& [i, e] : changed)
+    model.hg_coef[e] = hourglass_coefficient(model, i, e, sum_of(i), sum_of(nbr.index[e]));
   if (diagonal) add_hourglass_diagonal(model, changed, 1.0, model.hg_diagonal);
   return report;
 }

@@ -35,7 +35,8 @@ std::vector<index_t> pairs_crossing(const Model& model, const Points& x, const B
 /// `triangles` (each as three corners): with x = model.X and a cut's sheets in the reference configuration
 /// (cut_surface.hpp), the pairs those cuts part, in any model over the same object (levels of detail carry a
 /// cut of the active set to the object, and the object's cuts to the next active set, by them).
-std::vector<index_t> pairs_crossing_triangles(const Model& model, const Points& x, std::span<const std::array<Vec3, 3>> triangles);
+std::vector<index_t> pairs_crossing_triangles(const Model& model, const Points& x,
+                                              std::span<const std::array<Vec3, 3>> triangles);
 
 /// The area a number of severed pairs stands for, m^2: in a body of uniform point density rho = 1 / spacing^3
 /// and support h, a plane of area A is crossed by rho^2 A pi h^4 / 4 pairs (a point at distance z from it has
@@ -45,13 +46,12 @@ double cut_area(const Model& model, index_t severed_pairs);
 
 /// What one cut changed.
 struct CutReport {
-  index_t severed_pairs = 0;      ///< pairs newly severed (a pair and its reverse count once)
-  index_t refitted_stencils = 0;  ///< stencils that lost pairs and were refitted
-  index_t regularised = 0;        ///< of those, the ones left one-sided or too thin, hence regularised
-  std::vector<index_t> cut_points;  ///< the ends of the newly severed pairs, each once
+  index_t severed_pairs = 0;                    ///< pairs newly severed (a pair and its reverse count once)
+  index_t refitted_stencils = 0;                ///< stencils that lost pairs and were refitted
+  index_t regularised = 0;                      ///< of those, the ones left one-sided or too thin, hence regularised
+  std::vector<index_t> cut_points;              ///< the ends of the newly severed pairs, each once
   std::vector<std::array<index_t, 2>> severed;  ///< the newly severed pairs (i, j), i < j
 };
-
 
 /// Sever the pairs `pairs` (each given in either direction; severed ones are skipped) and refit what depends
 /// on them: the stencils that lost pairs (M_i, d_ij, d_ii), the hourglass coefficients of their pairs and of

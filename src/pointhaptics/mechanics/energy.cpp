@@ -20,9 +20,11 @@ EnergyTerms strain_energy(const Model& model, const Points& u, std::vector<Mat3>
     std::vector<Mat3> own;
     std::vector<Mat3>& gradients = scratch ? *scratch : own;
     gradients.resize(static_cast<std::size_t>(model.n_points));
-    tbb::parallel_for(tbb::blocked_range<index_t>(0, model.n_points, 512), [&](const tbb::blocked_range<index_t>& range) {
-      for (index_t i = range.begin(); i != range.end(); ++i) gradients[i] = displacement_gradient(model, u, i);  // seed Eq. 10
-    });
+    tbb::parallel_for(tbb::blocked_range<index_t>(0, model.n_points, 512),
+                      [&](const tbb::blocked_range<index_t>& range) {
+                        for (index_t i = range.begin(); i != range.end(); ++i)
+                          gradients[i] = displacement_gradient(model, u, i);  // seed Eq. 10
+                      });
     // deterministic: the same split at every run, so the same sum (line searches compare energies)
     return tbb::parallel_deterministic_reduce(
         tbb::blocked_range<index_t>(0, model.n_points, 512), EnergyTerms{},

@@ -11,7 +11,8 @@ struct EnergyTerms {
   double elastic = 0;    ///< sum_i v_i 0.5 S_i : E_i (St. Venant-Kirchhoff), J
   double volume = 0;     ///< sum_i 0.5 k_v v_i (det F_i - 1)^2, J
   double hourglass = 0;  ///< zero-energy-mode penalty (physics.md), J
-  double viscous = 0;    ///< within a viscoelastic step: the overstress's term -sum_i v_i H_i : E_i, J (not stored energy)
+  double viscous =
+      0;  ///< within a viscoelastic step: the overstress's term -sum_i v_i H_i : E_i, J (not stored energy)
   double total() const { return elastic + volume + hourglass + viscous; }
 };
 

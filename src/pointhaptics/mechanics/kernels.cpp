@@ -43,8 +43,7 @@ double kernel_derivative(KernelType type, double r, double h) {
       const double a = h - r;
       return -15.0 / (pi * std::pow(h, 6)) * 3.0 * a * a;
     }
-    case KernelType::VISCOSITY:
-      return 15.0 / (2.0 * pi * h * h * h) * (-1.5 * q * q + 2.0 * q - 0.5 / (q * q)) / h;
+    case KernelType::VISCOSITY: return 15.0 / (2.0 * pi * h * h * h) * (-1.5 * q * q + 2.0 * q - 0.5 / (q * q)) / h;
     case KernelType::QUADRATIC: {
       const double c = 4.0 / (pi * h * h * h);
       return q < 0.5 ? c * (-4.0 * q) / h : c * (-4.0) * (1.0 - q) / h;

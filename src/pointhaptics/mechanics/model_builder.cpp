@@ -23,7 +23,8 @@ void validate_material(const MaterialParams& m) {
   if (!(m.young > 0) || !std::isfinite(m.young)) bad("young", m.young, "must be positive and finite (Pa)");
   if (!(m.poisson > -1 && m.poisson < 0.5)) bad("poisson", m.poisson, "must lie in (-1, 0.5)");
   if (!(m.density > 0) || !std::isfinite(m.density)) bad("density", m.density, "must be positive and finite (kg/m^3)");
-  if (!(m.volume_stiffness >= 0) || !std::isfinite(m.volume_stiffness)) bad("volume_stiffness", m.volume_stiffness, "must be >= 0 and finite (Pa)");
+  if (!(m.volume_stiffness >= 0) || !std::isfinite(m.volume_stiffness))
+    bad("volume_stiffness", m.volume_stiffness, "must be >= 0 and finite (Pa)");
   if (!(m.damping >= 0) || !std::isfinite(m.damping)) bad("damping", m.damping, "must be >= 0 and finite (1/s)");
   if (!(m.hourglass >= 0) || !std::isfinite(m.hourglass)) bad("hourglass", m.hourglass, "must be >= 0 and finite");
   if (!m.prony.empty() && !valid_prony(m.prony)) throw Error(fmt::format("material: prony: {}", prony_rule));
@@ -50,14 +51,17 @@ Model build_model(const PointCloud& cloud, const MaterialParams& material, const
   const index_t n = cloud.size();
   if (n == 0) throw Error("model: the object has no points");
   if (!material_of.empty()) {
-    if (static_cast<index_t>(material_of.size()) != n) throw Error("model: per-point materials must give one per point");
+    if (static_cast<index_t>(material_of.size()) != n)
+      throw Error("model: per-point materials must give one per point");
     if (point_materials.empty() || point_materials.size() > max_point_materials)
       throw Error(fmt::format("model: {} materials in one object; at most {} (the object's and its regions')",
                               point_materials.size(), max_point_materials));
     for (const MaterialParams& p : point_materials) {
       validate_material(p);
-      if (p.volume_stiffness != material.volume_stiffness || p.hourglass != material.hourglass || p.volume != material.volume)
-        throw Error("model: regions may change young, poisson, density and model; volume_stiffness, hourglass and volume are the object's");
+      if (p.volume_stiffness != material.volume_stiffness || p.hourglass != material.hourglass ||
+          p.volume != material.volume)
+        throw Error(
+            "model: regions may change young, poisson, density and model; volume_stiffness, hourglass and volume are the object's");
     }
     for (const std::uint8_t k : material_of)
       if (k >= point_materials.size()) throw Error(fmt::format("model: per-point material {} does not exist", int{k}));
@@ -148,7 +152,8 @@ Model build_model(const PointCloud& cloud, const MaterialParams& material, const
 
   // the weight of each stencil's stress: its volume, times its stiffness scale
   if (cloud.stiffness_scale.size()) {
-    if (cloud.stiffness_scale.size() != n || !(cloud.stiffness_scale.array() > 0).all() || !cloud.stiffness_scale.allFinite())
+    if (cloud.stiffness_scale.size() != n || !(cloud.stiffness_scale.array() > 0).all() ||
+        !cloud.stiffness_scale.allFinite())
       throw Error("model: per-point stiffness scales must be positive and finite, one per point");
     model.stiffness_scale = cloud.stiffness_scale;
     model.stiffness_volume = model.volume.cwiseProduct(model.stiffness_scale);
@@ -196,9 +201,10 @@ void check_every_free_point_has_neighbours(const Model& model, const std::string
       if (alone++ == 0) first = i;
     }
   if (alone > 0)
-    throw Error(fmt::format("{}: {} of {} points (the first: point {} at ({:.4g}, {:.4g}, {:.4g}) m) have no neighbour within the "
-                            "support h = {:.4g} m: the support is too small for the spacing, or the points too far apart",
-                            name, alone, model.n_points, first, model.X(0, first), model.X(1, first), model.X(2, first), model.h));
+    throw Error(fmt::format(
+        "{}: {} of {} points (the first: point {} at ({:.4g}, {:.4g}, {:.4g}) m) have no neighbour within the "
+        "support h = {:.4g} m: the support is too small for the spacing, or the points too far apart",
+        name, alone, model.n_points, first, model.X(0, first), model.X(1, first), model.X(2, first), model.h));
 }
 
 }  // namespace pointhaptics

@@ -9,7 +9,6 @@
 
 namespace pointhaptics {
 
-
 /// Build the model: h, neighbours, volumes and masses, M_i (seed Eq. 11) with its conditioning check,
 /// d_ij and d_ii (Eq. 10), and the hourglass coefficients. All points are free and unloaded; the
 /// scene builder adds boundary conditions and loads before the model is used.

@@ -83,7 +83,9 @@ ModelPatch model_patch(const Model& model, const std::vector<index_t>& free) {
   m.stiffness_volume = rows(model.stiffness_volume);
   m.hg_diagonal = rows(model.hg_diagonal);
   m.fixed.assign(static_cast<std::size_t>(n), 1);
-  for (index_t k = 0; k < patch.n_free; ++k) m.fixed[static_cast<std::size_t>(k)] = model.fixed[static_cast<std::size_t>(patch.full_of[static_cast<std::size_t>(k)])];
+  for (index_t k = 0; k < patch.n_free; ++k)
+    m.fixed[static_cast<std::size_t>(k)] =
+        model.fixed[static_cast<std::size_t>(patch.full_of[static_cast<std::size_t>(k)])];
   if (!model.material_of.empty())
     for (const index_t i : patch.full_of) m.material_of.push_back(model.material_of[static_cast<std::size_t>(i)]);
   // the pairs within the patch, each row sorted by the patch's index: the free points, the inner ring and the
@@ -93,12 +95,14 @@ ModelPatch model_patch(const Model& model, const std::vector<index_t>& free) {
   auto part_of = [&](index_t k) { return k < patch.n_free ? 0 : k < inner_end ? 1 : 2; };
   std::vector<index_t> pair_of;  // patch pair -> the model's
   m.neighbours.offset.assign(1, 0);
-  m.neighbours.index.reserve(static_cast<std::size_t>(n) * static_cast<std::size_t>(model.neighbours.row_size(patch.full_of[0]) + 1));
+  m.neighbours.index.reserve(static_cast<std::size_t>(n) *
+                             static_cast<std::size_t>(model.neighbours.row_size(patch.full_of[0]) + 1));
   std::array<std::vector<std::array<index_t, 2>>, 3> parts;  // (patch neighbour, model pair) per part of a row
   for (index_t k = 0; k < n; ++k) {
     const index_t i = patch.full_of[static_cast<std::size_t>(k)];
     for (index_t e = model.neighbours.begin(i); e < model.neighbours.end(i); ++e)
-      if (const index_t l = patch_of[static_cast<std::size_t>(model.neighbours.index[e])]; l >= 0) parts[part_of(l)].push_back({l, e});
+      if (const index_t l = patch_of[static_cast<std::size_t>(model.neighbours.index[e])]; l >= 0)
+        parts[part_of(l)].push_back({l, e});
     for (std::vector<std::array<index_t, 2>>& part : parts) {
       for (const auto& [l, e] : part) {
         m.neighbours.index.push_back(l);

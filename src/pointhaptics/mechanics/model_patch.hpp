@@ -9,10 +9,10 @@
 namespace pointhaptics {
 
 struct ModelPatch {
-  Model model;                  ///< the patch: `free` points first, then the rings around them (held; the
-                                ///< outer one passive, Model::n_passive)
-  std::vector<index_t> full_of; ///< patch index -> the model's
-  index_t n_free = 0;           ///< the first n_free points: the free ones
+  Model model;                   ///< the patch: `free` points first, then the rings around them (held; the
+                                 ///< outer one passive, Model::n_passive)
+  std::vector<index_t> full_of;  ///< patch index -> the model's
+  index_t n_free = 0;            ///< the first n_free points: the free ones
 };
 
 /// The points `free` (each once; the model's held ones stay held) and, held, the two rings of neighbours around

@@ -25,8 +25,8 @@ struct VertexWeights {
 };
 
 /// The MLS weights of vertex y with support h, widened until the moment matrix is well conditioned.
-VertexWeights vertex_weights(const Model& model, const KdTree& tree, const Vec3& y, double h, index_t vertex, bool skip_uncarried,
-                             const VertexSees& sees) {
+VertexWeights vertex_weights(const Model& model, const KdTree& tree, const Vec3& y, double h, index_t vertex,
+                             bool skip_uncarried, const VertexSees& sees) {
   std::vector<std::pair<index_t, double>> found;
   nanoflann::SearchParams params;
   params.sorted = false;
@@ -64,16 +64,19 @@ VertexWeights vertex_weights(const Model& model, const KdTree& tree, const Vec3&
     return out;
   }
   if (!skip_uncarried)
-    throw Error(fmt::format("surface vertex {} at ({:.4g}, {:.4g}, {:.4g}) m: too few points around it to carry it "
-                            "(none or only a flat set within {:.3g} m)",
-                            vertex, y.x(), y.y(), y.z(), h / 1.5));
+    throw Error(
+        fmt::format("surface vertex {} at ({:.4g}, {:.4g}, {:.4g}) m: too few points around it to carry it "
+                    "(none or only a flat set within {:.3g} m)",
+                    vertex, y.x(), y.y(), y.z(), h / 1.5));
   return VertexWeights{{}, {}, true, false};
 }
 
 }  // namespace
 
-SurfaceMap build_surface_map(const Model& model, const Points& Y, std::vector<char>* uncarried, const VertexSees& sees) {
-  if (model.n_points < 4) throw Error(fmt::format("surface: {} points cannot carry a surface (at least 4)", model.n_points));
+SurfaceMap build_surface_map(const Model& model, const Points& Y, std::vector<char>* uncarried,
+                             const VertexSees& sees) {
+  if (model.n_points < 4)
+    throw Error(fmt::format("surface: {} points cannot carry a surface (at least 4)", model.n_points));
   if (!Y.allFinite()) throw Error("surface: a vertex is not finite");
   const index_t m = static_cast<index_t>(Y.cols());
   const KdTree tree(model.X);
@@ -104,10 +107,12 @@ SurfaceMap build_surface_map(const Model& model, const Points& Y, std::vector<ch
   return map;
 }
 
-void interpolate_at_surface(const SurfaceMap& map, const Eigen::Ref<const Eigen::MatrixXd>& field, Eigen::MatrixXd& out) {
+void interpolate_at_surface(const SurfaceMap& map, const Eigen::Ref<const Eigen::MatrixXd>& field,
+                            Eigen::MatrixXd& out) {
   out.setZero(field.rows(), map.n_vertices());
   for (index_t v = 0; v < map.n_vertices(); ++v)
-    for (index_t e = map.points.begin(v); e < map.points.end(v); ++e) out.col(v) += map.weight[e] * field.col(map.points.index[e]);
+    for (index_t e = map.points.begin(v); e < map.points.end(v); ++e)
+      out.col(v) += map.weight[e] * field.col(map.points.index[e]);
 }
 
 // The carry runs for every frame drawn or written (and, with contact on the surface, every step), so it is
@@ -145,7 +150,8 @@ SurfaceMap without_negative_weights(SurfaceMap map) {
     double sum = 0;
     for (index_t e = map.points.begin(v); e < map.points.end(v); ++e) sum += std::max(map.weight[e], 0.0);
     // a carried vertex's weights sum to 1, so some are positive; an empty row stays empty
-    for (index_t e = map.points.begin(v); e < map.points.end(v); ++e) map.weight[e] = sum > 0 ? std::max(map.weight[e], 0.0) / sum : 0.0;
+    for (index_t e = map.points.begin(v); e < map.points.end(v); ++e)
+      map.weight[e] = sum > 0 ? std::max(map.weight[e], 0.0) / sum : 0.0;
   }
   return map;
 }

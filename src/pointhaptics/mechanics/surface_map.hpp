@@ -14,7 +14,7 @@ namespace pointhaptics {
 struct SurfaceMap {
   Csr points;                  ///< row v: the points that carry vertex v
   std::vector<double> weight;  ///< phi_j(Y_v), by the entries of `points`; each row sums to 1
-  index_t widened = 0;         ///< vertices whose neighbourhood was widened (too few points, or too flat, within the support)
+  index_t widened = 0;  ///< vertices whose neighbourhood was widened (too few points, or too flat, within the support)
 
   index_t n_vertices() const { return points.n_rows(); }
 };
@@ -29,7 +29,8 @@ struct SurfaceMap {
 /// With `sees`, a vertex is carried only by the points it sees: sees(v, j) false leaves point j out of vertex
 /// v's neighbourhood (a cut object's vertex, carried by the points on its side of the cuts: cut_surface.hpp).
 using VertexSees = std::function<bool(index_t vertex, index_t point)>;
-SurfaceMap build_surface_map(const Model& model, const Points& Y, std::vector<char>* uncarried = nullptr, const VertexSees& sees = {});
+SurfaceMap build_surface_map(const Model& model, const Points& Y, std::vector<char>* uncarried = nullptr,
+                             const VertexSees& sees = {});
 
 /// The map with each vertex's negative weights left out and the rest scaled to sum to 1 (a vertex without
 /// points keeps its empty row): a partition of unity of non-negative weights, so a force on a vertex pushes
@@ -41,7 +42,8 @@ SurfaceMap without_negative_weights(SurfaceMap map);
 
 /// W f: a field of the points (k x n, e.g. k = 1 von Mises stress, 9 a stress tensor) at the vertices (k x m),
 /// into `out` (resized once).
-void interpolate_at_surface(const SurfaceMap& map, const Eigen::Ref<const Eigen::MatrixXd>& field, Eigen::MatrixXd& out);
+void interpolate_at_surface(const SurfaceMap& map, const Eigen::Ref<const Eigen::MatrixXd>& field,
+                            Eigen::MatrixXd& out);
 
 /// y = Y + W u (3 x m), into `y` (resized once; no allocation after).
 void carry_surface(const SurfaceMap& map, const Points& Y, const Points& u, Points& y);

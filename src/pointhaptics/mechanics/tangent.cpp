@@ -17,8 +17,9 @@ void Tangent::linearise(const Model& model, const Points& u, TangentMode mode, W
     linearisation_.resize(doubles_of<L> * static_cast<std::size_t>(model.n_points));
     double* base = linearisation_.data();
     for_each_point(model.n_points, ws, [&](index_t i) {
-      const L at = energy.linearise(i, displacement_gradient(model, u, i), mode == TangentMode::PROJECTED);  // seed Eq. 10
-      std::memcpy(static_cast<void*>(base + doubles_of<L> * static_cast<std::size_t>(i)), &at, sizeof(L));
+      const L at =
+          energy.linearise(i, displacement_gradient(model, u, i), mode == TangentMode::PROJECTED);  // seed Eq. 10
+      detail::store_linearisation(base, i, at);
     });
   });
 }

@@ -26,7 +26,8 @@ class Tangent {
   /// linearise; allocates only the first time for a model size; not for two threads at once). The
   /// hourglass part is the model's precomputed hg_diagonal, which also counts the pairs of passive points'
   /// stencils: with passive points those blocks are approximate (fine for a preconditioner).
-  void diagonal_blocks(const Model& model, Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks, Workspace* ws = nullptr) const;
+  void diagonal_blocks(const Model& model, Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks,
+                       Workspace* ws = nullptr) const;
   /// The moduli v_i dP_i/dG_i of every stencil i at the last linearise() (9 x 9 on column-major vec(dG),
   /// 81 doubles per point, column-major; the added terms included), for the assembled tangent
   /// (tangent_matrix.hpp). Parallel as linearise(); allocates only the first time for a model size.

@@ -33,7 +33,8 @@ void Tangent::moduli(const Model& model, std::vector<double>& out, Workspace* ws
   });
 }
 
-void Tangent::diagonal_blocks(const Model& model, Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks, Workspace* ws) const {
+void Tangent::diagonal_blocks(const Model& model, Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks,
+                              Workspace* ws) const {
   const Csr& nbr = model.neighbours;
   const index_t n = model.n_points, stencil_end = model.stencil_end();
   blocks.resize(9, n);
@@ -54,7 +55,8 @@ void Tangent::diagonal_blocks(const Model& model, Eigen::Matrix<double, 9, Eigen
         const index_t i = nbr.index[e];
         if (i >= stencil_end) continue;
         // d_ij of the pair (i, j) in i's row
-        K += model.stiffness_volume[i] * energy.stiffness_block(i, load_linearisation<L>(base, i), model.d.col(model.reverse_pair[e]));
+        K += model.stiffness_volume[i] *
+             energy.stiffness_block(i, load_linearisation<L>(base, i), model.d.col(model.reverse_pair[e]));
       }
       blocks.col(j) = K.reshaped();
     });

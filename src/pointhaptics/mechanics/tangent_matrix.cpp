@@ -34,10 +34,8 @@ void for_each_row_range(index_t n, int chunks, Workspace* ws, Fn&& fn) {
   const auto range = [&](int c) {
     fn(c, static_cast<index_t>(std::int64_t{n} * c / chunks), static_cast<index_t>(std::int64_t{n} * (c + 1) / chunks));
   };
-  if (ws)
-    ws->for_each_chunk([&](int c) { range(c); });
-  else
-    tbb::parallel_for(0, chunks, range);
+  if (ws) ws->for_each_chunk([&](int c) { range(c); });
+  else tbb::parallel_for(0, chunks, range);
 }
 
 /// Row j of the hourglass bound H_a = sum_i sum_{k in N(i)} k_ik w w^T (x) I, w_m = [m = k] - [m = i] - d_im . X_ik
@@ -79,10 +77,13 @@ void build_tangent_pattern(const Model& model, TangentMatrix& K) {
       if (!seen[k]) seen[k] = 1, row.push_back(k);
     };
     add(j);  // a held point's row keeps its diagonal block (it has no stencil of its own when passive)
-    for_each_stencil_containing(model, j, [&](index_t i, const Vec3&) { for_each_stencil_point(model, i, [&](index_t k, const Vec3&) { add(k); }); });
+    for_each_stencil_containing(model, j, [&](index_t i, const Vec3&) {
+      for_each_stencil_point(model, i, [&](index_t k, const Vec3&) { add(k); });
+    });
     std::sort(row.begin(), row.end());
     for (index_t k : row) seen[k] = 0;
-    K.diagonal[j] = pattern.n_entries() + static_cast<index_t>(std::lower_bound(row.begin(), row.end(), j) - row.begin());
+    K.diagonal[j] =
+        pattern.n_entries() + static_cast<index_t>(std::lower_bound(row.begin(), row.end(), j) - row.begin());
     pattern.index.insert(pattern.index.end(), row.begin(), row.end());
     pattern.offset.push_back(pattern.n_entries());
   }
@@ -111,7 +112,8 @@ void assemble_tangent(const Model& model, const Tangent& tangent, TangentMatrix&
       for_each_stencil_containing(model, j, [&](index_t i, const Vec3& d_ij) {
         const Eigen::Map<const Eigen::Matrix<double, 9, 9>> C(moduli.data() + 81 * static_cast<std::size_t>(i));
         // A(a, b + 3e) = sum_c d_ij(c) C(a + 3c, b + 3e): j's force row of the stencil's stress derivative
-        const Eigen::Matrix<double, 3, 9> A = d_ij[0] * C.topRows<3>() + d_ij[1] * C.middleRows<3>(3) + d_ij[2] * C.bottomRows<3>();
+        const Eigen::Matrix<double, 3, 9> A =
+            d_ij[0] * C.topRows<3>() + d_ij[1] * C.middleRows<3>(3) + d_ij[2] * C.bottomRows<3>();
         for_each_stencil_point(model, i, [&](index_t k, const Vec3& d_ik) {
           Eigen::Map<Mat3> block(row + 9 * static_cast<std::size_t>(slot[k]));
           block += d_ik[0] * A.leftCols<3>() + d_ik[1] * A.middleCols<3>(3) + d_ik[2] * A.rightCols<3>();
@@ -130,7 +132,9 @@ index_t find_block(const TangentMatrix& K, index_t j, index_t k) {
   const auto it = std::lower_bound(first, last, k);
   return it != last && *it == k ? static_cast<index_t>(it - K.pattern.index.begin()) : -1;
 }
-Eigen::Map<Mat3> block(TangentMatrix& K, index_t e) { return Eigen::Map<Mat3>(K.values.data() + 9 * static_cast<std::size_t>(e)); }
+Eigen::Map<Mat3> block(TangentMatrix& K, index_t e) {
+  return Eigen::Map<Mat3>(K.values.data() + 9 * static_cast<std::size_t>(e));
+}
 }  // namespace
 
 void add_coupling(TangentMatrix& K, index_t j, index_t k, double a, const Mat3& S) {

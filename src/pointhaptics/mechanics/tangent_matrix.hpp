@@ -11,11 +11,11 @@ namespace pointhaptics {
 struct TangentMatrix {
   /// row j: the points k with a block K_jk (sharing a stencil with j), sorted, j itself included
   Csr pattern;
-  std::vector<index_t> diagonal;  ///< the entry of the block K_jj in row j  (n)
-  std::vector<double> values;     ///< K_jk per entry, 9 doubles, column-major 3x3, N/m
+  std::vector<index_t> diagonal;            ///< the entry of the block K_jj in row j  (n)
+  std::vector<double> values;               ///< K_jk per entry, 9 doubles, column-major 3x3, N/m
   std::vector<std::vector<index_t>> slots;  ///< assembly scratch: a row's entry per point, per thread (-1: none)
-  std::vector<double> moduli;                ///< assembly scratch: the stencils' moduli (Tangent::moduli)
-  index_t model_pairs = -1;                  ///< the neighbour pairs of the model the pattern was built for
+  std::vector<double> moduli;               ///< assembly scratch: the stencils' moduli (Tangent::moduli)
+  index_t model_pairs = -1;                 ///< the neighbour pairs of the model the pattern was built for
   index_t n_blocks() const { return pattern.n_entries(); }
 };
 

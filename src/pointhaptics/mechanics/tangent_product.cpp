@@ -19,9 +19,10 @@ void Tangent::apply(const Model& model, const Points& du, Workspace& ws, Points&
   with_material(model, viscous_step(ws), [&](const auto& energy) {
     using L = typename std::decay_t<decltype(energy)>::Linearisation;
     // the force loop with the stress map linearised gives -K du; the hourglass part is linear already
-    detail::stencil_sum(model, du, ws, out, -1.0, [energy, volume, base, projected](index_t i, const Mat3& dG) PH_ALWAYS_INLINE -> Mat3 {
-      return volume[i] * energy.stress_derivative(i, load_linearisation<L>(base, i), dG, projected);
-    });
+    detail::stencil_sum(model, du, ws, out, -1.0,
+                        [energy, volume, base, projected](index_t i, const Mat3& dG) PH_ALWAYS_INLINE -> Mat3 {
+                          return volume[i] * energy.stress_derivative(i, load_linearisation<L>(base, i), dG, projected);
+                        });
   });
 }
 

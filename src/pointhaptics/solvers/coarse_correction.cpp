@@ -14,14 +14,15 @@ namespace {
 struct Cells {
   Vec3 low;
   double size;
-  explicit Cells(const Model& fine) : low(fine.X.rowwise().minCoeff()), size(CoarseCorrection::coarsening(fine) * fine.spacing) {}
+  explicit Cells(const Model& fine)
+      : low(fine.X.rowwise().minCoeff()), size(CoarseCorrection::coarsening(fine) * fine.spacing) {}
   // the cell of x, shifted by an eighth of a cell so that lattice points on a cell's low faces fall inside it
   // despite sampling round-off; t is x in cells
   std::uint64_t key(const Vec3& x, Vec3* t_out = nullptr) const {
     const Vec3 t = (x - low) / size + Vec3::Constant(0.125);
     if (t_out) *t_out = t;
-    return (static_cast<std::uint64_t>(std::floor(t.x())) << 42) | (static_cast<std::uint64_t>(std::floor(t.y())) << 21) |
-           static_cast<std::uint64_t>(std::floor(t.z()));
+    return (static_cast<std::uint64_t>(std::floor(t.x())) << 42) |
+           (static_cast<std::uint64_t>(std::floor(t.y())) << 21) | static_cast<std::uint64_t>(std::floor(t.z()));
   }
 };
 }  // namespace
@@ -46,7 +47,8 @@ std::vector<index_t> CoarseCorrection::coarse_points(const Model& fine) {
     const std::uint64_t key = cells.key(fine.X.col(i), &t);
     const double distance = (t - t.array().floor().matrix()).squaredNorm();
     auto [it, fresh] = kept.try_emplace(key, Kept{i, distance});
-    if (!fresh && (distance < it->second.distance || (distance == it->second.distance && i < it->second.point))) it->second = {i, distance};
+    if (!fresh && (distance < it->second.distance || (distance == it->second.distance && i < it->second.point)))
+      it->second = {i, distance};
   }
   std::vector<index_t> points;
   points.reserve(kept.size());
@@ -96,7 +98,8 @@ bool CoarseCorrection::build(const Model& fine) {
     coarse_ = std::make_unique<Model>(build_model(cloud, fine.material, kernel, fine.point_materials, material_of));
     for (index_t c = 0; c < n; ++c) coarse_->fixed[c] = fine.fixed[selected_[c]];
     for (index_t c = 0; c < n; ++c)
-      if (!coarse_->fixed[c] && coarse_->neighbours.end(c) == coarse_->neighbours.begin(c)) throw Error("a lone coarse point");
+      if (!coarse_->fixed[c] && coarse_->neighbours.end(c) == coarse_->neighbours.begin(c))
+        throw Error("a lone coarse point");
     prolongation_ = build_surface_map(*coarse_, fine.X);
   } catch (const Error&) {
     coarse_.reset();
@@ -128,8 +131,8 @@ bool CoarseCorrection::factorise(const Model& fine, const Points& u, double iner
 void CoarseCorrection::add_correction(const Model& fine, const Points& r, Points& z) {
   if (!ready_) return;
   coarse_r_.setZero();
-  spread_surface_forces(prolongation_, r, coarse_r_);  // P^T r (held fine points carry r = 0)
-  cholesky_.solve(coarse_r_, coarse_z_);             // zero at held coarse points
+  spread_surface_forces(prolongation_, r, coarse_r_);             // P^T r (held fine points carry r = 0)
+  cholesky_.solve(coarse_r_, coarse_z_);                          // zero at held coarse points
   carry_surface(prolongation_, fine_zero_, coarse_z_, fine_dz_);  // P z_c
   for (index_t i = 0; i < fine.n_points; ++i)
     if (!fine.fixed[i]) z.col(i) += fine_dz_.col(i);

@@ -32,13 +32,15 @@ double estimated_stable_time_step(const Model& model, double safety) {
   return safety * a / std::sqrt(modulus / rho);
 }
 
-double stable_time_step(const Model& model, double safety, int lanczos_steps, int n_threads, const std::vector<index_t>& focus) {
+double stable_time_step(const Model& model, double safety, int lanczos_steps, int n_threads,
+                        const std::vector<index_t>& focus) {
   // Lanczos on M^-1/2 K M^-1/2 over the free points at rest: its largest Ritz value approaches the
   // largest omega^2 from below, and symplectic Euler is stable for h < 2 / omega_max
   const Eigen::Index n = 3 * static_cast<Eigen::Index>(model.n_points);
   Eigen::VectorXd scale(n);
   for (index_t i = 0; i < model.n_points; ++i)
-    for (int a = 0; a < 3; ++a) scale[3 * i + a] = model.fixed[i] || !(model.mass[i] > 0) ? 0.0 : 1.0 / std::sqrt(model.mass[i]);
+    for (int a = 0; a < 3; ++a)
+      scale[3 * i + a] = model.fixed[i] || !(model.mass[i] > 0) ? 0.0 : 1.0 / std::sqrt(model.mass[i]);
   // (a neighbour search: made only when Lanczos cannot answer)
   auto fallback = [&] { return estimated_stable_time_step(model, 0.7); };
   if (scale.squaredNorm() == 0) return fallback();
@@ -79,17 +81,20 @@ double stable_time_step(const Model& model, double safety, int lanczos_steps, in
     T(k, k) = alpha[k];
     if (k + 1 < done) T(k, k + 1) = T(k + 1, k) = beta[k];
   }
-  const double omega2 = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(T, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
+  const double omega2 =
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(T, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
   if (!(omega2 > 0) || !std::isfinite(omega2)) return fallback();
   return safety * 2.0 / std::sqrt(omega2);
 }
 
-double local_stable_time_step(const Model& model, const std::vector<index_t>& around, int rings, double safety, int lanczos_steps) {
+double local_stable_time_step(const Model& model, const std::vector<index_t>& around, int rings, double safety,
+                              int lanczos_steps) {
   const ModelPatch patch = model_patch(model, neighbourhood(model, around, rings));
   // the free points come first in the patch, in increasing order, and `around` is among them
   const auto free_end = patch.full_of.begin() + patch.n_free;
   std::vector<index_t> focus;
-  for (const index_t i : around) focus.push_back(static_cast<index_t>(std::lower_bound(patch.full_of.begin(), free_end, i) - patch.full_of.begin()));
+  for (const index_t i : around)
+    focus.push_back(static_cast<index_t>(std::lower_bound(patch.full_of.begin(), free_end, i) - patch.full_of.begin()));
   return stable_time_step(patch.model, safety, lanczos_steps, 1, focus);
 }
 
@@ -107,7 +112,7 @@ double min_free_mass(const Model& model) {
 }
 
 namespace {
-const double covered_stiffening = 1.25;  // stiffening the safety factor of stable_time_step() absorbs
+const double covered_stiffening = 1.25;    // stiffening the safety factor of stable_time_step() absorbs
 const double stiffening_relax_time = 0.5;  // s: how slowly the planned stiffening falls back (explicit_step)
 }  // namespace
 

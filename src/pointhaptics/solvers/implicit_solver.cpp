@@ -55,9 +55,10 @@ StepReport ImplicitSolver::step(const Model& model, State& state, Workspace& ws,
   report.residual = stats.residual;
   if (!stats.converged) {
     report.status = StepStatus::FAILED;
-    report.failure = fmt::format("implicit step at t = {:.6g} s did not converge ({}, residual {:.3g} after {} Newton "
-                                 "iterations); try a smaller dt or a larger solver.max_iterations",
-                                 state.time, stats.failure, stats.residual, stats.iterations);
+    report.failure = fmt::format(
+        "implicit step at t = {:.6g} s did not converge ({}, residual {:.3g} after {} Newton "
+        "iterations); try a smaller dt or a larger solver.max_iterations",
+        state.time, stats.failure, stats.residual, stats.iterations);
     return report;
   }
   // a step the iteration budget ended keeps its iterate, as the scene asked (real time): counted, not a failure

@@ -23,8 +23,8 @@ void precondition_blocks(const Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks,
 // blocks += the problem's own 3x3 diagonal terms beyond the material: the inertia's, the springs' and, unless
 // `term` is false, its further term's (block-Jacobi takes only these; the Cholesky factor takes the term's
 // coupling between points where the term gives it: EnergyTerm::add_to_matrix)
-void add_problem_blocks(const Model& model, const NewtonProblem& problem, Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks,
-                        bool term = true) {
+void add_problem_blocks(const Model& model, const NewtonProblem& problem,
+                        Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks, bool term = true) {
   if (problem.term && term) problem.term->add_diagonal_blocks(blocks);
   for (index_t i = 0; i < model.n_points; ++i) {
     Eigen::Map<Mat3> B(blocks.col(i).data());
@@ -55,7 +55,8 @@ double NewtonSolver::energy(const Model& model, const NewtonProblem& problem, co
   for (index_t i = 0; i < model.n_points; ++i) {
     if (model.fixed[i]) continue;
     pi -= problem.load->col(i).dot(u.col(i));
-    if (problem.inertia > 0) pi += 0.5 * problem.inertia * model.mass[i] * (u.col(i) - problem.anchor->col(i)).squaredNorm();
+    if (problem.inertia > 0)
+      pi += 0.5 * problem.inertia * model.mass[i] * (u.col(i) - problem.anchor->col(i)).squaredNorm();
     if (problem.springs) {
       const Vec3 e = u.col(i) - problem.spring_anchor->col(i);
       pi += 0.5 * e.dot(Eigen::Map<const Mat3>(problem.springs->col(i).data()) * e);
@@ -91,25 +92,26 @@ double NewtonSolver::residual(const Model& model, const NewtonProblem& problem, 
     term_forces = f.norm();
   }
   mask_held(model, r);
-  const double scale = std::max({problem.load->norm(), ws.f_int.norm(), std::sqrt(inertial), term_forces, force_floor_, 1e-300});
+  const double scale =
+      std::max({problem.load->norm(), ws.f_int.norm(), std::sqrt(inertial), term_forces, force_floor_, 1e-300});
   return r.norm() / scale;
 }
 
 bool NewtonSolver::blocks_stale(const Model& model, const NewtonProblem& problem, Workspace& ws) const {
   return refresh_blocks_ || blocks_model_ != &model || ws.solver_scratch().blocks.cols() != model.n_points ||
-         blocks_inertia_ != problem.inertia || blocks_springs_ != (problem.springs != nullptr) || blocks_term_ != (problem.term != nullptr);
+         blocks_inertia_ != problem.inertia || blocks_springs_ != (problem.springs != nullptr) ||
+         blocks_term_ != (problem.term != nullptr);
 }
 
 void NewtonSolver::note_cg_rate(long long iterations, double eta) {
   const double decades = std::max(1.0, -std::log10(std::max(eta, 1e-300)));
   const double rate = static_cast<double>(iterations) / decades;
-  if (cg_rate_at_build_ < 0)
-    cg_rate_at_build_ = rate;
-  else if (rate > 1.5 * cg_rate_at_build_ + 1)
-    refresh_blocks_ = true;
+  if (cg_rate_at_build_ < 0) cg_rate_at_build_ = rate;
+  else if (rate > 1.5 * cg_rate_at_build_ + 1) refresh_blocks_ = true;
 }
 
-void NewtonSolver::build_preconditioner(const Model& model, const NewtonProblem& problem, const Points& u, Workspace& ws) {
+void NewtonSolver::build_preconditioner(const Model& model, const NewtonProblem& problem, const Points& u,
+                                        Workspace& ws) {
   // the two-level preconditioner's coarse level lags with the blocks (rebuilt with them)
   two_level_ = kind_ == Preconditioner::TWO_LEVEL && (coarse_.built_for(model) || coarse_.build(model)) &&
                coarse_.factorise(model, u, problem.inertia);
@@ -151,7 +153,8 @@ void NewtonSolver::assemble(const Model& model, const NewtonProblem& problem, Wo
   added_blocks_.setZero(9, model.n_points);
   add_problem_blocks(model, problem, added_blocks_, !coupled);
   for (index_t i = 0; i < model.n_points; ++i)
-    Eigen::Map<Mat3>(matrix_.values.data() + 9 * static_cast<std::size_t>(matrix_.diagonal[i])) += Eigen::Map<const Mat3>(added_blocks_.col(i).data());
+    Eigen::Map<Mat3>(matrix_.values.data() + 9 * static_cast<std::size_t>(matrix_.diagonal[i])) +=
+        Eigen::Map<const Mat3>(added_blocks_.col(i).data());
 }
 
 bool NewtonSolver::factorise(const Model& model, const NewtonProblem& problem, Workspace& ws) {
@@ -183,16 +186,19 @@ void NewtonSolver::precondition(const Points& r, Points& z, Workspace& ws) {
   if (two_level_) coarse_.add_correction(*blocks_model_, r, z);
 }
 
-void NewtonSolver::apply_tangent(const Model& model, const NewtonProblem& problem, const Points& p, Workspace& ws, Points& q) const {
+void NewtonSolver::apply_tangent(const Model& model, const NewtonProblem& problem, const Points& p, Workspace& ws,
+                                 Points& q) const {
   tangent_.apply(model, p, ws, q);
   if (problem.inertia > 0) q += problem.inertia * (p.array().rowwise() * model.mass.transpose().array()).matrix();
   if (problem.springs)
-    for (index_t i = 0; i < model.n_points; ++i) q.col(i) += Eigen::Map<const Mat3>(problem.springs->col(i).data()) * p.col(i);
+    for (index_t i = 0; i < model.n_points; ++i)
+      q.col(i) += Eigen::Map<const Mat3>(problem.springs->col(i).data()) * p.col(i);
   if (problem.term) problem.term->add_tangent_product(p, q);
   mask_held(model, q);
 }
 
-void NewtonSolver::linearise(const Model& model, const NewtonProblem& problem, const Points& u, Workspace& ws, bool material) {
+void NewtonSolver::linearise(const Model& model, const NewtonProblem& problem, const Points& u, Workspace& ws,
+                             bool material) {
   if (problem.term) problem.term->linearise(model, u, TangentMode::PROJECTED);
   if (!material) return;
   tangent_.linearise(model, u, TangentMode::PROJECTED, &ws);
@@ -256,7 +262,8 @@ NewtonStats NewtonSolver::solve(const Model& model, const NewtonProblem& problem
   force_floor_ = force_floor(model);
   const bool background = settings.refactor_in_background(ws.n_threads());
   // a factor made in the background during an earlier solve (of this model: a new one is analysed again)
-  if (cholesky_.background_pending() && cholesky_.analysed_for(model) && (!settings.real_time || cholesky_.background_ready()))
+  if (cholesky_.background_pending() && cholesky_.analysed_for(model) &&
+      (!settings.real_time || cholesky_.background_ready()))
     take_background_factor(stats);
   double rel = residual(model, problem, u, ws, r);
   // Pi at the current iterate, evaluated only when a line search needs it (NaN: not yet)
@@ -282,7 +289,8 @@ NewtonStats NewtonSolver::solve(const Model& model, const NewtonProblem& problem
     }
     ++stats.iterations;
     // in real time a background factor is taken up as soon as it is ready
-    if (settings.real_time && cholesky_.background_ready() && cholesky_.analysed_for(model)) take_background_factor(stats);
+    if (settings.real_time && cholesky_.background_ready() && cholesky_.analysed_for(model))
+      take_background_factor(stats);
     // inexact Newton: the linear solve is as accurate as the residual (quadratic convergence), at most
     // 1e-2, and never much more accurate than the tolerance needs
     const double eta = std::max(std::min(0.01, rel), 0.5 * settings.tolerance / rel);
@@ -297,7 +305,8 @@ NewtonStats NewtonSolver::solve(const Model& model, const NewtonProblem& problem
       preconditioner_mode_ = mode;
       // the Cholesky factor lags across iterations and solves while CG converges fast with it
       // (an exact tangent found indefinite once is not factorised again: only a projected one, which is not)
-      use_cholesky_ = settings.preconditioner == Preconditioner::CHOLESKY && cholesky_.factorised() && !refactorise_ && !factor_stale_;
+      use_cholesky_ = settings.preconditioner == Preconditioner::CHOLESKY && cholesky_.factorised() && !refactorise_ &&
+                      !factor_stale_;
       if (settings.preconditioner == Preconditioner::CHOLESKY && !use_cholesky_ && !factor_stale_ &&
           (mode == TangentMode::PROJECTED || !exact_indefinite_)) {
         use_cholesky_ = factorise(model, problem, ws);
@@ -314,9 +323,10 @@ NewtonStats NewtonSolver::solve(const Model& model, const NewtonProblem& problem
       // (0.5 s of a 1 ms step, measured): cut short, this iteration is solved with block-Jacobi instead
       const bool may_fall_back = use_cholesky_ && background;
       const int stale_limit = 4 * settings.refactor_iterations;
-      bool positive = conjugate_gradients(model, problem, r, eta,
-                                          may_fall_back ? std::min(stale_limit, settings.max_cg_iterations) : settings.max_cg_iterations,
-                                          ws, dx, stats.cg_iterations);
+      bool positive = conjugate_gradients(
+          model, problem, r, eta,
+          may_fall_back ? std::min(stale_limit, settings.max_cg_iterations) : settings.max_cg_iterations, ws, dx,
+          stats.cg_iterations);
       const long long factor_cg = use_cholesky_ ? stats.cg_iterations - cg_before : 0;
       if (may_fall_back && positive && factor_cg >= stale_limit) {
         use_cholesky_ = false;

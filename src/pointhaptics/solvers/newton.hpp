@@ -13,9 +13,9 @@
 namespace pointhaptics {
 
 struct NewtonSettings {
-  double tolerance = 1e-8;      ///< converged when |residual| <= tolerance * force scale (see NewtonStats)
-  int max_iterations = 50;      ///< Newton iterations per solve
-  int max_cg_iterations = 2000; ///< CG iterations per Newton iteration
+  double tolerance = 1e-8;       ///< converged when |residual| <= tolerance * force scale (see NewtonStats)
+  int max_iterations = 50;       ///< Newton iterations per solve
+  int max_cg_iterations = 2000;  ///< CG iterations per Newton iteration
   /// Accept the last iterate when max_iterations is reached instead of reporting failure
   /// (the real-time budget of implicit dynamics).
   bool accept_at_budget = false;
@@ -77,16 +77,16 @@ struct NewtonProblem {
 
 struct NewtonStats {
   bool converged = false;
-  int iterations = 0;            ///< Newton iterations
-  long long cg_iterations = 0;   ///< CG iterations, summed
-  int factorisations = 0;        ///< CHOLESKY: numeric factorisations of the tangent in this solve (made or taken up)
+  int iterations = 0;           ///< Newton iterations
+  long long cg_iterations = 0;  ///< CG iterations, summed
+  int factorisations = 0;       ///< CHOLESKY: numeric factorisations of the tangent in this solve (made or taken up)
   int background_factorisations = 0;  ///< ... of them, made on the worker thread
   int stale_factor_fallbacks = 0;     ///< CG solves cut short with a factor far behind the tangent (while the worker
                                       ///< refactorises) and done again with block-Jacobi
-  int projected = 0;             ///< iterations that fell back to the positive semi-definite tangent
-  double residual = 0;           ///< |r|_free / max(|b|, |f_int|, |k M (u - a)|, |tool forces|, force_floor) at the end
-  bool stalled = false;          ///< converged at the round-off floor above the tolerance
-  const char* failure = "";      ///< why it stopped without converging
+  int projected = 0;                  ///< iterations that fell back to the positive semi-definite tangent
+  double residual = 0;       ///< |r|_free / max(|b|, |f_int|, |k M (u - a)|, |tool forces|, force_floor) at the end
+  bool stalled = false;      ///< converged at the round-off floor above the tolerance
+  const char* failure = "";  ///< why it stopped without converging
 };
 
 /// Newton's method with its tangent; its vectors are the workspace's (Workspace::solver_scratch()).
@@ -102,7 +102,8 @@ class NewtonSolver {
   /// and the block-Jacobi preconditioner. (A tool's compliance: what the object gives under a load.) Without
   /// `material` only the term is linearised again, the material's tangent and the preconditioner lag (they
   /// cost most: a 9x9 eigen decomposition per point).
-  void linearise(const Model& model, const NewtonProblem& problem, const Points& u, Workspace& ws, bool material = true);
+  void linearise(const Model& model, const NewtonProblem& problem, const Points& u, Workspace& ws,
+                 bool material = true);
   /// H x = b over the free points with the tangent of the last linearise(), by PCG from the x given (a warm
   /// start) to |b - H x| <= tolerance |b| or max_iterations; x keeps the last iterate. Uses the workspace's
   /// solver scratch. Returns the CG iterations taken (negative when CG met a direction of non-positive
@@ -176,7 +177,6 @@ class NewtonSolver {
   Preconditioner kind_ = Preconditioner::BLOCK_JACOBI;
   CoarseCorrection coarse_;
   bool two_level_ = false;
-
 };
 
 }  // namespace pointhaptics

@@ -44,15 +44,15 @@ enum class StepStatus {
 /// numerically: the pipeline records the report, and a failed state is never stepped again.
 struct StepReport {
   StepStatus status = StepStatus::CONVERGED;
-  int substeps = 0;            ///< explicit sub-steps, or static load increments
-  int iterations = 0;          ///< Newton iterations (explicit: the sub-steps)
-  long long cg_iterations = 0; ///< CG iterations, summed
-  int factorisations = 0;      ///< preconditioner = "cholesky": numeric factorisations of the tangent
+  int substeps = 0;                   ///< explicit sub-steps, or static load increments
+  int iterations = 0;                 ///< Newton iterations (explicit: the sub-steps)
+  long long cg_iterations = 0;        ///< CG iterations, summed
+  int factorisations = 0;             ///< preconditioner = "cholesky": numeric factorisations of the tangent
   int background_factorisations = 0;  ///< ... of them, made on a worker thread
-  double factor_bytes = 0;     ///< ... and the factor's size, bytes (0: none; "two_level": the coarse factor's)
-  index_t coarse_points = 0;   ///< preconditioner = "two_level": the coarse level's points (0: none)
-  double residual = 0;         ///< Newton's relative residual at the end (0 for explicit steps)
-  std::string failure;         ///< why the step FAILED (empty otherwise; allocated only then)
+  double factor_bytes = 0;            ///< ... and the factor's size, bytes (0: none; "two_level": the coarse factor's)
+  index_t coarse_points = 0;          ///< preconditioner = "two_level": the coarse level's points (0: none)
+  double residual = 0;                ///< Newton's relative residual at the end (0 for explicit steps)
+  std::string failure;                ///< why the step FAILED (empty otherwise; allocated only then)
 };
 
 /// One step of a model's state. A solver is made for one model and keeps buffers sized for it, so that a
@@ -86,7 +86,8 @@ NewtonSettings newton_settings(const SolverSpec& spec);
 /// Held points at their prescribed displacement at time t (ramped in over each group's ramp), times
 /// `load_factor` (static load stepping scales them with the load). With a velocity and a step h > 0 their
 /// velocity becomes the motion over that step. The one loop over held points of every solver.
-void hold_points(const Model& model, double t, Points& u, Points* velocity = nullptr, double h = 0, double load_factor = 1);
+void hold_points(const Model& model, double t, Points& u, Points* velocity = nullptr, double h = 0,
+                 double load_factor = 1);
 
 /// Prescribed displacement of a fixed group at time t (ramped in linearly over group.ramp).
 Vec3 prescribed_displacement(const FixedGroup& group, double t);

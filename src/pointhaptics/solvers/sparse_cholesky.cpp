@@ -74,9 +74,9 @@ struct SparseCholesky::Background {
   cholmod_common common;
   cholmod_sparse* A = nullptr;
   cholmod_factor* L = nullptr;
-  bool good = false;    // the worker's last result (read after `running` is seen false)
+  bool good = false;  // the worker's last result (read after `running` is seen false)
   double seconds = 0;
-  bool pending = false;  // the simulation's thread only: a job was handed over and not yet taken up
+  bool pending = false;          // the simulation's thread only: a job was handed over and not yet taken up
   std::function<void()> before;  // SparseCholesky::before_background_factorisation, at the hand-over
   std::mutex mutex;
   std::condition_variable wake, finished;
@@ -178,7 +178,8 @@ void SparseCholesky::analyse(const Model& model, const TangentMatrix& K) {
       column_start.push_back(static_cast<int>(rows.size()));
     }
   }
-  f.A = cholmod_allocate_sparse(dofs, dofs, rows.size(), /*sorted=*/1, /*packed=*/1, /*stype=*/-1, CHOLMOD_REAL, &f.common);
+  f.A = cholmod_allocate_sparse(dofs, dofs, rows.size(), /*sorted=*/1, /*packed=*/1, /*stype=*/-1, CHOLMOD_REAL,
+                                &f.common);
   std::copy(column_start.begin(), column_start.end(), static_cast<int*>(f.A->p));
   std::copy(rows.begin(), rows.end(), static_cast<int*>(f.A->i));
   // CHOLMOD tries METIS after AMD when AMD's fill is high, as it is on a small, nearly dense tangent (the

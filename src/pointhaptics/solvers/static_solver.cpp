@@ -11,8 +11,9 @@ namespace pointhaptics {
 
 namespace {
 
-StaticStats load_stepping(const Model& model, State& state, Workspace& ws, NewtonSolver& newton, const NewtonSettings& settings,
-                          Points& load, Points& trial, EnergyTerm* term, StaticStats stats) {
+StaticStats load_stepping(const Model& model, State& state, Workspace& ws, NewtonSolver& newton,
+                          const NewtonSettings& settings, Points& load, Points& trial, EnergyTerm* term,
+                          StaticStats stats) {
   double reached = 0.0, increment = 1.0;
   const double min_increment = 1e-4;
   NewtonProblem problem;
@@ -65,8 +66,10 @@ StaticStats solve_static(const Model& model, State& state, Workspace& ws, Newton
   while (term && stats.converged && !term->update_multipliers(model, state.u)) {
     if (++stats.multiplier_updates > max_updates) {
       stats.converged = false;
-      stats.failure = fmt::format("static solver: the tool's contact constraint is still not met after {} updates of its "
-                                  "multipliers", max_updates);
+      stats.failure = fmt::format(
+          "static solver: the tool's contact constraint is still not met after {} updates of its "
+          "multipliers",
+          max_updates);
       break;
     }
     stats.load_steps = 0;
@@ -78,7 +81,8 @@ StaticStats solve_static(const Model& model, State& state, Workspace& ws, Newton
 StaticSolver::StaticSolver(const Model& model, const NewtonSettings& settings) : settings_(settings), newton_(model) {}
 
 StepReport StaticSolver::step(const Model& model, State& state, Workspace& ws, DynamicForces* forces) {
-  const StaticStats stats = solve_static(model, state, ws, newton_, settings_, forces ? forces->energy_term() : nullptr);
+  const StaticStats stats =
+      solve_static(model, state, ws, newton_, settings_, forces ? forces->energy_term() : nullptr);
   StepReport report;
   report.status = stats.converged ? StepStatus::CONVERGED : StepStatus::FAILED;
   report.substeps = stats.load_steps;

@@ -7,16 +7,16 @@ namespace pointhaptics {
 
 struct StaticStats {
   bool converged = false;
-  int iterations = 0;            ///< Newton iterations over all load steps
+  int iterations = 0;  ///< Newton iterations over all load steps
   long long cg_iterations = 0;
-  int factorisations = 0;        ///< preconditioner = "cholesky": numeric factorisations of the tangent
+  int factorisations = 0;             ///< preconditioner = "cholesky": numeric factorisations of the tangent
   int background_factorisations = 0;  ///< ... of them, made on a worker thread
-  int projected = 0;             ///< Newton iterations that used the positive semi-definite tangent
-  int load_steps = 0;            ///< converged load increments
-  int cutbacks = 0;              ///< failed increments that were retried with a smaller one
-  double residual = 0;           ///< relative residual at the end
-  int multiplier_updates = 0;    ///< with a constrained term (a tool's contact): its augmented Lagrangian's updates
-  std::string failure;           ///< why it did not converge
+  int projected = 0;                  ///< Newton iterations that used the positive semi-definite tangent
+  int load_steps = 0;                 ///< converged load increments
+  int cutbacks = 0;                   ///< failed increments that were retried with a smaller one
+  double residual = 0;                ///< relative residual at the end
+  int multiplier_updates = 0;  ///< with a constrained term (a tool's contact): its augmented Lagrangian's updates
+  std::string failure;         ///< why it did not converge
 };
 
 /// Solve f_int(u) + f_ext = 0 on the free points, with held points at their prescribed displacement.

@@ -26,7 +26,8 @@ TEST(Hourglass, PairForceIsTheGradientOfThePairEnergy) {
       const Vec3 e = h * Vec3::Unit(a);
       numeric[a] = (hourglass_pair_energy(k, du + e, G_sum, x) - hourglass_pair_energy(k, du - e, G_sum, x)) / (2 * h);
     }
-    const Vec3 force = hourglass_pair_force(k, du, Vec3(G_sum.col(0)), Vec3(G_sum.col(1)), Vec3(G_sum.col(2)), x[0], x[1], x[2]);
+    const Vec3 force =
+        hourglass_pair_force(k, du, Vec3(G_sum.col(0)), Vec3(G_sum.col(1)), Vec3(G_sum.col(2)), x[0], x[1], x[2]);
     ASSERT_LE((force - numeric).norm(), 1e-6 * force.norm());
     ASSERT_LE((force - k * hourglass_residual(du, G_sum, x)).norm(), 1e-12 * force.norm());
   }
@@ -54,7 +55,8 @@ TEST(Hourglass, PrecomputedDiagonalIsTheSecondDifferenceOfTheEnergy) {
       const double plus = strain_energy(model, u).hourglass;
       u(a, m) = -h;
       const double minus = strain_energy(model, u).hourglass;
-      EXPECT_NEAR((plus + minus) / (h * h), model.hg_diagonal[m], 1e-9 * model.hg_diagonal[m]) << "point " << m << " axis " << a;
+      EXPECT_NEAR((plus + minus) / (h * h), model.hg_diagonal[m], 1e-9 * model.hg_diagonal[m])
+          << "point " << m << " axis " << a;
     }
 }
 

@@ -52,8 +52,8 @@ std::vector<std::array<Mat3, 4>> regimes() {
   for (Mat3& G : compressed) G = -0.45 * Mat3::Identity() + test::random_matrix(rng, 0.1);
   groups.push_back(compressed);
   // one lane of each kind the four-point form hands back, among ordinary ones
-  std::array<Mat3, 4> mixed = {test::random_matrix(rng, 0.1), test::random_matrix(rng, 0.02), test::random_matrix(rng, 0.1),
-                               test::random_matrix(rng, 0.2)};
+  std::array<Mat3, 4> mixed = {test::random_matrix(rng, 0.1), test::random_matrix(rng, 0.02),
+                               test::random_matrix(rng, 0.1), test::random_matrix(rng, 0.2)};
   mixed[1](1, 1) -= 0.97;  // J ~ 0.03, below the floor
   groups.push_back(mixed);
   std::array<Mat3, 4> inverted = mixed;
@@ -76,7 +76,8 @@ MaterialParams params(MaterialModel model) {
 
 /// Every lane of energy.scaled_stress(i, count, G, scale) against energy.scaled_stress(i + k, G_k, scale_k).
 template <class Energy>
-void expect_lanes_equal_points(const Energy& energy, const std::array<Mat3, 4>& group, int count, const std::string& what) {
+void expect_lanes_equal_points(const Energy& energy, const std::array<Mat3, 4>& group, int count,
+                               const std::string& what) {
   const Lanes scale = {1.5e-6, 0.7e-6, 2.1e-6, 1e-6};
   const Matrix3<Lanes> P = energy.scaled_stress(0, count, lanes_of(group), scale);
   for (int k = 0; k < count; ++k) {
@@ -87,7 +88,8 @@ void expect_lanes_equal_points(const Energy& energy, const std::array<Mat3, 4>& 
 }
 
 TEST(FourPointStress, EqualsEachPointsOwnForEveryModelAndRegime) {
-  for (MaterialModel model_kind : {MaterialModel::SVK, MaterialModel::NEO_HOOKEAN, MaterialModel::MOONEY_RIVLIN, MaterialModel::COROTATED}) {
+  for (MaterialModel model_kind :
+       {MaterialModel::SVK, MaterialModel::NEO_HOOKEAN, MaterialModel::MOONEY_RIVLIN, MaterialModel::COROTATED}) {
     for (double volume_stiffness : {0.0, 3e5}) {
       Model model;
       model.material = params(model_kind);
@@ -96,8 +98,9 @@ TEST(FourPointStress, EqualsEachPointsOwnForEveryModelAndRegime) {
         int g = 0;
         for (const auto& group : regimes())
           for (int count : {4, 3, 1})
-            expect_lanes_equal_points(energy, group, count,
-                                      fmt::format("{} (volume {}) group {}", to_string(model_kind), volume_stiffness, g++));
+            expect_lanes_equal_points(
+                energy, group, count,
+                fmt::format("{} (volume {}) group {}", to_string(model_kind), volume_stiffness, g++));
       });
     }
   }
@@ -105,15 +108,17 @@ TEST(FourPointStress, EqualsEachPointsOwnForEveryModelAndRegime) {
 
 TEST(FourPointStress, NotFiniteLanesStayNotFiniteAndLeaveTheOthersAlone) {
   std::mt19937 rng(5);
-  std::array<Mat3, 4> group = {test::random_matrix(rng, 0.1), test::random_matrix(rng, 0.1), test::random_matrix(rng, 0.1),
-                               test::random_matrix(rng, 0.1)};
+  std::array<Mat3, 4> group = {test::random_matrix(rng, 0.1), test::random_matrix(rng, 0.1),
+                               test::random_matrix(rng, 0.1), test::random_matrix(rng, 0.1)};
   group[2](0, 1) = std::numeric_limits<double>::quiet_NaN();
-  for (MaterialModel model_kind : {MaterialModel::SVK, MaterialModel::NEO_HOOKEAN, MaterialModel::MOONEY_RIVLIN, MaterialModel::COROTATED}) {
+  for (MaterialModel model_kind :
+       {MaterialModel::SVK, MaterialModel::NEO_HOOKEAN, MaterialModel::MOONEY_RIVLIN, MaterialModel::COROTATED}) {
     Model model;
     model.material = params(model_kind);
     with_material(model, [&](const auto& energy) {
       const Matrix3<Lanes> P = energy.scaled_stress(0, 4, lanes_of(group), Lanes{} + 1.0);
-      for (int k : {0, 1, 3}) EXPECT_LE((lane(P, k) - energy.stress(k, group[k])).norm(), 1e-13 * lane(P, k).norm()) << to_string(model_kind);
+      for (int k : {0, 1, 3})
+        EXPECT_LE((lane(P, k) - energy.stress(k, group[k])).norm(), 1e-13 * lane(P, k).norm()) << to_string(model_kind);
       EXPECT_FALSE(lane(P, 2).allFinite()) << to_string(model_kind);
     });
   }
@@ -122,13 +127,16 @@ TEST(FourPointStress, NotFiniteLanesStayNotFiniteAndLeaveTheOthersAlone) {
 TEST(FourPointStress, MixedObjectsDispatchEachGroupOrEachPoint) {
   Model model;
   model.material = params(MaterialModel::SVK);
-  model.point_materials = {model.material, params(MaterialModel::NEO_HOOKEAN), params(MaterialModel::COROTATED), params(MaterialModel::MOONEY_RIVLIN)};
-  for (const std::vector<std::uint8_t>& material_of : {std::vector<std::uint8_t>{1, 1, 1, 1}, std::vector<std::uint8_t>{3, 3, 3, 3},
-                                                        std::vector<std::uint8_t>{0, 1, 2, 3}, std::vector<std::uint8_t>{2, 2, 0, 2}}) {
+  model.point_materials = {model.material, params(MaterialModel::NEO_HOOKEAN), params(MaterialModel::COROTATED),
+                           params(MaterialModel::MOONEY_RIVLIN)};
+  for (const std::vector<std::uint8_t>& material_of :
+       {std::vector<std::uint8_t>{1, 1, 1, 1}, std::vector<std::uint8_t>{3, 3, 3, 3},
+        std::vector<std::uint8_t>{0, 1, 2, 3}, std::vector<std::uint8_t>{2, 2, 0, 2}}) {
     model.material_of = material_of;
     with_material(model, [&](const auto& energy) {
       for (const auto& group : regimes())
-        for (int count : {4, 2}) expect_lanes_equal_points(energy, group, count, fmt::format("materials {}", fmt::join(material_of, ",")));
+        for (int count : {4, 2})
+          expect_lanes_equal_points(energy, group, count, fmt::format("materials {}", fmt::join(material_of, ",")));
     });
   }
 }

@@ -159,9 +159,7 @@ TYPED_TEST(Hyperelastic, InvertedAndFlattenedNeighbourhoodsStayFiniteAndArePushe
 // dP/dF spectral norm at G, over the rest value
 template <class M>
 double tangent_ratio(const M& m, const Mat3& G) {
-  auto norm = [&](const Mat3& g) {
-    return Eigen::JacobiSVD<Mat9>(m.linearise(g, false).H).singularValues()[0];
-  };
+  auto norm = [&](const Mat3& g) { return Eigen::JacobiSVD<Mat9>(m.linearise(g, false).H).singularValues()[0]; };
   return norm(G) / norm(Mat3::Zero());
 }
 
@@ -252,7 +250,7 @@ TEST(Materials, UniaxialCompressionStiffensNeoHookeanWhereStVenantKirchhoffColla
   // collapse of issue 17; neo-Hookean's keeps growing
   auto axial = [](const auto& m, double s) {
     double lateral = 1.0, lo = 1.0, hi = 3.0;  // compressed along x, the lateral stretch is >= 1
-    for (int b = 0; b < 80; ++b) {               // bisection for zero lateral stress
+    for (int b = 0; b < 80; ++b) {             // bisection for zero lateral stress
       lateral = 0.5 * (lo + hi);
       const Mat3 G = Vec3(s - 1, lateral - 1, lateral - 1).asDiagonal();
       (m.stress(G)(1, 1) > 0 ? hi : lo) = lateral;
@@ -274,20 +272,23 @@ TEST(Materials, UniaxialCompressionStiffensNeoHookeanWhereStVenantKirchhoffColla
 TEST(MixedEnergy, DispatchesEachPointToItsOwnMaterial) {
   Model model;
   model.material = params(MaterialModel::SVK);
-  model.point_materials = {model.material, params(MaterialModel::NEO_HOOKEAN, 1e6), params(MaterialModel::COROTATED, 3e5)};
+  model.point_materials = {model.material, params(MaterialModel::NEO_HOOKEAN, 1e6),
+                           params(MaterialModel::COROTATED, 3e5)};
   model.material_of = {0, 1, 2, 1};
   std::mt19937 rng(10);
   const Mat3 G = test::random_matrix(rng, 0.2), dG = test::random_matrix(rng, 1.0);
   with_material(model, [&](const auto& energy) {
     for (index_t i = 0; i < 4; ++i) {
       const AnyMaterial own = material_constants(model.point_materials[model.material_of[i]]);
-      std::visit([&](const auto& m) {
-        EXPECT_LE((energy.stress(i, G) - m.stress(G)).norm(), 1e-12 * m.stress(G).norm()) << "point " << i;
-        EXPECT_NEAR(energy.energy_density(i, G), m.energy_density(G), 1e-12 * m.energy_density(G));
-        const Mat3 expected = test::numeric_directional([&](const Mat3& g) { return m.stress(g); }, G, dG);
-        const auto at = energy.linearise(i, G, false);
-        EXPECT_LE((energy.stress_derivative(i, at, dG, false) - expected).norm(), 1e-6 * expected.norm());
-      }, own);
+      std::visit(
+          [&](const auto& m) {
+            EXPECT_LE((energy.stress(i, G) - m.stress(G)).norm(), 1e-12 * m.stress(G).norm()) << "point " << i;
+            EXPECT_NEAR(energy.energy_density(i, G), m.energy_density(G), 1e-12 * m.energy_density(G));
+            const Mat3 expected = test::numeric_directional([&](const Mat3& g) { return m.stress(g); }, G, dG);
+            const auto at = energy.linearise(i, G, false);
+            EXPECT_LE((energy.stress_derivative(i, at, dG, false) - expected).norm(), 1e-6 * expected.norm());
+          },
+          own);
     }
   });
 }

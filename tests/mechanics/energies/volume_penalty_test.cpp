@@ -41,7 +41,8 @@ TEST(VolumePenalty, StiffnessBlockIsTheDerivativeContractedWithTheStencilVector)
     const Vec3 d = test::random_matrix(rng, 50.0).col(0);
     for (const bool exact : {true, false}) {
       Mat3 expected;
-      for (int b = 0; b < 3; ++b) expected.col(b) = volume.stress_derivative(F, Vec3::Unit(b) * d.transpose(), exact) * d;
+      for (int b = 0; b < 3; ++b)
+        expected.col(b) = volume.stress_derivative(F, Vec3::Unit(b) * d.transpose(), exact) * d;
       ASSERT_LE((volume.stiffness_block(F, d) - expected).norm(), 1e-10 * expected.norm());
     }
   }
@@ -57,7 +58,8 @@ TEST(VolumePenalty, RestAndRotationsCostNothing) {
   }
   // a uniform compression to J = 0.9: 0.5 k (0.1)^2
   const double s = std::cbrt(0.9);
-  EXPECT_NEAR(volume.energy_density((s - 1) * Mat3::Identity()), 0.5 * volume.stiffness * 0.01, 1e-9 * volume.stiffness);
+  EXPECT_NEAR(volume.energy_density((s - 1) * Mat3::Identity()), 0.5 * volume.stiffness * 0.01,
+              1e-9 * volume.stiffness);
 }
 
 }  // namespace

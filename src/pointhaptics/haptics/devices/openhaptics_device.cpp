@@ -22,9 +22,9 @@ struct HDErrorInfo {
 constexpr HDerror HD_SUCCESS = 0x0000;
 constexpr HDenum HD_CURRENT_BUTTONS = 0x2000, HD_CURRENT_POSITION = 0x2050, HD_CURRENT_VELOCITY = 0x2051,
                  HD_CURRENT_TRANSFORM = 0x2052, HD_USABLE_WORKSPACE_DIMENSIONS = 0x2551, HD_OUTPUT_DOF = 0x2554,
-                 HD_NOMINAL_MAX_STIFFNESS = 0x2602, HD_NOMINAL_MAX_CONTINUOUS_FORCE = 0x2604, HD_NOMINAL_MAX_DAMPING = 0x2609,
-                 HD_NOMINAL_MAX_TORQUE_CONTINUOUS_FORCE = 0x2623, HD_CURRENT_FORCE = 0x2700, HD_CURRENT_TORQUE = 0x2701,
-                 HD_FORCE_OUTPUT = 0x4000;
+                 HD_NOMINAL_MAX_STIFFNESS = 0x2602, HD_NOMINAL_MAX_CONTINUOUS_FORCE = 0x2604,
+                 HD_NOMINAL_MAX_DAMPING = 0x2609, HD_NOMINAL_MAX_TORQUE_CONTINUOUS_FORCE = 0x2623,
+                 HD_CURRENT_FORCE = 0x2700, HD_CURRENT_TORQUE = 0x2701, HD_FORCE_OUTPUT = 0x4000;
 constexpr HHD HD_INVALID_HANDLE = 0xFFFFFFFF;
 
 }  // namespace
@@ -48,12 +48,14 @@ struct OpenHapticsDevice::Api {
   }
 };
 
-OpenHapticsDevice::OpenHapticsDevice(const std::string& library, const std::string& device_name) : api_(std::make_unique<Api>()) {
+OpenHapticsDevice::OpenHapticsDevice(const std::string& library, const std::string& device_name)
+    : api_(std::make_unique<Api>()) {
   api_->library = ::dlopen(library.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (!api_->library)
-    throw Error(fmt::format("OpenHaptics: cannot load {} ({}); install the OpenHaptics runtime and the device "
-                            "driver, or use device.kind = \"virtual\"",
-                            library, ::dlerror()));
+    throw Error(
+        fmt::format("OpenHaptics: cannot load {} ({}); install the OpenHaptics runtime and the device "
+                    "driver, or use device.kind = \"virtual\"",
+                    library, ::dlerror()));
   auto load = [&](auto& fn, const char* name) {
     fn = reinterpret_cast<std::remove_reference_t<decltype(fn)>>(::dlsym(api_->library, name));
     if (!fn) throw Error(fmt::format("OpenHaptics: {} has no function {}", library, name));
@@ -95,8 +97,8 @@ OpenHapticsDevice::OpenHapticsDevice(const std::string& library, const std::stri
   specs_.workspace_radius = 0.5e-3 * std::min({box[3] - box[0], box[4] - box[1], box[5] - box[2]});
   specs_.max_torque = output_dof >= 6 && torque > 0 ? 1e-3 * torque : 0.0;
   if (!(specs_.max_force > 0) || !(specs_.max_stiffness > 0))
-    throw DeviceError(fmt::format("OpenHaptics: the device reports max force {} N and stiffness {} N/m", specs_.max_force,
-                                  specs_.max_stiffness));
+    throw DeviceError(fmt::format("OpenHaptics: the device reports max force {} N and stiffness {} N/m",
+                                  specs_.max_force, specs_.max_stiffness));
   api_->hdEnable(HD_FORCE_OUTPUT);
   api_->hdStartScheduler();
   check("starting the scheduler");
@@ -105,14 +107,14 @@ OpenHapticsDevice::OpenHapticsDevice(const std::string& library, const std::stri
 OpenHapticsDevice::~OpenHapticsDevice() {
   try {
     stop();
-  } catch (...) {
-  }
+  } catch (...) {}
 }
 
 void OpenHapticsDevice::check(const char* what) {
   const HDErrorInfo e = api_->hdGetError();
   if (e.errorCode != HD_SUCCESS)
-    throw DeviceError(fmt::format("OpenHaptics: error 0x{:04x} (internal {}) while {}", e.errorCode, e.internalErrorCode, what));
+    throw DeviceError(
+        fmt::format("OpenHaptics: error 0x{:04x} (internal {}) while {}", e.errorCode, e.internalErrorCode, what));
 }
 
 DeviceState OpenHapticsDevice::read(double t) {
@@ -131,11 +133,13 @@ DeviceState OpenHapticsDevice::read(double t) {
   s.position = 1e-3 * Vec3(p[0], p[1], p[2]);  // mm -> m
   s.velocity = 1e-3 * Vec3(v[0], v[1], v[2]);
   s.buttons = static_cast<unsigned>(buttons);
-  if (!s.position.allFinite() || !s.velocity.allFinite()) throw DeviceError("OpenHaptics: the device reported a non-finite position");
+  if (!s.position.allFinite() || !s.velocity.allFinite())
+    throw DeviceError("OpenHaptics: the device reported a non-finite position");
   // the stylus's orientation (a capsule tool turns with it): the transform's rotation, made orthonormal
   const Eigen::Map<const Eigen::Matrix4d> pose(transform);
   const Mat3 rotation = pose.topLeftCorner<3, 3>();
-  if (rotation.allFinite() && std::abs(rotation.determinant() - 1) < 0.1) s.orientation = Eigen::Quaterniond(rotation).normalized();
+  if (rotation.allFinite() && std::abs(rotation.determinant() - 1) < 0.1)
+    s.orientation = Eigen::Quaterniond(rotation).normalized();
   return s;
 }
 

@@ -18,11 +18,11 @@ class OpenHapticsDevice : public Device {
   explicit OpenHapticsDevice(const std::string& library = "libHD.so", const std::string& device_name = "");
   ~OpenHapticsDevice() override;
   DeviceSpecs specs() const override { return specs_; }
-  DeviceState read(double t) override;     ///< begins an HD frame; the stylus's orientation from its transform
+  DeviceState read(double t) override;  ///< begins an HD frame; the stylus's orientation from its transform
   /// Kept for the next command(), on a device with six output degrees of freedom (specs().max_torque > 0).
   void set_torque(const Vec3& torque) override { torque_ = torque; }
   void command(const Vec3& force) override;  ///< sets the force (and the torque) and ends the frame
-  void stop() override;                     ///< zero force, scheduler stopped, device disabled (idempotent)
+  void stop() override;                      ///< zero force, scheduler stopped, device disabled (idempotent)
 
  private:
   struct Api;

@@ -2,7 +2,8 @@
 
 namespace pointhaptics {
 
-ReplayDevice::ReplayDevice(std::vector<HapticLogRow> rows, const DeviceSpecs& specs) : rows_(std::move(rows)), specs_(specs) {
+ReplayDevice::ReplayDevice(std::vector<HapticLogRow> rows, const DeviceSpecs& specs)
+    : rows_(std::move(rows)), specs_(specs) {
   if (rows_.empty()) throw Error("replay device: the log has no rows");
 }
 

@@ -11,7 +11,7 @@ class VirtualDevice : public Device {
  public:
   VirtualDevice(Trajectory trajectory, const DeviceSpecs& specs, const HandDynamics& hand = {});
   DeviceSpecs specs() const override { return specs_; }
-  DeviceState read(double t) override;   ///< advances the dynamics to t (sub-steps of at most 0.25 ms)
+  DeviceState read(double t) override;  ///< advances the dynamics to t (sub-steps of at most 0.25 ms)
   void command(const Vec3& force) override;
   void stop() override { endpoint_.set_force(Vec3::Zero()); }
 

@@ -42,4 +42,15 @@ PH_ALWAYS_INLINE inline L load_linearisation(const double* base, index_t i) {
   return at;
 }
 
+template <class L>
+PH_ALWAYS_INLINE inline void store_linearisation(double* base, index_t i, const L& at) {
+  static_assert(std::is_standard_layout_v<L> && sizeof(L) % sizeof(double) == 0);
+  // Eigen's fixed-size matrices are arrays of doubles (standard layout, asserted) whose copy constructor is
+  // user-provided, so they are not TriviallyCopyable by the letter; copying their bytes is what that
+  // constructor does. The buffer's doubles are only 8-byte aligned, so the bytes are copied, not placed.
+  double* target = base + doubles_of<L> * static_cast<std::size_t>(i);
+  // NOLINTNEXTLINE(bugprone-undefined-memory-manipulation)
+  std::memcpy(static_cast<void*>(target), &at, sizeof(L));
+}
+
 }  // namespace pointhaptics::detail

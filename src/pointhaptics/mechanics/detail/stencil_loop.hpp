@@ -172,11 +172,13 @@ void stencil_sum(const Model& model, const Points& u, Workspace& ws, Points& y, 
     else stencil_loop<false>(model, ws.padded_u, ws.gradients, first, last, target, stress);
   };
   const int n_chunks = ws.n_threads();
-  const index_t stencil_end = model.stencil_end();  // passive points: gradients (their neighbours read them), no stencil
+  const index_t stencil_end =
+      model.stencil_end();  // passive points: gradients (their neighbours read them), no stencil
   // every gradient is needed before any stencil's hourglass term (it reads its neighbours' G_j), and
   // every padded u before any gradient
   ws.for_each_chunk([&](int c) { pad_points(u, ws.chunk_begin(c), ws.chunk_end(c), ws.padded_u); });
-  ws.for_each_chunk([&](int c) { gradient_pass(model, ws.padded_u, ws.chunk_begin(c), ws.chunk_end(c), ws.gradients); });
+  ws.for_each_chunk(
+      [&](int c) { gradient_pass(model, ws.padded_u, ws.chunk_begin(c), ws.chunk_end(c), ws.gradients); });
   ws.for_each_chunk([&](int c) {
     PaddedPoints& buffer = ws.chunk_forces[c];
     const index_t lo = ws.scatter_begin(c), hi = ws.scatter_end(c);

@@ -12,7 +12,9 @@ inline constexpr double polar_floor = 1e-6;
 
 /// The scaling g = |det X|^-1/3 of the polar iteration while X is far from orthogonal (det outside (0.5, 2)),
 /// else 1.
-PH_ALWAYS_INLINE inline double polar_scaling(double det) { return det > 0.5 && det < 2 ? 1.0 : std::cbrt(1.0 / std::abs(det)); }
+PH_ALWAYS_INLINE inline double polar_scaling(double det) {
+  return det > 0.5 && det < 2 ? 1.0 : std::cbrt(1.0 / std::abs(det));
+}
 PH_ALWAYS_INLINE inline Lanes polar_scaling(const Lanes& det) {
   Lanes g = Lanes{} + 1.0;
   const LaneMask far = !((det > 0.5) & (det < 2.0));
@@ -53,7 +55,7 @@ inline Mat3 rotation_of(const Mat3& F) {
   if (J > polar_floor) return to_eigen(polar_rotation(to_matrix3(F), J));
   Eigen::JacobiSVD<Mat3> svd(F, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Mat3 U = svd.matrixU();
-  const Mat3 V = svd.matrixV();
+  const Mat3& V = svd.matrixV();
   if ((U * V.transpose()).determinant() < 0) U.col(2) = -U.col(2);  // singular values descend: flip the smallest
   return U * V.transpose();
 }
@@ -129,7 +131,8 @@ struct Corotated : HessianTangent<Corotated> {
     const double sigma_min = std::max(std::sqrt(std::max(s1, 0.0)), J / s3);
     const double pair_min = std::max(0.1, 2 * sigma_min);
     // |tr S - 3|: the singular values lie in [sqrt(s1), sqrt(s3)] when F is not inverted
-    const double trace_bound = J > 0 ? std::max(3 * std::sqrt(s3) - 3, 3 - 3 * std::sqrt(std::max(s1, 0.0))) : 3 * std::sqrt(s3) + 3;
+    const double trace_bound =
+        J > 0 ? std::max(3 * std::sqrt(s3) - 3, 3 - 3 * std::sqrt(std::max(s1, 0.0))) : 3 * std::sqrt(s3) + 3;
     const double now = 2 * mu + 3 * lambda + (lambda * trace_bound + 2 * mu) * 2 / pair_min;
     const double rest = 2 * mu + 3 * lambda + 2 * mu;
     return std::max(1.0, now / rest);

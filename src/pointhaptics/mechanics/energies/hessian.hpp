@@ -100,8 +100,8 @@ struct PowerOfJ {
 /// (neo-Hookean, Mooney-Rivlin); the lanes below the floor (or not finite) are marked in `general`, for the
 /// model's one-point form.
 template <class Material>
-PH_ALWAYS_INLINE inline Matrix3<Lanes> regular_lanes_stress(const Material& material, const Matrix3<Lanes>& G, const Lanes& scale,
-                                                            LaneMask& general) {
+PH_ALWAYS_INLINE inline Matrix3<Lanes> regular_lanes_stress(const Material& material, const Matrix3<Lanes>& G,
+                                                            const Lanes& scale, LaneMask& general) {
   const Lanes jm1 = volume_change(G);
   general = !(1 + jm1 >= PowerOfJ::j_floor);
   return material.regular_stress(G, jm1, scale);

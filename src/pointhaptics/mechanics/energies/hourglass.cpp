@@ -44,11 +44,15 @@ void add_pair_diagonal(const Model& model, index_t i, index_t e, double sign, Pa
 double hourglass_coefficient(const Model& model, index_t i, index_t e, double weight_sum_i, double weight_sum_j) {
   const index_t j = model.neighbours.index[e];
   // each end's share carries its own Young's modulus (per-point materials): a stiff inclusion's pairs are stiff
-  auto share = [&](index_t p, double weight_sum) { return weight_sum > 0 ? model.young_at(p) * model.volume[p] / weight_sum : 0.0; };
+  auto share = [&](index_t p, double weight_sum) {
+    return weight_sum > 0 ? model.young_at(p) * model.volume[p] / weight_sum : 0.0;
+  };
   const double r2 = (model.X.col(j) - model.X.col(i)).squaredNorm();
   // w_ji from j's own support (equal to w_ij with one support for all), so that k_ij = k_ji
   return 0.5 * model.material.hourglass *
-         (pair_weight(model, i, e) * share(i, weight_sum_i) + pair_weight(model, j, model.reverse_pair[e]) * share(j, weight_sum_j)) / r2;
+         (pair_weight(model, i, e) * share(i, weight_sum_i) +
+          pair_weight(model, j, model.reverse_pair[e]) * share(j, weight_sum_j)) /
+         r2;
 }
 
 void build_hourglass(Model& model, const std::vector<double>& weight_sum) {

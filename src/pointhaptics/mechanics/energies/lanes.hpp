@@ -116,7 +116,8 @@ template <class T>
 PH_ALWAYS_INLINE inline Matrix3<T> green_strain(const Matrix3<T>& G) {
   Matrix3<T> E;
   for (int c = 0; c < 3; ++c)
-    for (int r = c; r < 3; ++r) E(r, c) = E(c, r) = 0.5 * (G(r, c) + G(c, r) + G(0, r) * G(0, c) + G(1, r) * G(1, c) + G(2, r) * G(2, c));
+    for (int r = c; r < 3; ++r)
+      E(r, c) = E(c, r) = 0.5 * (G(r, c) + G(c, r) + G(0, r) * G(0, c) + G(1, r) * G(1, c) + G(2, r) * G(2, c));
   return E;
 }
 /// cof F: rows are the cross products of F's rows (deformation.hpp's cofactor).
@@ -221,7 +222,9 @@ PH_ALWAYS_INLINE inline double inverse_cube_root(double J) { return 1 / std::cbr
 /// neo-Hookean stress.
 PH_ALWAYS_INLINE inline Lanes inverse_cube_root(const Lanes& J) {
   const Lanes x = J - 1;
-  Lanes y = 0.99931112135651146 + x * (-0.33390365079123296 + x * (0.24391399229695226 + x * (-0.19397435934763865 + x * 0.079520639421947842)));
+  Lanes y =
+      0.99931112135651146 +
+      x * (-0.33390365079123296 + x * (0.24391399229695226 + x * (-0.19397435934763865 + x * 0.079520639421947842)));
   const LaneMask outside = (J < 0.5) | (J > 2.0);
   if (any_lane(outside)) [[unlikely]]
     for (int k = 0; k < lane_count; ++k)

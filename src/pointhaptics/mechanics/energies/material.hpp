@@ -76,7 +76,9 @@ struct AddedTerms {
 
   bool active() const { return volume.active() || viscous.active(); }
   /// The viscous overstress's term of a step's energy, J/m^3 (0 outside a viscoelastic step).
-  double viscous_energy_density(index_t i, const Mat3& G) const { return viscous.active() ? viscous.energy_density(i, G) : 0.0; }
+  double viscous_energy_density(index_t i, const Mat3& G) const {
+    return viscous.active() ? viscous.energy_density(i, G) : 0.0;
+  }
   double energy_density(index_t i, const Mat3& G) const {
     return (volume.active() ? volume.energy_density(G) : 0.0) + viscous_energy_density(i, G);
   }
@@ -86,7 +88,8 @@ struct AddedTerms {
   }
   /// `projected` keeps the volume's Gauss-Newton part and drops the viscous overstress's term (its sign
   /// follows the history's).
-  PH_ALWAYS_INLINE void add_stress_derivative(index_t i, const Mat3& F, const Mat3& dG, bool projected, Mat3& dP) const {
+  PH_ALWAYS_INLINE void add_stress_derivative(index_t i, const Mat3& F, const Mat3& dG, bool projected,
+                                              Mat3& dP) const {
     if (volume.active()) dP += volume.stress_derivative(F, dG, !projected);
     if (viscous.active() && !projected) dP += viscous.stress_derivative(i, dG);
   }
@@ -99,8 +102,8 @@ struct AddedTerms {
 /// lanes the material's four-point form leaves (`general`: inverted or degenerate neighbourhoods) by the
 /// one-point form, and the added terms when active.
 template <class Energy>
-void complete_lanes(const Energy& energy, index_t i, int count, const Matrix3<Lanes>& G, const Lanes& scale, const LaneMask& general,
-                    Matrix3<Lanes>& P) {
+void complete_lanes(const Energy& energy, index_t i, int count, const Matrix3<Lanes>& G, const Lanes& scale,
+                    const LaneMask& general, Matrix3<Lanes>& P) {
   for (int k = 0; k < count; ++k) {
     Mat3 Gk, Pk;
     for (int e = 0; e < 9; ++e) Gk.data()[e] = G.m[e][k], Pk.data()[e] = P.m[e][k];
@@ -118,7 +121,8 @@ concept FourPointStiffening = requires(const Material& m, const Matrix3<Lanes>& 
 
 /// energy.stiffening(i + k, G_k) in the lanes k < count where `general` is set; the others keep `s`.
 template <class Energy>
-Lanes complete_stiffening(const Energy& energy, index_t i, int count, const Matrix3<Lanes>& G, const LaneMask& general, Lanes s) {
+Lanes complete_stiffening(const Energy& energy, index_t i, int count, const Matrix3<Lanes>& G, const LaneMask& general,
+                          Lanes s) {
   for (int k = 0; k < count; ++k) {
     if (!general[k]) continue;
     Mat3 Gk;
@@ -136,9 +140,13 @@ struct PointEnergy : AddedTerms {
 
   /// The material's energy per unit volume, without the added terms, J/m^3.
   double material_energy_density(index_t, const Mat3& G) const { return material.energy_density(G); }
-  double energy_density(index_t i, const Mat3& G) const { return material_energy_density(i, G) + AddedTerms::energy_density(i, G); }
+  double energy_density(index_t i, const Mat3& G) const {
+    return material_energy_density(i, G) + AddedTerms::energy_density(i, G);
+  }
   /// The material's own first Piola-Kirchhoff stress, without the added terms, Pa, times `scale`.
-  PH_ALWAYS_INLINE Mat3 material_scaled_stress(index_t, const Mat3& G, double scale) const { return material.scaled_stress(G, scale); }
+  PH_ALWAYS_INLINE Mat3 material_scaled_stress(index_t, const Mat3& G, double scale) const {
+    return material.scaled_stress(G, scale);
+  }
   Mat3 material_stress(index_t i, const Mat3& G) const { return material_scaled_stress(i, G, 1.0); }
   /// First Piola-Kirchhoff stress P = dW/dF, Pa, times `scale` (the force loop's v_i).
   PH_ALWAYS_INLINE Mat3 scaled_stress(index_t i, const Mat3& G, double scale) const {
@@ -147,10 +155,12 @@ struct PointEnergy : AddedTerms {
     return P;
   }
   /// The same for the points i .. i + count - 1 (count <= 4) at once (lanes.hpp).
-  PH_ALWAYS_INLINE Matrix3<Lanes> scaled_stress(index_t i, int count, const Matrix3<Lanes>& G, const Lanes& scale) const {
+  PH_ALWAYS_INLINE Matrix3<Lanes> scaled_stress(index_t i, int count, const Matrix3<Lanes>& G,
+                                                const Lanes& scale) const {
     LaneMask general;
     Matrix3<Lanes> P = material.scaled_stress(G, scale, general);
-    if (AddedTerms::active() || any_lane(general)) [[unlikely]] complete_lanes(*this, i, count, G, scale, general, P);
+    if (AddedTerms::active() || any_lane(general)) [[unlikely]]
+      complete_lanes(*this, i, count, G, scale, general, P);
     return P;
   }
   PH_ALWAYS_INLINE Mat3 stress(index_t i, const Mat3& G) const { return scaled_stress(i, G, 1.0); }
@@ -174,7 +184,8 @@ struct PointEnergy : AddedTerms {
     LaneMask general = LaneMask{} - 1;  // every lane
     Lanes s = Lanes{} + 1;
     if constexpr (FourPointStiffening<Material>) s = material.stiffening(G, general);
-    if (any_lane(general)) [[unlikely]] s = complete_stiffening(*this, i, count, G, general, s);
+    if (any_lane(general)) [[unlikely]]
+      s = complete_stiffening(*this, i, count, G, general, s);
     return s;
   }
 };
@@ -197,7 +208,9 @@ struct MixedEnergy : AddedTerms {
   double material_energy_density(index_t i, const Mat3& G) const {
     return visit(i, [&](const auto& m) { return m.energy_density(G); });
   }
-  double energy_density(index_t i, const Mat3& G) const { return material_energy_density(i, G) + AddedTerms::energy_density(i, G); }
+  double energy_density(index_t i, const Mat3& G) const {
+    return material_energy_density(i, G) + AddedTerms::energy_density(i, G);
+  }
   PH_ALWAYS_INLINE Mat3 material_scaled_stress(index_t i, const Mat3& G, double scale) const {
     return visit(i, [&](const auto& m) -> Mat3 { return m.scaled_stress(G, scale); });
   }
@@ -208,12 +221,14 @@ struct MixedEnergy : AddedTerms {
     return P;
   }
   /// Four points at once when they share a material, else lane by lane.
-  PH_ALWAYS_INLINE Matrix3<Lanes> scaled_stress(index_t i, int count, const Matrix3<Lanes>& G, const Lanes& scale) const {
+  PH_ALWAYS_INLINE Matrix3<Lanes> scaled_stress(index_t i, int count, const Matrix3<Lanes>& G,
+                                                const Lanes& scale) const {
     LaneMask general = LaneMask{} - 1;  // every lane
     Matrix3<Lanes> P{};
     if (std::all_of(material_of + i + 1, material_of + i + count, [&](std::uint8_t m) { return m == material_of[i]; }))
       P = visit(i, [&](const auto& m) { return m.scaled_stress(G, scale, general); });
-    if (AddedTerms::active() || any_lane(general)) [[unlikely]] complete_lanes(*this, i, count, G, scale, general, P);
+    if (AddedTerms::active() || any_lane(general)) [[unlikely]]
+      complete_lanes(*this, i, count, G, scale, general, P);
     return P;
   }
   PH_ALWAYS_INLINE Mat3 stress(index_t i, const Mat3& G) const { return scaled_stress(i, G, 1.0); }
@@ -256,9 +271,11 @@ decltype(auto) with_material(const Model& model, const ViscousStep& step, Fn&& f
     mixed.viscous = step.overstress;
     return fn(static_cast<const MixedEnergy&>(mixed));
   }
-  return std::visit([&](const auto& material) -> decltype(auto) {
-    return fn(PointEnergy<std::decay_t<decltype(material)>>{{volume, step.overstress}, material});
-  }, material_constants(model.material, step.shear_factor, bulk_factor));
+  return std::visit(
+      [&](const auto& material) -> decltype(auto) {
+        return fn(PointEnergy<std::decay_t<decltype(material)>>{{volume, step.overstress}, material});
+      },
+      material_constants(model.material, step.shear_factor, bulk_factor));
 }
 
 /// fn(energy) with the model's elastic energy (no viscous step).

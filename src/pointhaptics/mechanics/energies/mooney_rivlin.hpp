@@ -39,8 +39,8 @@ struct MooneyRivlin : HessianTangent<MooneyRivlin> {
     const PowerOfJ g1(J, 2.0 / 3.0), g2(J, 4.0 / 3.0);
     const Mat3 C = F.transpose() * F;
     const double i1 = C.trace(), i2 = 0.5 * (i1 * i1 - (C * C).trace());
-    return scale * (c10 * (g1.first * i1 * cof + 2 * g1.value * F) + c01 * (g2.first * i2 * cof + 2 * g2.value * (i1 * F - F * C)) +
-                    bulk * jm1 * cof);
+    return scale * (c10 * (g1.first * i1 * cof + 2 * g1.value * F) +
+                    c01 * (g2.first * i2 * cof + 2 * g2.value * (i1 * F - F * C)) + bulk * jm1 * cof);
   }
   /// Four points' stresses (hessian.hpp's regular_lanes_stress; the other lanes by the form above).
   PH_ALWAYS_INLINE Matrix3<Lanes> scaled_stress(const Matrix3<Lanes>& G, const Lanes& scale, LaneMask& general) const {
@@ -53,7 +53,8 @@ struct MooneyRivlin : HessianTangent<MooneyRivlin> {
     const Matrix3<T> cof = cofactor(plus_identity(G, 1.0));
     const T y = inverse_cube_root(T(1 + jm1)), g1 = y * y, g2 = g1 * g1;  // std::pow cost a third of the force loop
     const Matrix3<T> E = green_strain(G);
-    const Matrix3<T> inner = T(c10 * g1 + c01 * g2 * (1 + 2 * trace(E))) * deviator(E) - T((2 * c01) * g2) * deviator(symmetric_square(E));
+    const Matrix3<T> inner =
+        T(c10 * g1 + c01 * g2 * (1 + 2 * trace(E))) * deviator(E) - T((2 * c01) * g2) * deviator(symmetric_square(E));
     return T(scale * 4 * (g1 * y)) * (cof * inner) + T(scale * bulk * jm1) * cof;
   }
   PH_ALWAYS_INLINE Mat3 stress(const Mat3& G) const { return scaled_stress(G, 1.0); }
@@ -70,8 +71,10 @@ struct MooneyRivlin : HessianTangent<MooneyRivlin> {
     const double dJ = (cof.array() * dF.array()).sum(), di1 = 2 * (F.array() * dF.array()).sum();
     const double di2 = 2 * (B.array() * dF.array()).sum();
     const Mat3 dB = di1 * F + i1 * dF - dF * C - F * dC;
-    return c10 * ((g1.second * dJ * i1 + g1.first * di1) * cof + g1.first * i1 * dcof + 2 * g1.first * dJ * F + 2 * g1.value * dF) +
-           c01 * ((g2.second * dJ * i2 + g2.first * di2) * cof + g2.first * i2 * dcof + 2 * g2.first * dJ * B + 2 * g2.value * dB) +
+    return c10 * ((g1.second * dJ * i1 + g1.first * di1) * cof + g1.first * i1 * dcof + 2 * g1.first * dJ * F +
+                  2 * g1.value * dF) +
+           c01 * ((g2.second * dJ * i2 + g2.first * di2) * cof + g2.first * i2 * dcof + 2 * g2.first * dJ * B +
+                  2 * g2.value * dB) +
            bulk * (dJ * cof + jm1 * dcof);
   }
 
@@ -90,7 +93,8 @@ struct MooneyRivlin : HessianTangent<MooneyRivlin> {
   /// The C01 (I2bar - 3) terms of |dP| / |dF|, over C01.
   static double second_bound(const Mat3& F, const PowerOfJ& g) {
     const double i1 = F.squaredNorm(), f = std::sqrt(i1), c = cofactor(F).norm(), i2 = i1 * i1 / 3, b = 2 * i1 * f;
-    return 12 * i1 * g.value + std::abs(g.second) * i2 * c * c + std::abs(g.first) * (2 * b * c + 2 * i2 * f + 2 * c * b);
+    return 12 * i1 * g.value + std::abs(g.second) * i2 * c * c +
+           std::abs(g.first) * (2 * b * c + 2 * i2 * f + 2 * c * b);
   }
 };
 

@@ -61,7 +61,8 @@ struct NeoHookean : HessianTangent<NeoHookean> {
     const PowerOfJ g(J, 2.0 / 3.0);
     const double i1 = (F.array() * F.array()).sum();
     const double dJ = (cof.array() * dF.array()).sum(), di1 = 2 * (F.array() * dF.array()).sum();
-    return c10() * ((g.second * dJ * i1 + g.first * di1) * cof + g.first * i1 * dcof + 2 * g.first * dJ * F + 2 * g.value * dF) +
+    return c10() * ((g.second * dJ * i1 + g.first * di1) * cof + g.first * i1 * dcof + 2 * g.first * dJ * F +
+                    2 * g.value * dF) +
            bulk * (dJ * cof + jm1 * dcof);
   }
 

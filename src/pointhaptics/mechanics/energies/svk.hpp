@@ -13,7 +13,9 @@ struct StVenantKirchhoff {
   double lambda = 0, mu = 0;  ///< Lame's parameters, Pa
 
   /// Second Piola-Kirchhoff stress S(E), Pa.
-  PH_ALWAYS_INLINE Mat3 second_piola(const Mat3& E) const { return lambda * E.trace() * Mat3::Identity() + 2.0 * mu * E; }
+  PH_ALWAYS_INLINE Mat3 second_piola(const Mat3& E) const {
+    return lambda * E.trace() * Mat3::Identity() + 2.0 * mu * E;
+  }
 
   /// Energy per unit reference volume, J/m^3.
   double energy_density(const Mat3& G) const {
@@ -29,7 +31,9 @@ struct StVenantKirchhoff {
     const Matrix3<T> S = plus_identity((2.0 * mu) * E, T(lambda * trace(E)));
     return scale * (plus_identity(G, 1.0) * S);
   }
-  PH_ALWAYS_INLINE Mat3 scaled_stress(const Mat3& G, double scale) const { return to_eigen(scaled_stress(to_matrix3(G), scale)); }
+  PH_ALWAYS_INLINE Mat3 scaled_stress(const Mat3& G, double scale) const {
+    return to_eigen(scaled_stress(to_matrix3(G), scale));
+  }
   /// Four points' stresses (every lane is handled: `general` is left clear).
   PH_ALWAYS_INLINE Matrix3<Lanes> scaled_stress(const Matrix3<Lanes>& G, const Lanes& scale, LaneMask& general) const {
     general = LaneMask{};
