@@ -379,8 +379,12 @@ RawCloud parse_ply(std::string_view data, const std::string& name) {
             throw Error(fmt::format("{}: truncated in element \"{}\"", name, elements[e].name));
           const double c = load_binary(p.count_type, bytes + at, swap);
           if (!(c >= 0)) throw Error(fmt::format("{}: negative list length in element \"{}\"", name, elements[e].name));
-          n = static_cast<std::uint64_t>(c);
           at += ply_size(p.count_type);
+          // a count (of a float type, say) beyond what the bytes left can hold is refused before it is
+          // converted: 1e25 has no 64-bit integer value
+          if (c > static_cast<double>((data.size() - at) / ply_size(p.type)))
+            throw Error(fmt::format("{}: truncated in element \"{}\"", name, elements[e].name));
+          n = static_cast<std::uint64_t>(c);
         }
         if (n > (data.size() - at) / ply_size(p.type))
           throw Error(fmt::format("{}: truncated in element \"{}\"", name, elements[e].name));
