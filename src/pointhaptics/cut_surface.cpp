@@ -111,6 +111,11 @@ class SheetGrid {
   }
 
  private:
+  std::size_t flat_index(index_t i, index_t j, index_t k) const {
+    const auto size = [](index_t v) { return static_cast<std::size_t>(v); };
+    return size(i) + size(cells_[0]) * (size(j) + size(cells_[1]) * size(k));
+  }
+
   template <class Fn>
   void for_cells(const Box& b, Fn&& fn) const {
     index_t first[3], last[3];
@@ -122,7 +127,7 @@ class SheetGrid {
     }
     for (index_t k = first[2]; k <= last[2]; ++k)
       for (index_t j = first[1]; j <= last[1]; ++j)
-        for (index_t i = first[0]; i <= last[0]; ++i) fn(static_cast<std::size_t>(i + cells_[0] * (j + cells_[1] * k)));
+        for (index_t i = first[0]; i <= last[0]; ++i) fn(flat_index(i, j, k));
   }
 
   std::span<const SheetTriangle> sheets_;
@@ -254,12 +259,12 @@ void add_sheet_faces(const TriangleMesh& mesh, std::span<const SheetTriangle> sh
       return t[0] + (static_cast<double>(i) / static_cast<double>(k)) * (t[1] - t[0]) +
              (static_cast<double>(j) / static_cast<double>(k)) * (t[2] - t[0]);
     };
-    d.assign(static_cast<std::size_t>(row * row), 0.0);
+    d.assign(static_cast<std::size_t>(row) * static_cast<std::size_t>(row), 0.0);
     tbb::parallel_for(index_t{0}, row, [&](index_t i) {
       for (index_t j = 0; i + j <= k; ++j)
         d[static_cast<std::size_t>(id(i, j))] = distance.signed_distance(position(i, j));
     });
-    grid_vertex.assign(static_cast<std::size_t>(row * row), {-1, -1});
+    grid_vertex.assign(static_cast<std::size_t>(row) * static_cast<std::size_t>(row), {-1, -1});
     edge_vertex.clear();
     auto pair_at = [&](const Vec3& p) -> std::array<index_t, 2> {
       return {out.add(p, p + offset * n), out.add(p, p - offset * n)};

@@ -102,7 +102,8 @@ ContactSamples contact_samples(const TriangleMesh& mesh, double max_edge) {
   const auto samples = static_cast<index_t>(position.size()) - n;
   out.Y.resize(3, samples);
   out.samples.assign(combination.begin() + n, combination.end());
-  for (index_t k = 0; k < samples; ++k) out.Y.col(k) = position[static_cast<std::size_t>(n + k)];
+  for (index_t k = 0; k < samples; ++k)
+    out.Y.col(k) = position[static_cast<std::size_t>(n) + static_cast<std::size_t>(k)];
   return out;
 }
 

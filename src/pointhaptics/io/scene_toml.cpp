@@ -130,7 +130,7 @@ void apply_setting(toml::table& root, const SceneSetting& s, const std::string& 
     const bool last = k + 1 == parts.size();
     if (toml::table* table = at->as_table()) {
       if (last) {
-        value.get("value")->visit([&](auto&& v) { table->insert_or_assign(part, std::move(v)); });
+        value.get("value")->visit([&](auto& v) { table->insert_or_assign(part, std::move(v)); });
         return;
       }
       if (!table->get(part)) table->insert(part, toml::table{});
@@ -142,7 +142,7 @@ void apply_setting(toml::table& root, const SceneSetting& s, const std::string& 
         throw bad(fmt::format("\"{}\" is not an index of the array (it has {} entries)", part, array->size()));
       if (last) {
         value.get("value")->visit(
-            [&](auto&& v) { array->replace(array->cbegin() + static_cast<std::ptrdiff_t>(index), std::move(v)); });
+            [&](auto& v) { array->replace(array->cbegin() + static_cast<std::ptrdiff_t>(index), std::move(v)); });
         return;
       }
       at = array->get(index);

@@ -12,7 +12,10 @@ struct VolumeImage {
   index_t nx = 0, ny = 0, nz = 0;
   Eigen::Matrix4d voxel_to_world = Eigen::Matrix4d::Identity();  ///< voxel index (i, j, k, 1) -> position, m
   std::vector<float> values;                                     ///< scaled intensities, i fastest  (nx ny nz)
-  double at(index_t i, index_t j, index_t k) const { return values[static_cast<std::size_t>(i + nx * (j + ny * k))]; }
+  double at(index_t i, index_t j, index_t k) const {
+    const auto size = [](index_t v) { return static_cast<std::size_t>(v); };  // 512M voxels overflow index_t
+    return values[size(i) + size(nx) * (size(j) + size(ny) * size(k))];
+  }
 };
 
 /// Read a 3-D image: NIfTI-1/2 (the sform, else the qform, else the voxel sizes; units from xyzt_units,

@@ -68,7 +68,7 @@ VtkSeries::VtkSeries(std::string folder, std::string base) : folder_(std::move(f
 
 std::string VtkSeries::add(double time, const Points& points, const std::vector<VtkArray>& arrays) {
   const std::string name = fmt::format("{}_{:06d}.vtp", base_, frames_);
-  const std::string path = (std::filesystem::path(folder_) / name).string();
+  std::string path = (std::filesystem::path(folder_) / name).string();
   write_vtp(path, points, arrays);
   entries_.push_back({time, 0, name});
   ++frames_;
@@ -80,7 +80,7 @@ std::string VtkSeries::add_surface(const Points& vertices, const VtkTriangles& t
                                    const std::vector<VtkArray>& arrays) {
   if (frames_ == 0) throw Error(fmt::format("{}: a surface needs its frame first", pvd_));
   const std::string name = fmt::format("{}_surface_{:06d}.vtp", base_, frames_ - 1);
-  const std::string path = (std::filesystem::path(folder_) / name).string();
+  std::string path = (std::filesystem::path(folder_) / name).string();
   write_vtp(path, vertices, arrays, triangles);
   entries_.push_back({entries_.back().time, 1, name});
   write_collection();

@@ -158,6 +158,7 @@ CutReport sever_pairs(Model& model, const std::vector<index_t>& pairs, bool keep
   report.refitted_stencils = static_cast<index_t>(stencils.size());
   // the weight sums of the changed pairs' ends (every end is the first of some changed pair), each once
   std::vector<std::pair<index_t, double>> weight_sum;
+  weight_sum.reserve(changed.size());
   for (const auto& [i, e] : changed) weight_sum.emplace_back(i, 0.0);
   std::sort(weight_sum.begin(), weight_sum.end());
   weight_sum.erase(std::unique(weight_sum.begin(), weight_sum.end(),
