@@ -18,6 +18,7 @@
 #include <array>
 #include <cmath>
 #include <memory>
+#include <csignal>
 #include <mutex>
 #include <optional>
 
@@ -98,6 +99,60 @@ struct PySimulation {
     return *surface;
   }
 };
+
+// Ctrl-C during a long call (step, run, probe, a static solve), which runs with the GIL released: Python's own
+// handler would only run once the call returned, so the call puts in one that asks the library to stop
+// (run_control.hpp: every loop polls it, within 0.1 s), and raises KeyboardInterrupt when it has. Signals reach
+// only the main thread's handlers; calls on other threads keep Python's.
+extern "C" void stop_on_interrupt(int) { ph::request_stop(); }
+
+class InterruptibleCall {
+ public:
+  InterruptibleCall() {
+    ph::clear_stop_request();
+    if (PyThread_get_thread_ident() != main_thread_ident) return;
+    struct sigaction ours {};
+    ours.sa_handler = stop_on_interrupt;
+    sigemptyset(&ours.sa_mask);
+    installed_ = sigaction(SIGINT, &ours, &python_) == 0;
+  }
+  ~InterruptibleCall() {
+    if (installed_) sigaction(SIGINT, &python_, nullptr);
+  }
+  InterruptibleCall(const InterruptibleCall&) = delete;
+  InterruptibleCall& operator=(const InterruptibleCall&) = delete;
+  /// After the call, with the GIL held: KeyboardInterrupt if it was stopped (the object stays usable).
+  void raise_if_stopped(bool stopped) {
+    if (!stopped && !ph::stop_requested()) return;
+    ph::clear_stop_request();
+    PyErr_SetNone(PyExc_KeyboardInterrupt);
+    throw py::error_already_set();
+  }
+  static inline unsigned long main_thread_ident = 0;
+
+ private:
+  bool installed_ = false;
+  struct sigaction python_ {};
+};
+
+// A long call on the object: Ctrl-C stops it (InterruptibleCall), the GIL is released and the object's lock held
+template <class Work>
+void long_call(PySimulation& p, Work&& work) {
+  InterruptibleCall call;
+  bool stopped = false;
+  {
+    py::gil_scoped_release release;
+    const std::lock_guard<std::mutex> lock(p.mutex);
+    try {
+      stopped = work();
+    } catch (const ph::Interrupted&) {
+      stopped = true;
+    }
+    p.carry_surface();
+  }
+  call.raise_if_stopped(stopped);
+  if (p.sim->diagnostics().failed) throw ph::Error(p.sim->diagnostics().failure);
+}
 
 // The object's lock for a call that holds the GIL: waiting for it (a step on another thread may hold it
 // for long) releases the GIL, so that the holder, which never takes the GIL while holding the lock, can
@@ -231,6 +286,16 @@ std::unique_ptr<PySimulation> from_points(const RowPoints& X, double spacing, py
 PYBIND11_MODULE(_pointhaptics, m) {
   m.doc() = "PointHaptics: meshless (MLS) deformable objects for haptic rendering";
   py::register_exception<ph::Error>(m, "Error", PyExc_ValueError);
+  // NumPy's C API, looked up now, with the GIL held and no other thread in this module: pybind11 looks it up on
+  // first use behind a static guard, and a first use by a thread while another waited for the object's lock
+  // deadlocked (issue 52: the guard's holder needed the GIL that the waiter held)
+  py::module_::import("numpy");
+  (void)py::detail::npy_api::get();
+  (void)py::array_t<double>(0);
+  (void)py::array_t<long long>(0);
+  (void)py::array_t<bool>(0);
+  InterruptibleCall::main_thread_ident =
+      py::module_::import("threading").attr("main_thread")().attr("ident").cast<unsigned long>();
 
   m.attr("__version__") = "0.1.0";
   m.def(
@@ -312,10 +377,11 @@ names the problem.)doc")
       .def(
           "step",
           [](PySimulation& p) {
-            py::gil_scoped_release release;
-            const std::lock_guard<std::mutex> lock(p.mutex);
-            const ph::StepReport report = p.sim->step();
-            p.carry_surface();
+            ph::StepReport report;
+            long_call(p, [&] {
+              report = p.sim->step();
+              return false;
+            });
             raise_if_failed(report);
           },
           "Advance by one solver step: dt of explicit dynamics (sub-stepped below the stable step) or implicit "
@@ -324,12 +390,14 @@ names the problem.)doc")
       .def(
           "run",
           [](PySimulation& p, double duration) {
-            if (!(duration >= 0)) throw ph::Error("run: duration must be >= 0 (s)");
-            py::gil_scoped_release release;
-            const std::lock_guard<std::mutex> lock(p.mutex);
-            p.sim->run(duration);
-            p.carry_surface();
-            if (p.sim->diagnostics().failed) throw ph::Error(p.sim->diagnostics().failure);
+            {
+              const auto lock = locked(p);
+              p.sim->steps_in(duration);  // a duration that is not one, or too long, is refused before anything runs
+            }
+            long_call(p, [&] {
+              p.sim->run(duration);
+              return false;
+            });
           },
           py::arg("duration"),
           "Step until `duration` seconds more have passed (static: solve once); stops at a failed step and raises "
@@ -462,20 +530,19 @@ names the problem.)doc")
           [](PySimulation& p) {
             if (!p.from_scene)
               throw ph::Error("run_scene: this Simulation was made from_points; it has no scene to run");
-            py::gil_scoped_release release;
-            const std::lock_guard<std::mutex> lock(p.mutex);
-            if (p.scene.probe.present && !p.scene.probe.held()) {
-              // a device's probe: its session in simulated time (`pointhaptics run --deterministic`)
-              const std::unique_ptr<ph::Device> device = ph::make_scene_device(p.scene);
-              ph::InteractiveOptions options = p.interactive;
-              options.real_time = false;
-              options.log = false;
-              p.last_session = ph::run_interactive(*p.sim, *device, options);
-            } else {
+            long_call(p, [&] {
+              if (p.scene.probe.present && !p.scene.probe.held()) {
+                // a device's probe: its session in simulated time (`pointhaptics run --deterministic`)
+                const std::unique_ptr<ph::Device> device = ph::make_scene_device(p.scene);
+                ph::InteractiveOptions options = p.interactive;
+                options.real_time = false;
+                options.log = false;
+                p.last_session = ph::run_interactive(*p.sim, *device, options);
+                return p.last_session->interrupted;
+              }
               p.sim->run(p.scene.solver.duration);
-            }
-            p.carry_surface();
-            if (p.sim->diagnostics().failed) throw ph::Error(p.sim->diagnostics().failure);
+              return false;
+            });
           },
           "Run the scene as `pointhaptics run --deterministic` does: solver.duration seconds of dynamics, or the static "
           "solve, or with a device's [probe] its session in simulated time. Raises pointhaptics.Error on a failed step; "
@@ -567,15 +634,12 @@ names the problem.)doc")
             ph::InteractiveOptions o = ph::scene_interactive_options(scene, p.sim->model());
             o.real_time = real_time;
             ph::InteractiveResult r;
-            {
-              py::gil_scoped_release release;
-              const std::lock_guard<std::mutex> lock(p.mutex);
+            long_call(p, [&] {
               // the probe pushes on the object's surface (with levels of detail, on the part the active set carries)
               o.surface = std::make_shared<const ph::ObjectSurface>(p.object_surface());
               r = ph::run_interactive(*p.sim, device, o);
-              p.carry_surface();
-            }
-            if (p.sim->diagnostics().failed) throw ph::Error(p.sim->diagnostics().failure);
+              return r.interrupted;
+            });
             // the columns of --force-log: t, x, y, z, vx, vy, vz, buttons, fx, fy, fz, tx, ty, tz
             py::array_t<double> log({static_cast<py::ssize_t>(r.log.size()), py::ssize_t{14}});
             auto w = log.mutable_unchecked<2>();

@@ -134,9 +134,14 @@ void print_summary(ph::Simulation& sim, const ph::RunSummary& s, double setup_s)
         setup_s, s.wall_s, s.step_ms_mean, s.step_ms_max, s.steps_per_s);
 }
 
-// SIGINT or SIGTERM during a run: stop at the next step and write what was reached (issue 21)
+// SIGINT or SIGTERM during a run: every loop of the set-up and of the steps polls the stop request
+// (run_control.hpp), so that it is honoured within 0.1 s wherever the time goes, and what was reached is
+// written (issues 21 and 52)
 std::atomic<bool> interrupted{false};
-extern "C" void on_interrupt(int) { interrupted.store(true); }
+extern "C" void on_interrupt(int) {
+  interrupted.store(true);
+  ph::request_stop();
+}
 
 // An output that fails (a full disk) is reported, and the others are still written
 struct OutputErrors {
@@ -164,24 +169,53 @@ int run_command(const RunOptions& opt) {
   session_options.threads = opt.threads;
   session_options.max_memory = static_cast<double>(opt.max_memory);
   for (const std::string& setting : opt.settings) session_options.settings.push_back(ph::parse_scene_setting(setting));
-  ph::SceneSession session = ph::open_scene_file(opt.scene, session_options);
-  const ph::Scene& scene = session.scene;
-  ph::Simulation& sim = *session.simulation;
-  const double setup_s = session.setup_seconds;
+  // from here a signal stops the run where it is, the set-up included; long work is announced and shown
+  interrupted.store(false);
+  ph::clear_stop_request();
+  std::signal(SIGINT, on_interrupt);
+  std::signal(SIGTERM, on_interrupt);
+  ph::cli::PhaseProgress progress(opt.scene, !opt.quiet);
+  ph::set_progress_sink(&progress);
+  struct Restore {
+    ~Restore() {
+      ph::set_progress_sink(nullptr);
+      std::signal(SIGINT, SIG_DFL);
+      std::signal(SIGTERM, SIG_DFL);
+    }
+  } restore;
+  std::optional<ph::SceneSession> opened;
   // the object's surface, for --surface and the ParaView frames, built before the run (a reconstruction
   // too fine for the machine is refused at once)
   // (after cuts, split along them: cut_surface.hpp)
   std::optional<ph::CutSurface> surface;
-  if (!opt.surface.empty() || vtk) surface.emplace(ph::build_object_surface(scene, sim.model()));
+  try {
+    opened.emplace(ph::open_scene_file(opt.scene, session_options));
+    if (!opt.surface.empty() || vtk)
+      surface.emplace(ph::build_object_surface(opened->scene, opened->simulation->model()));
+  } catch (const ph::Interrupted& e) {
+    // stopped in the set-up: the result says so, with the model if there is one
+    progress.finish();
+    ph::RunSummary summary;
+    summary.interrupted = true;
+    summary.failure = e.what();
+    if (!opt.json.empty()) {
+      if (opened) ph::write_result_json(opt.json, opened->simulation->model(), opened->simulation->state(), summary);
+      else ph::write_result_json(opt.json, ph::Model{}, ph::State{}, summary);
+    }
+    fmt::print(stderr, "pointhaptics: {}: {} (the set-up){}\n", opt.scene, e.what(),
+               opened ? "" : "; no model was built");
+    return 130;
+  }
+  ph::SceneSession& session = *opened;
+  const ph::Scene& scene = session.scene;
+  ph::Simulation& sim = *session.simulation;
+  const double setup_s = session.setup_seconds;
   auto vtk_surface = [&]() -> const ph::ObjectSurface* {
     return surface ? &surface->at(sim.model(), sim.cut_sheets()) : nullptr;
   };
   if (vtk) ph::add_vtk_frame(*vtk, sim, vtk_surface());  // the initial state
   const double start_time = sim.time();
   const bool options_real_time = !opt.deterministic;
-  interrupted.store(false);
-  std::signal(SIGINT, on_interrupt);
-  std::signal(SIGTERM, on_interrupt);
   ph::InteractiveResult interactive;
   OutputErrors errors;
   // a probe driven by a device runs the haptic loop; a tool held at a position is part of the scene's solve
@@ -214,40 +248,46 @@ int run_command(const RunOptions& opt) {
   } else {
     ph::cli::ProgressBar bar(!opt.quiet);
     const auto stepping = std::chrono::steady_clock::now();
+    const long long n_steps = sim.steps_in(scene.solver.duration);
+    const bool explicit_steps = scene.solver.kind == ph::SolverKind::EXPLICIT;
+    long long steps_done = 0;
     bool estimated = false;
-    sim.run(scene.solver.duration, [&](long long step, long long n_steps) {
-      bar.update(static_cast<double>(step) / static_cast<double>(n_steps));
-      // after a second, a run that will take long says so, with what it costs and what would be faster
+    // `done`: steps done, a long step's share of its sub-steps included. After a second, a run that will take
+    // long says so, with what it costs and what would be faster: within its first step if that is long
+    const auto observe = [&](double done) {
+      bar.update(done / static_cast<double>(n_steps));
       const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - stepping).count();
-      if (!estimated && elapsed > 1.0 && step < n_steps) {
-        estimated = true;
-        const double total = elapsed / static_cast<double>(step) * static_cast<double>(n_steps);
-        if (total > 60) {
-          const ph::RunSummary so_far = sim.summary();
-          const bool stiff = scene.solver.kind == ph::SolverKind::EXPLICIT && so_far.substeps > 4 * so_far.steps;
-          fmt::print(
-              stderr,
-              "pointhaptics: {}: this run will take about {} ({} steps of {:.3g} s at {:.3g} ms each{}){}; Ctrl-C "
-              "stops it and writes the state reached\n",
-              opt.scene, total < 7200 ? fmt::format("{:.0f} min", total / 60) : fmt::format("{:.1f} h", total / 3600),
-              n_steps, scene.solver.dt, 1e3 * elapsed / static_cast<double>(step),
-              scene.solver.kind == ph::SolverKind::EXPLICIT
-                  ? fmt::format(", {:.0f} sub-steps each below the stable step {:.3g} s",
-                                static_cast<double>(so_far.substeps) / static_cast<double>(so_far.steps),
-                                so_far.stable_dt)
-                  : std::string(),
-              stiff ? "; a stiff object: solver.kind = \"implicit\" takes steps of any size" : "");
-        }
-      }
-      // frames: every vtk_every steps (default: about 50 over the run), and the last state below
-      const long long every = opt.vtk_every > 0 ? opt.vtk_every : std::max<long long>(1, n_steps / 50);
-      if (vtk && step % every == 0 && step < n_steps)
-        errors.attempt([&] { ph::add_vtk_frame(*vtk, sim, vtk_surface()); });
-      return !interrupted.load();
-    });
+      if (estimated || elapsed <= 1.0 || !(done > 0) || done >= static_cast<double>(n_steps)) return;
+      estimated = true;
+      const double total = elapsed / done * static_cast<double>(n_steps);
+      if (total <= 60) return;
+      const double stable = explicit_steps ? sim.stable_dt() : 0.0;
+      bar.finish();
+      fmt::print(stderr,
+                 "pointhaptics: {}: this run will take about {} ({} steps of {:.3g} s at {} each{}){}; Ctrl-C stops it "
+                 "and writes the state reached\n",
+                 opt.scene, ph::format_duration(total), n_steps, scene.solver.dt, ph::format_duration(elapsed / done),
+                 explicit_steps ? fmt::format(", in sub-steps below the stable step {:.3g} s", stable) : std::string(),
+                 explicit_steps && scene.solver.dt > 4 * stable
+                     ? "; a stiff object: solver.kind = \"implicit\" takes steps of any size"
+                     : "");
+    };
+    progress.within_step = [&](double fraction) { observe(static_cast<double>(steps_done) + fraction); };
+    try {
+      sim.run(scene.solver.duration, [&](long long step, long long /*n_steps*/) {
+        steps_done = step;
+        observe(static_cast<double>(step));
+        // frames: every vtk_every steps (default: about 50 over the run), and the last state below
+        const long long every = opt.vtk_every > 0 ? opt.vtk_every : std::max<long long>(1, n_steps / 50);
+        if (vtk && step % every == 0 && step < n_steps)
+          errors.attempt([&] { ph::add_vtk_frame(*vtk, sim, vtk_surface()); });
+        return !interrupted.load();
+      });
+    } catch (const ph::Interrupted&) {
+      // inside a step: the state is the step's start (Newton) or its last sub-step (explicit)
+    }
+    progress.within_step = nullptr;
   }
-  std::signal(SIGINT, SIG_DFL);
-  std::signal(SIGTERM, SIG_DFL);
   // the last state (an interactive run writes only the first and the last)
   if (vtk) errors.attempt([&] { ph::add_vtk_frame(*vtk, sim, vtk_surface()); });
   if (!opt.csv.empty()) errors.attempt([&] { ph::write_points_csv(opt.csv, sim); });
@@ -257,7 +297,7 @@ int run_command(const RunOptions& opt) {
       ph::write_mesh(opt.surface, ph::TriangleMesh{ph::deformed_surface(cut, sim.state().u), cut.mesh.F}, "--surface");
     });
   ph::RunSummary summary = sim.summary();
-  summary.interrupted = interrupted.load();
+  summary.interrupted = interrupted.load() || interactive.interrupted;
   if (haptic) ph::add_interactive_summary(summary, interactive);
   if (!opt.json.empty()) errors.attempt([&] { ph::write_result_json(opt.json, sim.model(), sim.state(), summary); });
   if (!opt.quiet) {

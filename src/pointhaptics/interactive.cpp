@@ -1,5 +1,6 @@
 #include <pointhaptics/interactive.hpp>
 
+#include <pointhaptics/core/run_control.hpp>
 #include <pointhaptics/haptics/haptic_log.hpp>
 #include <pointhaptics/haptics/local_model_stray.hpp>
 
@@ -87,7 +88,9 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
     if (streamed) loop.take_log(options.log_sink);
     else if (options.log) loop.take_log([&](const HapticLogRow& row) { result.log.push_back(row); });
   };
-  const auto stopped = [&options] { return options.stop && options.stop->load(std::memory_order_acquire); };
+  const auto stopped = [&options] {
+    return stop_requested() || (options.stop && options.stop->load(std::memory_order_acquire));
+  };
   const auto start = std::chrono::steady_clock::now();
   const double t0 = sim.time();
   // display frames: at most one per display_period (of wall time in real time, else of simulated time),
@@ -103,38 +106,49 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
     last_display_step = result.simulation_steps;
     publish_display(sim, loop.frames().front(), result.simulation_steps - 1, *options.display);
   };
-  if (options.real_time) {
-    loop.start();
-    for (;;) {
-      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      if (wall >= options.duration || loop.device_failed() || stopped() || sim.diagnostics().failed) break;
-      if (sim.time() - t0 > wall) {  // ahead of the wall clock: wait for it
-        std::this_thread::sleep_for(std::chrono::duration<double>(sim.time() - t0 - wall));
-        continue;
-      }
-      result.max_contacts = std::max(result.max_contacts, simulation_step(sim, loop, stray));
-      ++result.simulation_steps;
-      display(false);
-      take_log();
-      if (options.after_step) options.after_step(result.simulation_steps);
-    }
-    loop.stop();
-  } else {
-    const double h = 1.0 / options.haptic_rate;
-    if (!std::isfinite(options.duration)) throw Error("interactive run: a deterministic run needs a finite duration");
-    const auto n_ticks = static_cast<long long>(std::llround(options.duration * options.haptic_rate));
-    for (long long k = 1; k <= n_ticks && !stopped() && !sim.diagnostics().failed; ++k) {
-      const double t = k * h;
-      if (!loop.tick(t, h)) break;
-      take_log();
-      while (sim.time() - t0 < t - 1e-12 && !sim.diagnostics().failed) {
+  // a stop requested inside a step ends the run there (the state is that of the step's start, or of its last
+  // explicit sub-step); the haptic loop is stopped either way
+  try {
+    if (options.real_time) {
+      loop.start();
+      for (;;) {
+        const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (wall >= options.duration || loop.device_failed() || stopped() || sim.diagnostics().failed) break;
+        if (sim.time() - t0 > wall) {  // ahead of the wall clock: wait for it
+          std::this_thread::sleep_for(std::chrono::duration<double>(sim.time() - t0 - wall));
+          continue;
+        }
         result.max_contacts = std::max(result.max_contacts, simulation_step(sim, loop, stray));
         ++result.simulation_steps;
         display(false);
+        take_log();
         if (options.after_step) options.after_step(result.simulation_steps);
       }
+      loop.stop();
+    } else {
+      const double h = 1.0 / options.haptic_rate;
+      if (!(options.duration >= 0) || !(options.duration * options.haptic_rate <= Simulation::max_run_steps))
+        throw Error(
+            fmt::format("interactive run: a deterministic run needs a finite duration of at most {:.3g} s (not "
+                        "{:.6g} s)",
+                        Simulation::max_run_steps / options.haptic_rate, options.duration));
+      const auto n_ticks = static_cast<long long>(std::llround(options.duration * options.haptic_rate));
+      for (long long k = 1; k <= n_ticks && !stopped() && !sim.diagnostics().failed; ++k) {
+        const double t = k * h;
+        if (!loop.tick(t, h)) break;
+        take_log();
+        while (sim.time() - t0 < t - 1e-12 && !sim.diagnostics().failed) {
+          result.max_contacts = std::max(result.max_contacts, simulation_step(sim, loop, stray));
+          ++result.simulation_steps;
+          display(false);
+          if (options.after_step) options.after_step(result.simulation_steps);
+        }
+      }
     }
+  } catch (const Interrupted&) {
+    loop.stop();
   }
+  result.interrupted = stopped();
   display(true);
   result.simulation_wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   result.haptic = loop.stats();

@@ -71,6 +71,7 @@ struct InteractiveResult {
   int max_contacts = 0;
   ToolSummary tool;               ///< the probe at the end (the result JSON's tool block)
   LocalModelSummary local_model;  ///< how far each local model strayed from the next update
+  bool interrupted = false;       ///< a stop was requested (run_control.hpp): the run ended at the state reached
 };
 
 /// Run the simulation with a probe driven by `device` for options.duration. Real time: the haptic loop
@@ -79,7 +80,8 @@ struct InteractiveResult {
 /// lock-free buffers. Deterministic (real_time = false): the same exchange, interleaved on one thread in
 /// simulated time (a haptic tick every 1/rate s, a simulation step every dt), for tests and experiments.
 /// A device that fails stops the run with zero force; the result says so. A step that fails stops the run
-/// (sim.diagnostics() says why). Throws Error on bad options.
+/// (sim.diagnostics() says why). A stop request (options.stop, or request_stop() from anywhere, honoured inside
+/// a step too) ends the run at the state reached, with `interrupted` set. Throws Error on bad options.
 InteractiveResult run_interactive(Simulation& sim, Device& device, const InteractiveOptions& options);
 
 /// A run's summary with its interactive session's: the probe's tool block and the haptic loop's figures.

@@ -1,6 +1,8 @@
 #pragma once
 /// @file The public API in one include: scenes, models, the simulation and its results.
 #include <pointhaptics/core/error.hpp>
+#include <pointhaptics/core/memory_limit.hpp>
+#include <pointhaptics/core/run_control.hpp>
 #include <pointhaptics/core/model.hpp>
 #include <pointhaptics/core/state.hpp>
 #include <pointhaptics/io/output_file.hpp>

@@ -8,21 +8,24 @@ namespace pointhaptics {
 
 /// What a model of n points will take, estimated before anything is built: neighbours per point from the
 /// support (4/3 pi (h / spacing)^3 on a lattice) and bytes (measured: about 400 B per point and 50 B per
-/// neighbour pair, model, state and solver scratch together; 2 kB per point at h = 2 spacings).
+/// neighbour pair, model, state and solver scratch together; 2 kB per point at h = 2 spacings) and the
+/// set-up's seconds (measured on 2 cores: 3e-8 s per point per neighbour^1.5, from the search to the stable
+/// step).
 struct ModelEstimate {
   double points = 0;
   double neighbours_per_point = 0;
   double bytes = 0;
+  double setup_seconds = 0;
 };
 ModelEstimate estimate_model(double n_points, const KernelParams& kernel, double spacing);
 /// The points the scene's object will have, before it is sampled: exact for a box, the volume over
 /// spacing^3 for a sphere or half-sphere; NaN for a file (known once read).
 double estimated_points(const Scene& scene);
-/// Memory the system can give this process now (MemAvailable of /proc/meminfo), bytes; infinity if unknown.
-double available_memory();
 /// Throws Error with the estimate if a model of n points would need more than max_memory bytes (0: the
-/// available memory): a run too big for the machine is refused before it allocates.
-void check_model_fits(double n_points, const Scene& scene, double max_memory);
+/// memory this process may still take, memory_limit(), naming the limit that binds): a run too big for the
+/// machine is refused before it allocates. A set-up estimated to take more than 2 s is announced
+/// (run_control.hpp) with its seconds and bytes.
+void check_model_fits(double n_points, const Scene& scene, double max_memory, bool announce_setup = true);
 
 /// Whether an object file is a point cloud (.xyz, .csv, .txt, or a .ply without faces) rather than a surface
 /// mesh or a volume image.

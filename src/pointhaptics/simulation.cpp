@@ -98,10 +98,19 @@ void Simulation::apply_scripted_cuts() {
   }
 }
 
-void Simulation::run(double duration, const std::function<bool(long long, long long)>& after_step) {
+long long Simulation::steps_in(double duration) const {
   const SolverSpec& spec = solver();
-  const long long n_steps =
-      spec.kind == SolverKind::STATIC ? 1 : std::max<long long>(0, std::llround(std::ceil(duration / spec.dt - 1e-9)));
+  if (spec.kind == SolverKind::STATIC) return 1;
+  const double steps = std::ceil(duration / spec.dt - 1e-9);
+  if (!(duration >= 0) || !(steps <= max_run_steps))
+    throw Error(fmt::format("run: a duration of {:.6g} s is {} (at most {:.0e} steps of dt = {:.3g} s, {:.3g} s)",
+                            duration, duration >= 0 ? "too long" : "not a duration", max_run_steps, spec.dt,
+                            max_run_steps * spec.dt));
+  return std::max<long long>(0, std::llround(steps));
+}
+
+void Simulation::run(double duration, const std::function<bool(long long, long long)>& after_step) {
+  const long long n_steps = steps_in(duration);
   for (long long k = 1; k <= n_steps; ++k) {
     if (step().status == StepStatus::FAILED) return;
     if (after_step && !after_step(k, n_steps)) return;

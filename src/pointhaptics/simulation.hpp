@@ -33,7 +33,14 @@ class Simulation {
   /// Dynamics: step until time() reaches `duration` (ceil(duration / dt) steps); static: one solve.
   /// Stops at a failed step (diagnostics().failed says so). after_step(step, n_steps), if given, is called
   /// after each step; returning false stops the run there (an interrupted run keeps the state reached).
+  /// A stop requested inside a step (run_control.hpp) throws Interrupted out of it, the state left where the
+  /// step's solver stopped: its start (implicit), its last sub-step (explicit, the time advanced to it) or the
+  /// last converged load increment (static). Throws Error for a duration that is negative, not finite or more
+  /// than max_run_steps steps.
   void run(double duration, const std::function<bool(long long step, long long n_steps)>& after_step = {});
+  /// The steps run(duration) takes (1 for a static solve); throws Error as run() does.
+  long long steps_in(double duration) const;
+  static constexpr double max_run_steps = 1e12;
   /// Filled by the caller before a step (MuJoCo's step1/step2).
   StepInputs& inputs() { return core().inputs(); }
   const StepDiagnostics& diagnostics() const { return core().diagnostics(); }

@@ -70,6 +70,15 @@ std::string error_of(const TriangleMesh& m) {
   return "accepted";
 }
 
+std::string error_of_sampling(const TriangleMesh& m) {
+  try {
+    sample_mesh_volume(m, 0.01, "mesh.obj");
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "accepted";
+}
+
 TEST(TriangleMesh, WindingNumberIsOneInsideAndZeroOutside) {
   const TriangleMesh b = box(Vec3::Zero(), Vec3(0.1, 0.05, 0.02));
   EXPECT_NEAR(winding_number(b, Vec3(0.05, 0.025, 0.01)), 1.0, 1e-12);
@@ -91,6 +100,41 @@ TEST(TriangleMesh, ClosedMeshesAreVolumeSampled) {
   const double exact = 4.0 / 3.0 * std::numbers::pi * std::pow(0.03, 3);
   EXPECT_NEAR(s.volume.sum(), exact, 0.03 * exact);
   for (index_t i = 0; i < s.size(); ++i) ASSERT_LT(s.X.col(i).norm(), 0.03);
+}
+
+// issue 52: a mesh's points stand for the volume it encloses, at any spacing and position, the points at cell
+// centres; single-precision vertices (as mesh files have) put no centre on a face
+TEST(TriangleMesh, SampledVolumesSumToTheEnclosedVolumeAtAnySpacing) {
+  for (const double side : {0.05, 0.2})
+    for (const double spacing : {0.01, 0.007, 0.013}) {
+      TriangleMesh cube = box(Vec3::Zero(), Vec3::Constant(side));
+      cube.V = cube.V.cast<float>().cast<double>();
+      const PointCloud c = sample_mesh_volume(cube, spacing, "cube");
+      EXPECT_NEAR(c.volume.sum(), side * side * side, 5e-3 * side * side * side) << side << " m at " << spacing;
+      for (index_t i = 0; i < c.size(); ++i)
+        ASSERT_TRUE((c.X.col(i).array() > 0).all() && (c.X.col(i).array() < side).all()) << c.X.col(i).transpose();
+      // a whole number of cells: the points are the cells' centres, each a full cell
+      if (std::abs(side / spacing - std::round(side / spacing)) < 1e-9) {
+        EXPECT_EQ(c.size(), std::lround(std::pow(side / spacing, 3)));
+        EXPECT_NEAR(c.volume.minCoeff(), std::pow(spacing, 3), 1e-6 * std::pow(spacing, 3));  // float vertices
+      }
+    }
+  // off the lattice: a sphere's polyhedron, whose cells on the surface are partly inside
+  const TriangleMesh ball = sphere(0.03);
+  for (const double spacing : {0.004, 0.006}) {
+    const PointCloud s = sample_mesh_volume(ball, spacing, "sphere");
+    EXPECT_NEAR(s.volume.sum(), enclosed_volume(ball), 5e-3 * enclosed_volume(ball));
+    // no point stands for more than its cell (the scaling to the enclosed volume is a few percent at most)
+    EXPECT_LT(s.volume.maxCoeff(), 1.05 * std::pow(spacing, 3));
+    EXPECT_LT(s.volume.minCoeff(), 0.9 * std::pow(spacing, 3));  // the surface's cells are partly inside
+  }
+}
+
+TEST(TriangleMesh, AnInsideOutMeshIsNamed) {
+  TriangleMesh inside_out = box(Vec3::Zero(), Vec3::Constant(0.05));
+  for (auto& f : inside_out.F) std::swap(f[0], f[1]);
+  EXPECT_LT(enclosed_volume(inside_out), 0);
+  EXPECT_NE(error_of_sampling(inside_out).find("inside-out"), std::string::npos) << error_of_sampling(inside_out);
 }
 
 TEST(TriangleMesh, OpenNonManifoldAndBadlyOrientedMeshesAreNamedErrors) {

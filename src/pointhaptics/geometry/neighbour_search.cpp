@@ -1,6 +1,7 @@
 #include <pointhaptics/geometry/neighbour_search.hpp>
 
 #include <pointhaptics/core/error.hpp>
+#include <pointhaptics/core/run_control.hpp>
 
 #include <pointhaptics/geometry/kd_tree.hpp>
 #include <oneapi/tbb/parallel_for.h>
@@ -27,11 +28,13 @@ std::vector<std::vector<index_t>> search_rows(const Points& X, Radius&& radius) 
   const index_t n = static_cast<index_t>(X.cols());
   const KdTree tree(X);
   std::vector<std::vector<index_t>> rows(n);
+  Progress progress("the neighbour search", n);
   tbb::parallel_for(tbb::blocked_range<index_t>(0, n, 256), [&](const tbb::blocked_range<index_t>& range) {
     std::vector<std::pair<index_t, double>> found;
     nanoflann::SearchParams params;
     params.sorted = false;
     for (index_t i = range.begin(); i != range.end(); ++i) {
+      throw_if_stop_requested("the neighbour search");  // a wide support finds 10^4 neighbours per point
       found.clear();
       const Vec3 q = X.col(i);
       const double r = radius(i);
@@ -39,6 +42,7 @@ std::vector<std::vector<index_t>> search_rows(const Points& X, Radius&& radius) 
       for (const auto& [j, r2] : found)
         if (static_cast<index_t>(j) != i && within_support((X.col(j) - q).squaredNorm(), r)) rows[i].push_back(j);
     }
+    progress.advance(static_cast<double>(range.size()));
   });
   return rows;
 }

@@ -1,6 +1,7 @@
 #include <pointhaptics/geometry/sampling.hpp>
 
 #include <pointhaptics/core/error.hpp>
+#include <pointhaptics/core/run_control.hpp>
 
 #include <pointhaptics/geometry/kd_tree.hpp>
 #include <oneapi/tbb/combinable.h>
@@ -125,9 +126,11 @@ Eigen::VectorXd clipped_cell_volumes(const Points& X, const std::function<bool(c
   // order (summed volumes differed from run to run in the last digit)
   tbb::combinable<std::vector<std::int64_t>> partial(
       [n] { return std::vector<std::int64_t>(static_cast<std::size_t>(n), 0); });
+  Progress progress("the points' cell volumes", cells[2]);
   tbb::parallel_for(0, cells[2], [&](int k) {
     auto& local = partial.local();
-    for (int j = 0; j < cells[1]; ++j)
+    for (int j = 0; j < cells[1]; ++j) {
+      throw_if_stop_requested("the points' cell volumes");
       for (int i = 0; i < cells[0]; ++i) {
         const Vec3 c = lo + fine * Vec3(i + 0.5, j + 0.5, k + 0.5);
         if (!inside(c)) continue;
@@ -136,6 +139,8 @@ Eigen::VectorXd clipped_cell_volumes(const Points& X, const std::function<bool(c
         tree.index().knnSearch(c.data(), 1, &nearest, &d2);
         ++local[static_cast<std::size_t>(nearest)];
       }
+    }
+    progress.advance();
   });
   std::vector<std::int64_t> count(static_cast<std::size_t>(n), 0);
   partial.combine_each([&](const std::vector<std::int64_t>& c) {

@@ -111,10 +111,4 @@ TriangleMesh half_sphere_surface(const Vec3& centre, double radius, double edge)
   });
 }
 
-double enclosed_volume(const TriangleMesh& mesh) {
-  double six_v = 0;
-  for (const auto& f : mesh.F) six_v += mesh.V.col(f[0]).dot(mesh.V.col(f[1]).cross(mesh.V.col(f[2])));
-  return six_v / 6;
-}
-
 }  // namespace pointhaptics

@@ -21,7 +21,4 @@ TriangleMesh sphere_surface(const Vec3& centre, double radius, double edge);
 /// its edges near `edge` and shares the equator ring.
 TriangleMesh half_sphere_surface(const Vec3& centre, double radius, double edge);
 
-/// The volume a closed, outward-oriented surface encloses (divergence theorem; negative if inward).
-double enclosed_volume(const TriangleMesh& mesh);
-
 }  // namespace pointhaptics

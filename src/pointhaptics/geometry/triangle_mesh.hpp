@@ -23,10 +23,13 @@ void check_closed_manifold(const TriangleMesh& mesh, const std::string& name);
 /// angles / 4 pi; 1 inside a closed outward-oriented mesh, 0 outside, robust to small defects.
 double winding_number(const TriangleMesh& mesh, const Vec3& p);
 
+/// The volume a closed, outward-oriented mesh encloses (divergence theorem; m^3, negative for an inside-out one).
+double enclosed_volume(const TriangleMesh& mesh);
+
 /// The points of a lattice of `spacing` (cell centres, centred in the bounding box) whose winding
-/// number exceeds 1/2, each standing for a cell of volume spacing^3. Throws Error (naming `name`) if the
-/// mesh fails check_closed_manifold, or holds no lattice point (spacing too coarse for it), or would hold
-/// more than `max_points`.
+/// number exceeds 1/2, each standing for the part of its cell inside the mesh, the volumes summing to
+/// enclosed_volume(). Throws Error (naming `name`) if the mesh fails check_closed_manifold, is inside out,
+/// holds no lattice point (spacing too coarse for it), or would hold more than `max_points`.
 PointCloud sample_mesh_volume(const TriangleMesh& mesh, double spacing, const std::string& name,
                               index_t max_points = 20'000'000);
 

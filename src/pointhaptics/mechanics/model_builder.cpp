@@ -1,6 +1,7 @@
 #include <pointhaptics/mechanics/model_builder.hpp>
 
 #include <pointhaptics/core/error.hpp>
+#include <pointhaptics/core/polled_loop.hpp>
 #include <pointhaptics/geometry/neighbour_search.hpp>
 #include <pointhaptics/mechanics/energies/hourglass.hpp>
 #include <pointhaptics/mechanics/kernels.hpp>
@@ -95,7 +96,7 @@ Model build_model(const PointCloud& cloud, const MaterialParams& material, const
   // each pair's reverse; the forces and the tangent rely on the lists being symmetric (and sorted)
   model.reverse_pair.resize(n_pairs);
   std::atomic<std::int64_t> one_sided{-1};
-  tbb::parallel_for(index_t{0}, n, [&](index_t i) {
+  parallel_for_polled("the neighbour pairs", n, [&](index_t i) {
     for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
       const index_t j = nbr.index[e];
       const index_t* row = nbr.index.data();
@@ -111,7 +112,7 @@ Model build_model(const PointCloud& cloud, const MaterialParams& material, const
   // kernel weights per pair; coincident points would make w (and M_i) meaningless
   Eigen::VectorXd w(n_pairs);
   std::atomic<std::int64_t> coincident{-1};
-  tbb::parallel_for(index_t{0}, n, [&](index_t i) {
+  parallel_for_polled("the kernel weights", n, [&](index_t i) {
     for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
       if ((model.X.col(nbr.index[e]) - model.X.col(i)).norm() <= 1e-9 * h) coincident = i;
       // with per-point supports the stencil of i uses its own h_i (zero weight for the pairs only j reaches)
@@ -167,7 +168,7 @@ Model build_model(const PointCloud& cloud, const MaterialParams& material, const
   model.hg_coef.resize(n_pairs);
   std::vector<double> condition(n, 0.0), weight_sum(n, 0.0);
   std::vector<unsigned char> regularised(n, 0);
-  tbb::parallel_for(index_t{0}, n, [&](index_t i) {
+  parallel_for_polled("the stencils", n, [&](index_t i) {
     const StencilFit fit = fit_stencil(model, i, w.data() + nbr.begin(i));
     condition[i] = fit.condition;
     weight_sum[i] = fit.weight_sum;

@@ -1,6 +1,7 @@
 #include <pointhaptics/solvers/explicit_solver.hpp>
 
 #include <pointhaptics/core/error.hpp>
+#include <pointhaptics/core/run_control.hpp>
 #include <pointhaptics/geometry/neighbour_search.hpp>
 #include <pointhaptics/mechanics/forces.hpp>
 #include <pointhaptics/mechanics/model_patch.hpp>
@@ -14,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <random>
 
 namespace pointhaptics {
@@ -114,6 +116,7 @@ double min_free_mass(const Model& model) {
 namespace {
 const double covered_stiffening = 1.25;    // stiffening the safety factor of stable_time_step() absorbs
 const double stiffening_relax_time = 0.5;  // s: how slowly the planned stiffening falls back (explicit_step)
+const int many_substeps = 1000;            // sub-steps in one step worth a progress report
 }  // namespace
 
 StepReport explicit_step(const Model& model, State& state, Workspace& ws, double dt, double stable_dt,
@@ -145,7 +148,13 @@ StepReport explicit_step(const Model& model, State& state, Workspace& ws, double
   const double limit2 = (100 * model.extent) * (100 * model.extent);
   StepReport report;
   double* first_bad = ws.chunk_scalars.data();  // per chunk: the first diverged point, or -1 (no atomics)
+  // a stiff object can need millions of sub-steps in one step: they are polled (a stop leaves the state at the
+  // last sub-step, a consistent state at its time) and, when many, shown as progress
+  std::optional<Progress> progress;
+  if (n_sub >= many_substeps) progress.emplace("explicit sub-steps", n_sub);
   for (int sub = 0; sub < n_sub; ++sub) {
+    if (progress) progress->reach(sub);
+    else throw_if_stop_requested("explicit sub-steps");
     if (sub > 0) compute_internal_forces(model, state.u, ws);
     if (forces) {
       ws.acceleration.setZero();  // scratch for the dynamic forces

@@ -1,5 +1,7 @@
 #include <pointhaptics/solvers/newton.hpp>
 
+#include <pointhaptics/core/run_control.hpp>
+
 #include <pointhaptics/mechanics/energy.hpp>
 #include <pointhaptics/mechanics/forces.hpp>
 #include <pointhaptics/solvers/reactions.hpp>
@@ -233,6 +235,7 @@ bool NewtonSolver::conjugate_gradients(const Model& model, const NewtonProblem& 
   double rz = dot(cg_r, cg_z);
   const double target = eta * r.norm();
   for (int k = 0; k < max_iterations; ++k) {
+    throw_if_stop_requested("conjugate gradients");  // each iteration costs about a force evaluation
     apply_tangent(model, problem, cg_p, ws, cg_q);
     const double curvature = dot(cg_p, cg_q);
     ++iterations;
@@ -287,6 +290,7 @@ NewtonStats NewtonSolver::solve(const Model& model, const NewtonProblem& problem
       stats.failure = "iteration limit reached";
       return stats;
     }
+    throw_if_stop_requested("Newton iterations");
     ++stats.iterations;
     // in real time a background factor is taken up as soon as it is ready
     if (settings.real_time && cholesky_.background_ready() && cholesky_.analysed_for(model))
@@ -374,6 +378,7 @@ NewtonStats NewtonSolver::solve(const Model& model, const NewtonProblem& problem
     double alpha = 1.0;
     bool accepted = false;
     for (int k = 0; k < 30 && !accepted; ++k, alpha *= 0.5) {
+      throw_if_stop_requested("a line search");
       trial = u + alpha * dx;
       Points& r_trial = s.cg_r;  // scratch: CG is done for this iteration
       const double rel_trial = residual(model, problem, trial, ws, r_trial);

@@ -1,5 +1,6 @@
 #include <pointhaptics/solvers/static_solver.hpp>
 
+#include <pointhaptics/core/run_control.hpp>
 #include <pointhaptics/mechanics/viscoelasticity.hpp>
 
 #include <fmt/format.h>
@@ -20,6 +21,7 @@ StaticStats load_stepping(const Model& model, State& state, Workspace& ws, Newto
   problem.load = &load;
   problem.term = term;
   while (reached < 1.0) {
+    throw_if_stop_requested("load steps");
     const double factor = std::min(1.0, reached + increment);
     load = factor * model.f_ext;
     // predictor: the last equilibrium, scaled to the new load factor (exact for a linear response)

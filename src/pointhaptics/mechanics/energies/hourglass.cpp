@@ -1,5 +1,6 @@
 #include <pointhaptics/mechanics/energies/hourglass.hpp>
 
+#include <pointhaptics/core/polled_loop.hpp>
 #include <pointhaptics/mechanics/stencil.hpp>
 
 #include <oneapi/tbb/blocked_range.h>
@@ -60,7 +61,7 @@ void build_hourglass(Model& model, const std::vector<double>& weight_sum) {
   const index_t n = model.n_points;
   // k_ji = k_ij to the bit (the formula is symmetric term by term), so each pair is computed once, from its
   // lower end, and copied to its reverse: no two iterations write one slot
-  tbb::parallel_for(index_t{0}, n, [&](index_t i) {
+  parallel_for_polled("the hourglass coefficients", n, [&](index_t i) {
     for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {
       const index_t j = nbr.index[e];
       if (j < i) continue;
@@ -76,14 +77,17 @@ void build_hourglass(Model& model, const std::vector<double>& weight_sum) {
   // chaotic contact then grew to millimetres)
   constexpr index_t blocks = 8;
   std::vector<Eigen::VectorXd> diagonals(static_cast<std::size_t>(blocks));
+  Progress progress("the hourglass diagonal", n);
   tbb::parallel_for(index_t{0}, blocks, [&](index_t b) {
     Eigen::VectorXd& diagonal = diagonals[static_cast<std::size_t>(b)];
     diagonal = Eigen::VectorXd::Zero(n);
     PairWeights pair{std::vector<double>(n, 0.0), {}};
-    for (index_t i = b * n / blocks; i < (b + 1) * n / blocks; ++i)
+    for (index_t i = b * n / blocks; i < (b + 1) * n / blocks; ++i) {
+      progress.advance();
       // r_ji = -r_ij and k_ji = k_ij, so a pair's reverse adds the same squares: each pair once, twice over
       for (index_t e = nbr.begin(i); e < nbr.end(i); ++e)
         if (nbr.index[e] > i) add_pair_diagonal(model, i, e, 2.0, pair, diagonal.data());
+    }
   });
   for (const Eigen::VectorXd& diagonal : diagonals) model.hg_diagonal += diagonal;
 }
