@@ -217,6 +217,7 @@ int run_command(const RunOptions& opt) {
   const double start_time = sim.time();
   const bool options_real_time = !opt.deterministic;
   ph::InteractiveResult interactive;
+  std::string stopped_inside_step;  ///< what a stop inside a step interrupted (empty: none)
   OutputErrors errors;
   // a probe driven by a device runs the haptic loop; a tool held at a position is part of the scene's solve
   const bool haptic = scene.probe.present && !scene.probe.held();
@@ -283,8 +284,10 @@ int run_command(const RunOptions& opt) {
           errors.attempt([&] { ph::add_vtk_frame(*vtk, sim, vtk_surface()); });
         return !interrupted.load();
       });
-    } catch (const ph::Interrupted&) {
-      // inside a step: the state is the step's start (Newton) or its last sub-step (explicit)
+    } catch (const ph::Interrupted& e) {
+      // inside a step: the state is the step's start (Newton), its last sub-step (explicit) or its last
+      // converged load increment (static), not a completed step
+      stopped_inside_step = e.what();
     }
     progress.within_step = nullptr;
   }
@@ -298,6 +301,11 @@ int run_command(const RunOptions& opt) {
     });
   ph::RunSummary summary = sim.summary();
   summary.interrupted = interrupted.load() || interactive.interrupted;
+  if (!stopped_inside_step.empty()) {
+    // the state is not a step's result: never reported as converged
+    summary.converged = false;
+    summary.failure = stopped_inside_step;
+  }
   if (haptic) ph::add_interactive_summary(summary, interactive);
   if (!opt.json.empty()) errors.attempt([&] { ph::write_result_json(opt.json, sim.model(), sim.state(), summary); });
   if (!opt.quiet) {

@@ -36,7 +36,8 @@ std::string result_json(const Model& model, const State& state, const RunSummary
   doc["solver"] = {{"kind", s.solver_kind},      {"converged", s.converged},
                    {"iterations", s.iterations}, {"residual", s.residual},
                    {"steps", s.steps},           {"substeps", s.substeps},
-                   {"stable_dt", s.stable_dt},   {"cg_iterations", s.cg_iterations}};
+                   {"stable_dt", s.stable_dt},   {"cg_iterations", s.cg_iterations},
+                   {"time", state.time}};
   if (!s.failure.empty()) doc["solver"]["failure"] = s.failure;
   doc["solver"]["inverted"] = s.inverted;
   doc["solver"]["inverted_steps"] = s.inverted_steps;
