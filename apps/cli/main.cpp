@@ -365,6 +365,8 @@ int run_command(const RunOptions& opt) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // --threads of every command: 0 (all) to 1024; CLI11's NonNegativeNumber printed its range with 309 digits
+  const CLI::Range thread_count(0, 1024);
   CLI::App app{"PointHaptics: point-based deformable objects with haptic rendering", "pointhaptics"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "pointhaptics 0.1.0");
@@ -390,8 +392,7 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   run_cmd->add_flag("--deterministic", run.deterministic,
                     "With a [probe]: interleave haptic ticks and simulation steps on one thread in simulated time");
-  run_cmd->add_option("--threads", run.threads, "Threads for the force evaluation (0: all)")
-      ->check(CLI::NonNegativeNumber);
+  run_cmd->add_option("--threads", run.threads, "Threads for the force evaluation (0: all)")->check(thread_count);
   run_cmd
       ->add_option("--set", run.settings,
                    "Change a key of the scene: KEY=VALUE, a dotted path and a TOML value (material.young=2e5, "
@@ -437,8 +438,7 @@ int main(int argc, char** argv) {
       "--no-panels", [&view](std::int64_t) { view.panels = false; }, "Only the 3-D view");
   view_cmd->add_option("--frames", view.frames, "Headless: draw this many frames and report the time per frame")
       ->check(CLI::Range(1, 100000));
-  view_cmd->add_option("--threads", view.threads, "Threads for the force evaluation (0: all)")
-      ->check(CLI::NonNegativeNumber);
+  view_cmd->add_option("--threads", view.threads, "Threads for the force evaluation (0: all)")->check(thread_count);
 #endif
 
   ph::bench::BenchOptions bench;
@@ -449,7 +449,7 @@ int main(int argc, char** argv) {
                         "Only benchmarks whose name matches this regex, e.g. 'forces/points:10000'");
   bench_cmd->add_option("--min-time", bench.min_time, "Seconds per benchmark")->check(CLI::PositiveNumber);
   bench_cmd->add_option("--sizes", bench.sizes, "Approximate point counts")->check(CLI::PositiveNumber);
-  bench_cmd->add_option("--threads", bench.threads, "Thread counts")->check(CLI::PositiveNumber);
+  bench_cmd->add_option("--threads", bench.threads, "Thread counts")->check(CLI::Range(1, 1024));
   bench_cmd
       ->add_option("--repetitions", bench.repetitions,
                    "Run each benchmark N times in random order and report medians (steadier on a shared machine)")
@@ -464,7 +464,7 @@ int main(int argc, char** argv) {
   cantilever_cmd->add_option("--out", cantilever.out, "Output folder")->required();
   cantilever_cmd->add_flag("--quick", cantilever.quick, "Two spacings, two loads and coarse FEM meshes (seconds)");
   cantilever_cmd->add_option("--threads", cantilever.threads, "Threads for the point model and ccx (0: all)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(thread_count);
   cantilever_cmd->add_option("--plot-script", cantilever.plot_script, "plot_cantilever.py to use");
 
   ph::experiments::MaterialsOptions materials;
@@ -473,7 +473,7 @@ int main(int argc, char** argv) {
   materials_cmd->add_option("--out", materials.out, "Output folder")->required();
   materials_cmd->add_flag("--quick", materials.quick, "Coarse CalculiX meshes only");
   materials_cmd->add_option("--threads", materials.threads, "Threads for the point model and ccx (0: all)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(thread_count);
   materials_cmd->add_option("--plot-script", materials.plot_script, "plot_materials.py to use");
   materials_cmd->add_option("--models", materials.models, "Only these models (svk, neo_hookean, mooney_rivlin)")
       ->delimiter(',');
@@ -503,7 +503,7 @@ int main(int argc, char** argv) {
   contact_cmd->add_option("--spacings", contact.per_radius, "Spacings as R / n: the n (default 4,8)")
       ->delimiter(',')
       ->check(CLI::Range(2, 64));
-  contact_cmd->add_option("--threads", contact.threads, "Threads (0: all)")->check(CLI::NonNegativeNumber);
+  contact_cmd->add_option("--threads", contact.threads, "Threads (0: all)")->check(thread_count);
   contact_cmd
       ->add_option("--refine", contact.refine,
                    "The first spacing once more with points at R / n near the contact ([[refine]]; default 8, 0: none)")
@@ -534,7 +534,7 @@ int main(int argc, char** argv) {
       "cut",
       "Cutting: a device's blade cuts the cantilever through near its root, a scripted one cuts a slit that opens under load");
   cut_cmd->add_option("--out", cut_experiment.out, "Output folder")->required();
-  cut_cmd->add_option("--threads", cut_experiment.threads, "Threads (0: all)")->check(CLI::NonNegativeNumber);
+  cut_cmd->add_option("--threads", cut_experiment.threads, "Threads (0: all)")->check(thread_count);
 
   ph::experiments::ForceProfileOptions profile;
   CLI::App* profile_cmd = experiment_cmd->add_subcommand(
@@ -544,10 +544,10 @@ int main(int argc, char** argv) {
                         "Run the haptic thread on the wall clock (default: simulated time)");
 
   ph::experiments::LodExperimentOptions lod_table, propagation, lod_error;
-  auto lod_options = [](CLI::App* cmd, ph::experiments::LodExperimentOptions& o) {
+  auto lod_options = [&thread_count](CLI::App* cmd, ph::experiments::LodExperimentOptions& o) {
     cmd->add_option("--out", o.out, "Output folder")->required();
     cmd->add_flag("--quick", o.quick, "Small objects and short runs (seconds)");
-    cmd->add_option("--threads", o.threads, "Threads (0: all)")->check(CLI::NonNegativeNumber);
+    cmd->add_option("--threads", o.threads, "Threads (0: all)")->check(thread_count);
     cmd->add_option("--seconds", o.seconds, "Wall seconds per timed configuration")->check(CLI::PositiveNumber);
   };
   CLI::App* lod_table_cmd = experiment_cmd->add_subcommand(

@@ -30,11 +30,18 @@ expect_error(deeply_nested_key "${good}a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a
 # issue 21: values that were accepted and gave nonsense
 expect_error(tiny_dt "[object]\nshape = \"box\"\nsize = [0.03, 0.01, 0.01]\nspacing = 0.005\n[solver]\ndt = 1e-300\n" "solver.dt: 1e-300 is out of range")
 expect_error(huge_device_specs "${good}[probe]\nkeyframes = [[0.0, 0.0, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0]]\n[device]\nspecs = \"custom\"\nmax_force = 1e300\nmax_stiffness = 400.0\nworkspace_radius = 0.1\n" "device.max_force")
-expect_error(far_lod_contact "${good}[lod]\nlevels = [ { distance = 3.0, K = 6 } ]\ncontact = [1e300, 0.0, 0.0]\n" "lod.contact: .* outside the object")
+expect_error(far_lod_contact "${good}[lod]\nlevels = [ { distance = 3.0, K = 6 } ]\ncontact = [10.0, 0.0, 0.0]\n" "lod.contact: .* outside the object")
+expect_error(huge_lod_contact "${good}[lod]\nlevels = [ { distance = 3.0, K = 6 } ]\ncontact = [1e300, 0.0, 0.0]\n" "lod.contact: .* out of range: each value must lie in")
 file(WRITE ${WORK}/sparse.xyz "0 0 0\n0.01 0 0\n0 0.01 0\n0 0 0.01\n0.01 0.01 0.01\n")
 expect_error(no_neighbours "[object]\nshape = \"file\"\nfile = \"${WORK}/sparse.xyz\"\nspacing = 0.001\n" "have no neighbour within the support")
 # issue 21: messages that named the wrong cause
-expect_error(huge_spacing "[object]\nshape = \"box\"\nsize = [0.1, 0.1, 0.1]\nspacing = 1e300\n" "spacing 1e\\+300 m is larger than the body")
+expect_error(huge_spacing "[object]\nshape = \"box\"\nsize = [0.1, 0.1, 0.1]\nspacing = 50.0\n" "spacing 50 m is larger than the body")
+# issue 52: every number has a finite range, and a tolerance double precision can reach
+expect_error(far_spacing "[object]\nshape = \"box\"\nsize = [0.1, 0.1, 0.1]\nspacing = 1e300\n" "object.spacing: 1e\\+300 is out of range: must lie in \\(0, 100\\]")
+expect_error(tiny_tolerance "[object]\nshape = \"box\"\nsize = [0.03, 0.01, 0.01]\nspacing = 0.005\n[solver]\nkind = \"static\"\ntolerance = 1e-300\n" "solver.tolerance: 1e-300 is out of range: must lie in \\[1e-12, 0.01\\]")
+expect_error(huge_tolerance "[object]\nshape = \"box\"\nsize = [0.03, 0.01, 0.01]\nspacing = 0.005\n[solver]\nkind = \"static\"\ntolerance = 0.999\n" "solver.tolerance: 0.999 is out of range")
+expect_error(huge_probe_stiffness "${good}[probe]\nposition = [0.015, 0.012, 0.005]\nstiffness = 1e300\n" "probe.stiffness: 1e\\+300 is out of range: must lie in \\[0, 1e9\\]")
+expect_error(far_origin "[object]\nshape = \"box\"\nsize = [0.03, 0.01, 0.01]\nspacing = 0.005\norigin = [1e8, 0.0, 0.0]\n" "object.origin: .* out of range: .* cannot tell points a spacing apart")
 expect_error(tiny_spacing "[object]\nshape = \"box\"\nsize = [0.1, 0.1, 0.1]\nspacing = 1e-300\n" "spacing 1e-300 m is too fine")
 expect_error(huge_young "${good}[material]\nyoung = 1e300\n" "material.young: 1e\\+300 is out of range")
 expect_error(tiny_density "${good}[material]\ndensity = 1e-320\n" "material.density: 1e-320 is out of range")

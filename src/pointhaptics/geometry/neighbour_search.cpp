@@ -17,7 +17,10 @@ Csr rows_to_csr(const std::vector<std::vector<index_t>>& rows) {
   for (size_t i = 0; i < rows.size(); ++i) offset[i + 1] = offset[i] + static_cast<index_t>(rows[i].size());
   std::vector<index_t> index;
   index.reserve(offset.back());
-  for (const auto& row : rows) index.insert(index.end(), row.begin(), row.end());
+  for (const auto& row : rows) {
+    throw_if_stop_requested("the neighbour lists");
+    index.insert(index.end(), row.begin(), row.end());
+  }
   return Csr{std::move(offset), std::move(index)};
 }
 
@@ -50,8 +53,10 @@ std::vector<std::vector<index_t>> search_rows(const Points& X, Radius&& radius) 
 void sort_rows(std::vector<std::vector<index_t>>& rows) {
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows.size(), 256),
                     [&](const tbb::blocked_range<std::size_t>& range) {
-                      for (std::size_t i = range.begin(); i != range.end(); ++i)
+                      for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                        throw_if_stop_requested("the neighbour lists");
                         std::sort(rows[i].begin(), rows[i].end());
+                      }
                     });
 }
 
@@ -71,9 +76,11 @@ Csr radius_neighbours(const Points& X, const Eigen::VectorXd& support) {
   // candidates in a dense core); a pair only the wider side reaches is added to the other side's row after
   std::vector<std::vector<index_t>> rows = search_rows(X, [&support](index_t i) { return support[i]; });
   std::vector<std::vector<index_t>> extra(n);
-  for (index_t i = 0; i < n; ++i)
+  for (index_t i = 0; i < n; ++i) {
+    throw_if_stop_requested("the neighbour lists");
     for (index_t j : rows[i])
       if (!within_support((X.col(j) - X.col(i)).squaredNorm(), support[j])) extra[j].push_back(i);
+  }
   for (index_t i = 0; i < n; ++i) rows[i].insert(rows[i].end(), extra[i].begin(), extra[i].end());
   sort_rows(rows);
   return rows_to_csr(rows);

@@ -208,6 +208,10 @@ class TableReader {
     if (!array || array->size() != 3) fail_at(node, key, "expected an array of 3 numbers [x, y, z]");
     Vec3 v;
     for (int a = 0; a < 3; ++a) v[a] = as_number(*array->get(a), key);
+    // positions (m), forces (N), accelerations (m/s^2): beyond 1e9 no scene of this library means it
+    if (!(v.cwiseAbs().maxCoeff() <= 1e9))
+      fail_at(node, key,
+              fmt::format("[{}, {}, {}] is out of range: each value must lie in [-1e9, 1e9]", v.x(), v.y(), v.z()));
     return v;
   }
   bool boolean(std::string_view key, bool fallback) {
@@ -290,12 +294,18 @@ class TableReader {
   std::set<std::string> seen_;
 };
 
-auto positive = [](double x) { return x > 0; };
-auto non_negative = [](double x) { return x >= 0; };
+// Every number has a finite range, named in its message (issue 52: a probe stiffness of 1e300 was accepted and
+// made a "converged" solve carry 3.1e9 N): (0, hi] or [0, hi]
+auto positive_up_to(double hi) {
+  return [hi](double x) { return x > 0 && x <= hi; };
+}
+auto non_negative_up_to(double hi) {
+  return [hi](double x) { return x >= 0 && x <= hi; };
+}
 
 void read_object(TableReader& r, ObjectSpec& o, const Context& ctx) {
   o.shape = r.enumeration("shape", o.shape);
-  o.spacing = r.number("spacing", o.spacing, positive, "must be > 0 (m)");
+  o.spacing = r.number("spacing", o.spacing, positive_up_to(100), "must lie in (0, 100] (m)");
   o.surface_edge = r.number(
       "surface_edge", o.surface_edge, [&](double e) { return e > 0 && e >= 1e-3 * o.spacing; },
       "must be > 0 (m) and at least a thousandth of the spacing");
@@ -305,11 +315,17 @@ void read_object(TableReader& r, ObjectSpec& o, const Context& ctx) {
     if (!(o.size.array() > 0).all()) r.fail_at(*r.find("size"), "size", "every edge length must be > 0 (m)");
   }
   o.origin = r.vec3("origin", o.origin);
+  // far from 0 the points' coordinates lose the digits that tell them apart (1e17 m put them on each other)
+  if (!(o.origin.cwiseAbs().maxCoeff() <= 1e6))
+    r.fail_at(*r.find("origin"), "origin",
+              fmt::format("[{}, {}, {}] is out of range: each value must lie in [-1e6, 1e6] (m; farther out a double "
+                          "cannot tell points a spacing apart)",
+                          o.origin.x(), o.origin.y(), o.origin.z()));
   if (o.shape == ShapeKind::SPHERE || o.shape == ShapeKind::HALF_SPHERE) {
     if (!r.find("radius")) r.fail_table("radius", "a sphere needs radius = <m>");
   }
   if (o.shape == ShapeKind::SPHERE || o.shape == ShapeKind::HALF_SPHERE)
-    o.radius = r.number("radius", o.radius, positive, "must be > 0 (m)");
+    o.radius = r.number("radius", o.radius, positive_up_to(1e3), "must lie in (0, 1e3] (m)");
   if (o.shape == ShapeKind::FILE) {
     if (!r.find("file")) r.fail_table("file", "shape = \"file\" needs file = \"path\"");
     o.file = r.string("file", "");
@@ -372,9 +388,9 @@ void read_mooney_rivlin(TableReader& r, MaterialParams& m) {
   if (r.find("young") || r.find("poisson"))
     r.fail_at(*r.find(r.find("young") ? "young" : "poisson"), r.find("young") ? "young" : "poisson",
               "give either young and poisson or c10, c01 and bulk, not both");
-  m.c10 = r.number("c10", 0.0, non_negative, "must be >= 0 (Pa)");
-  m.c01 = r.number("c01", 0.0, non_negative, "must be >= 0 (Pa)");
-  const double bulk = r.number("bulk", 0.0, positive, "must be > 0 (Pa)");
+  m.c10 = r.number("c10", 0.0, non_negative_up_to(1e13), "must lie in [0, 1e13] (Pa)");
+  m.c01 = r.number("c01", 0.0, non_negative_up_to(1e13), "must lie in [0, 1e13] (Pa)");
+  const double bulk = r.number("bulk", 0.0, positive_up_to(1e14), "must lie in (0, 1e14] (Pa)");
   const double mu = 2 * (m.c10 + m.c01);
   if (!(mu > 0)) r.fail_at(*r.find("c10"), "c10", "c10 + c01 must be > 0 (Pa)");
   m.young = 9 * bulk * mu / (3 * bulk + mu);
@@ -405,7 +421,7 @@ void read_material(TableReader& r, MaterialParams& m) {
   m.volume_stiffness = r.number(
       "volume_stiffness", m.volume_stiffness, [](double x) { return x >= 0 && x <= 1e13; },
       "must lie in [0, 1e13] (Pa)");
-  m.damping = r.number("damping", m.damping, non_negative, "must be >= 0 (1/s)");
+  m.damping = r.number("damping", m.damping, non_negative_up_to(1e6), "must lie in [0, 1e6] (1/s)");
   m.hourglass = r.number(
       "hourglass", m.hourglass, [](double x) { return x >= 0 && x <= 10; }, "must lie in [0, 10]");
   m.volume = r.enumeration("volume", m.volume);
@@ -418,7 +434,7 @@ void read_kernel(TableReader& r, KernelParams& k) {
     r.fail_at(*r.find("support"), "support", "give either support (m) or support_factor, not both");
   k.support_factor = r.number(
       "support_factor", k.support_factor, [](double x) { return x > 1 && x <= 20; }, "must lie in (1, 20]");
-  k.support = r.number("support", 0.0, positive, "must be > 0 (m)");
+  k.support = r.number("support", 0.0, positive_up_to(1e3), "must lie in (0, 1e3] (m)");
 }
 
 void read_solver(TableReader& r, SolverSpec& s) {
@@ -428,7 +444,8 @@ void read_solver(TableReader& r, SolverSpec& s) {
   s.duration = r.number(
       "duration", s.duration, [](double x) { return x >= 0 && x <= 1e6; }, "must lie in [0, 1e6] (s)");
   s.tolerance = r.number(
-      "tolerance", s.tolerance, [](double x) { return x > 0 && x < 1; }, "must lie in (0, 1)");
+      "tolerance", s.tolerance, [](double x) { return x >= 1e-12 && x <= 1e-2; },
+      "must lie in [1e-12, 0.01] (a relative residual: below 1e-12 double precision cannot reach it, above 0.01 it is no equilibrium)");
   auto count = [&](std::string_view key, int fallback, int lo, int hi) {
     const auto node = r.find(key);
     const long long v = r.integer(key, fallback);
@@ -455,7 +472,8 @@ void read_selector(TableReader& r, PointSelector& f) {
     TableReader s(r.context(), *t, r.name("sphere"));
     if (!t->get("centre") || !t->get("radius"))
       s.fail_table("centre", "a sphere needs centre = [x, y, z] and radius (m)");
-    f.sphere = SphereRegion{s.vec3("centre", Vec3::Zero()), s.number("radius", 0.0, positive, "must be > 0 (m)")};
+    f.sphere = SphereRegion{s.vec3("centre", Vec3::Zero()),
+                            s.number("radius", 0.0, positive_up_to(1e3), "must lie in (0, 1e3] (m)")};
     s.finish();
   }
   if (const toml::table* t = r.subtable("cylinder")) {
@@ -467,8 +485,8 @@ void read_selector(TableReader& r, PointSelector& f) {
     const Vec3 axis = c.vec3("axis", cyl.axis);
     if (!(axis.norm() > 0)) c.fail_at(*t->get("axis"), "axis", "must not be zero");
     cyl.axis = axis.normalized();
-    cyl.radius = c.number("radius", 0.0, positive, "must be > 0 (m)");
-    cyl.half_length = c.number("half_length", 0.0, positive, "must be > 0 (m)");
+    cyl.radius = c.number("radius", 0.0, positive_up_to(1e3), "must lie in (0, 1e3] (m)");
+    cyl.half_length = c.number("half_length", 0.0, positive_up_to(1e3), "must lie in (0, 1e3] (m)");
     c.finish();
     f.cylinder = cyl;
   }
@@ -479,7 +497,7 @@ FixedSpec read_fixed(TableReader& r) {
   f.line = r.line();
   read_selector(r, f);
   f.displacement = r.vec3("displacement", f.displacement);
-  f.ramp = r.number("ramp", 0.0, non_negative, "must be >= 0 (s)");
+  f.ramp = r.number("ramp", 0.0, non_negative_up_to(1e6), "must lie in [0, 1e6] (s)");
   return f;
 }
 
@@ -524,9 +542,9 @@ CutSpec read_cut(TableReader& r) {
   if ((c.edge[1] - c.edge[0]).norm() == 0 || (c.to[1] - c.to[0]).norm() == 0)
     r.fail_table("edge", "the blade's edge has zero length (its two ends coincide)");
   c.start = r.number(
-      "start", c.start, [](double t) { return t >= 0; }, "must be >= 0 (s)");
+      "start", c.start, [](double t) { return t >= 0 && t <= 1e6; }, "must lie in [0, 1e6] (s)");
   c.duration = r.number(
-      "duration", c.duration, [](double t) { return t >= 0; }, "must be >= 0 (s)");
+      "duration", c.duration, [](double t) { return t >= 0 && t <= 1e6; }, "must lie in [0, 1e6] (s)");
   return c;
 }
 
@@ -559,11 +577,12 @@ std::string resolve(const Context& ctx, const std::string& file) {
 void read_probe(TableReader& r, ProbeSpec& p, const Context& ctx) {
   p.present = true;
   p.line = r.line();
-  p.radius = r.number("radius", p.radius, positive, "must be > 0 (m)");
+  p.radius = r.number("radius", p.radius, positive_up_to(10), "must lie in (0, 10] (m)");
   const std::string mode = r.choice("mode", "push", {"push", "grab", "cut"});
   p.grab = mode == "grab";
   p.cut = mode == "cut";
-  p.cut_resistance = r.number("cut_resistance", p.cut_resistance, non_negative, "must be >= 0 (J/m^2)");
+  p.cut_resistance =
+      r.number("cut_resistance", p.cut_resistance, non_negative_up_to(1e9), "must lie in [0, 1e9] (J/m^2)");
   if (!p.cut && r.find("cut_resistance"))
     r.fail_at(*r.find("cut_resistance"), "cut_resistance", "only a blade cuts (mode = \"cut\")");
   if (r.find("trajectory") && r.find("keyframes"))
@@ -584,10 +603,10 @@ void read_probe(TableReader& r, ProbeSpec& p, const Context& ctx) {
     }
   }
   if (r.find("origin")) p.origin = r.vec3("origin", p.origin);
-  p.scale = r.number("scale", p.scale, positive, "must be > 0 (scene metres per device metre)");
-  p.stiffness = r.number("stiffness", p.stiffness, non_negative, "must be >= 0 (N/m)");
+  p.scale = r.number("scale", p.scale, positive_up_to(1e6), "must lie in (0, 1e6] (scene metres per device metre)");
+  p.stiffness = r.number("stiffness", p.stiffness, non_negative_up_to(1e9), "must lie in [0, 1e9] (N/m)");
   p.capsule = r.choice("shape", "sphere", {"sphere", "capsule"}) == "capsule";
-  p.length = r.number("length", p.length, non_negative, "must be >= 0 (m)");
+  p.length = r.number("length", p.length, non_negative_up_to(10), "must lie in [0, 10] (m)");
   if (p.capsule && !(p.length > 0)) r.fail_table("length", "a capsule needs length > 0 (m): its axis segment");
   if (!p.capsule && r.find("length"))
     r.fail_at(*r.find("length"), "length", "only a capsule has a length (shape = \"capsule\")");
@@ -598,8 +617,8 @@ void read_probe(TableReader& r, ProbeSpec& p, const Context& ctx) {
       "friction", p.friction, [](double m) { return m >= 0 && m <= 10; }, "must be in [0, 10]");
   p.object_stiffness = r.choice("local_stiffness", "contact", {"contact", "object"}) == "object";
   p.non_negative_surface_map = r.choice("surface_map", "exact", {"exact", "non_negative"}) == "non_negative";
-  p.sample_spacing = r.number("sample_spacing", p.sample_spacing, positive,
-                              "must be > 0 (m: the contact's samples along the surface's edges)");
+  p.sample_spacing = r.number("sample_spacing", p.sample_spacing, positive_up_to(1),
+                              "must lie in (0, 1] (m: the contact's samples along the surface's edges)");
   if (r.find("position")) {
     p.position = r.vec3("position", p.position);
     if (r.find("trajectory") || r.find("keyframes"))
@@ -653,9 +672,9 @@ void read_lod(TableReader& r, LodSpec& l) {
   l.present = true;
   l.line = r.line();
   LodParams& p = l.params;
-  p.k1 = r.number("k1", p.k1, non_negative, "must be >= 0 (units of h)");
+  p.k1 = r.number("k1", p.k1, non_negative_up_to(1e3), "must lie in [0, 1e3] (units of h)");
   p.k2 = r.number(
-      "k2", p.k2, [&](double x) { return x >= p.k1; }, "must be >= k1 (units of h)");
+      "k2", p.k2, [&](double x) { return x >= p.k1 && x <= 1e3; }, "must lie in [k1, 1e3] (units of h)");
   if (const toml::node* node = r.find("levels")) {
     const toml::array* rows = node->as_array();
     if (!rows) r.fail_at(*node, "levels", "expected [ { distance = <h>, K = <0..10> }, ... ]");
@@ -668,8 +687,8 @@ void read_lod(TableReader& r, LodSpec& l) {
       if (!t->get("distance") || !t->get("K")) level.fail_table("distance", "each level needs both distance and K");
       LodLevel lv;
       lv.distance = level.number(
-          "distance", 0.0, [&](double x) { return x > previous; },
-          fmt::format("must exceed {} (k2 or the previous level's distance)", previous));
+          "distance", 0.0, [&](double x) { return x > previous && x <= 1e3; },
+          fmt::format("must exceed {} (k2 or the previous level's distance) and be at most 1e3", previous));
       const long long k = level.integer("K", 0);
       if (k < 0 || k > 10 || k < previous_k)
         level.fail_at(*t->get("K"), "K",
@@ -686,7 +705,7 @@ void read_lod(TableReader& r, LodSpec& l) {
   if (seed_value < 0) r.fail_at(*seed, "seed", "must be >= 0");
   p.seed = static_cast<std::uint64_t>(seed_value);
   p.scheme = r.enumeration("scheme", p.scheme);
-  p.reselect = r.number("reselect", p.reselect, positive, "must be > 0 (units of h)");
+  p.reselect = r.number("reselect", p.reselect, positive_up_to(1e3), "must lie in (0, 1e3] (units of h)");
   p.reselect_interval = r.number(
       "reselect_interval", p.reselect_interval, [](double x) { return x >= 0 && x <= 1e3; },
       "must lie in [0, 1000] (s)");

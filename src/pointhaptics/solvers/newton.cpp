@@ -399,10 +399,11 @@ NewtonStats NewtonSolver::solve(const Model& model, const NewtonProblem& problem
     }
     if (!accepted && slope <= 1e-12 * std::abs(current_pi())) {
       // the Newton step promises less than the round-off of Pi: the residual is at its floor (forces are
-      // sums of large cancelling stencil terms), so this is as converged as double precision allows
+      // sums of large cancelling stencil terms) above the tolerance, which double precision cannot reach on
+      // this problem: said so, not reported as converged (issue 52: a tolerance of 1e-300 "converged" at 1.8e-14)
       stats.residual = rel;
-      stats.converged = true;
       stats.stalled = true;
+      stats.failure = "the residual stalled at double precision's floor above the tolerance (raise solver.tolerance)";
       return stats;
     }
     if (!accepted) {

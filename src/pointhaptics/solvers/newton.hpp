@@ -85,7 +85,7 @@ struct NewtonStats {
                                       ///< refactorises) and done again with block-Jacobi
   int projected = 0;                  ///< iterations that fell back to the positive semi-definite tangent
   double residual = 0;       ///< |r|_free / max(|b|, |f_int|, |k M (u - a)|, |tool forces|, force_floor) at the end
-  bool stalled = false;      ///< converged at the round-off floor above the tolerance
+  bool stalled = false;      ///< stopped at the round-off floor above the tolerance (not converged)
   const char* failure = "";  ///< why it stopped without converging
 };
 
