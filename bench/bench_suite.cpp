@@ -1,6 +1,7 @@
 #include "bench_suite.hpp"
 
 #include <pointhaptics/core/error.hpp>
+#include <pointhaptics/core/memory_limit.hpp>
 #include <pointhaptics/core/workspace.hpp>
 #include <pointhaptics/geometry/sampling.hpp>
 #include <pointhaptics/geometry/shape_surfaces.hpp>
@@ -568,6 +569,19 @@ class CollectingReporter : public benchmark::ConsoleReporter {
 }  // namespace
 
 int run_bench_suite(const BenchOptions& options) {
+  // sizes too big for what this process may take are refused before anything is built (issue 52: --sizes
+  // 100000000 ran out of memory, and its message named --max-memory, which bench does not have); each size's
+  // models are held together (the force, step and material variants' caches)
+  const MemoryLimit limit = memory_limit();
+  for (int n : options.sizes) {
+    const ModelEstimate e = estimate_model(n, KernelParams{}, 1.0);
+    const double held = (2.0 + static_cast<double>(material_variants.size())) * e.bytes;
+    if (held > limit.bytes)
+      throw Error(
+          fmt::format("bench --sizes {}: its models would need about {:.3g} GB, more than {} ({:.3g} GB); "
+                      "give smaller --sizes",
+                      n, held / 1e9, limit.what, limit.bytes / 1e9));
+  }
   for (int n : options.sizes)
     for (int t : options.threads) {
       benchmark::RegisterBenchmark(fmt::format("forces/points:{}/threads:{}", n, t).c_str(), force_benchmark)

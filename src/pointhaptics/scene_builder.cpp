@@ -111,7 +111,10 @@ PointCloud sample_shape(const Scene& scene) {
     case ShapeKind::SPHERE: return sample_sphere(o.origin, o.radius, o.spacing);
     case ShapeKind::HALF_SPHERE: return sample_half_sphere(o.origin, o.radius, o.spacing);
     case ShapeKind::FILE: {
-      // point clouds as they are; surface meshes (and PLY files with faces) volume-sampled at the spacing
+      // point clouds as they are; surface meshes (and PLY files with faces) volume-sampled at the spacing. A
+      // file that is not a regular one (a link to /dev/zero) is refused before anything reads it, whatever its
+      // extension (a .ply's header was read for 11.6 s and 4.1 GB: issue 52)
+      check_input_file(o.file, "object file");
       if (is_volume_file(o.file)) {
         if (!std::isfinite(o.threshold_low))
           throw Error(

@@ -117,3 +117,39 @@ model = json.load(open(json_path))["model"]
 assert model["points"] == 125, model["points"]
 assert abs(model["total_volume"] - 1.25e-4) < 0.005 * 1.25e-4, model["total_volume"]
 print("cube.obj at 1 cm: 125 points,", model["total_volume"], "m^3")
+
+# the memory pre-check honours the process's own limit (a 4.2M-point box ran 36 s to 7.3 GB under ulimit -v)
+import resource  # noqa: E402
+
+
+def limited():
+    resource.setrlimit(resource.RLIMIT_AS, (2 * 1024**3, 2 * 1024**3))
+
+
+big = write("big.toml", """
+[object]
+shape = "box"
+size = [0.2, 0.2, 0.2]
+spacing = 0.0015
+""")
+start = time.monotonic()
+p = subprocess.run([cli, "run", big, "--quiet"], capture_output=True, text=True, timeout=120, preexec_fn=limited)
+assert p.returncode == 1 and "ulimit -v" in p.stderr, (p.returncode, p.stderr)
+assert time.monotonic() - start < 10, "refused before anything was built"
+print("ulimit -v 2 GB:", p.stderr.strip())
+# bench gets the same check, and names its own options
+p = subprocess.run([cli, "bench", "--sizes", "100000000"], capture_output=True, text=True, timeout=120)
+assert p.returncode == 1 and "give smaller --sizes" in p.stderr and "--max-memory" not in p.stderr, p.stderr
+print(p.stderr.strip())
+# an object file that is a link to a device is refused before it is read, whatever its extension
+for ext in (".ply", ".obj", ".xyz", ".nii"):
+    link = os.path.join(work, "zero" + ext)
+    if os.path.lexists(link):
+        os.remove(link)
+    os.symlink("/dev/zero", link)
+    scene = write("zero.toml", f'[object]\nshape = "file"\nfile = "{link}"\nspacing = 0.01\n')
+    start = time.monotonic()
+    p = subprocess.run([cli, "run", scene, "--quiet"], capture_output=True, text=True, timeout=60)
+    assert p.returncode == 1 and "not a regular file" in p.stderr, (ext, p.stderr)
+    assert time.monotonic() - start < 5, ext
+print("links to /dev/zero refused at once")

@@ -238,5 +238,53 @@ TEST_F(VolumeFile, BadVolumesAreNamedErrors) {
   EXPECT_NE(error_of([&] { read_volume(dir); }).find("is a folder"), std::string::npos);
 }
 
+// issue 52: where the voxel data starts, a voxel's size and a compressed file's inflated size are checked before
+// the data is read
+TEST_F(VolumeFile, OffsetsSpacingsAndCompressedSizesAreCheckedBeforeTheData) {
+  const Grid g;
+  const std::vector<float> v = voxels(g, sphere);
+  auto error_of = [](const std::function<void()>& f) {
+    try {
+      f();
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  for (const float offset : {0.0f, -100.0f, 1e30f, NAN}) {
+    const std::string path = write_nifti("offset.nii", g, v);
+    std::fstream file(path, std::ios::binary | std::ios::in | std::ios::out);
+    file.seekp(108);
+    file.write(reinterpret_cast<const char*>(&offset), sizeof offset);
+    file.close();
+    const std::string error = error_of([&] { read_volume(path); });
+    EXPECT_NE(error.find("vox_offset"), std::string::npos) << offset << ": " << error;
+  }
+  // a voxel spacing of 1e300 mm is named, not "inf lattice cells" later
+  const std::string far = dir + "/far.nrrd";
+  {
+    std::ofstream out(far, std::ios::binary);
+    out << "NRRD0004\ntype: float\ndimension: 3\nsizes: " << g.n << ' ' << g.n << ' ' << g.n
+        << "\nspace: right-anterior-superior\nspace directions: (1e300,0,0) (0,1,0) (0,0,1)\nencoding: raw\nendian: "
+           "little\n\n";
+    out.write(reinterpret_cast<const char*>(v.data()), static_cast<std::streamsize>(v.size() * sizeof(float)));
+  }
+  EXPECT_NE(error_of([&] { read_volume(far); }).find("a voxel spacing must lie in [1e-9, 1e3] m"), std::string::npos)
+      << error_of([&] { read_volume(far); });
+  // a .nii.gz whose gzip trailer does not match what its header declares is refused before it is inflated
+  const std::string plain = write_nifti("packed.nii", g, v);
+  ASSERT_EQ(std::system(("gzip -f -k " + plain).c_str()), 0);
+  const std::string packed = plain + ".gz";
+  EXPECT_EQ(read_volume(packed).values.size(), v.size());  // the intact file reads
+  {
+    std::fstream file(packed, std::ios::binary | std::ios::in | std::ios::out);
+    file.seekp(-4, std::ios::end);
+    const std::uint32_t lie = 3'900'000'000u;
+    file.write(reinterpret_cast<const char*>(&lie), sizeof lie);
+  }
+  EXPECT_NE(error_of([&] { read_volume(packed); }).find("inflates to 3900000000 bytes"), std::string::npos)
+      << error_of([&] { read_volume(packed); });
+}
+
 }  // namespace
 }  // namespace pointhaptics

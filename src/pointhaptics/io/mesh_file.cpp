@@ -98,6 +98,7 @@ void write_mesh(const std::string& path, const TriangleMesh& mesh, std::string_v
 }
 
 bool ply_has_faces(const std::string& path) {
+  check_input_file(path, "PLY file");
   std::ifstream in(path, std::ios::binary);
   std::string line;
   // the header only, however many comment or property lines it has (a mesh with over 1000 was taken for a

@@ -1,6 +1,8 @@
 #include <pointhaptics/io/volume_file.hpp>
 
 #include <pointhaptics/core/error.hpp>
+#include <pointhaptics/core/memory_limit.hpp>
+#include <pointhaptics/core/run_control.hpp>
 #include <pointhaptics/io/input_file.hpp>
 
 #include <fmt/format.h>
@@ -9,7 +11,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 
 namespace pointhaptics {
@@ -23,6 +27,30 @@ bool ends_with(const std::string& s, const std::string& tail) {
          });
 }
 
+// The size a gzip stream says it inflates to: its trailer's ISIZE, the size modulo 2^32 (RFC 1952)
+std::uint32_t gzip_inflated_size(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  in.seekg(-4, std::ios::end);
+  unsigned char b[4] = {0, 0, 0, 0};
+  in.read(reinterpret_cast<char*>(b), 4);
+  return static_cast<std::uint32_t>(b[0]) | static_cast<std::uint32_t>(b[1]) << 8 |
+         static_cast<std::uint32_t>(b[2]) << 16 | static_cast<std::uint32_t>(b[3]) << 24;
+}
+
+// Before an image is inflated or read: the memory its data and its float copy take, against what the process may
+// still take, and a read that will be long announced (issue 52: a 2 MB .nii.gz inflated to 3.9 GB first)
+void check_image_memory(const std::string& path, double voxels, double bytes_per_voxel) {
+  const double needed = voxels * (bytes_per_voxel + sizeof(float));
+  const MemoryLimit limit = memory_limit();
+  if (needed > limit.bytes)
+    throw Error(fmt::format("{}: its {:.3g} voxels would take {:.3g} GB read, more than {} ({:.3g} GB)", path, voxels,
+                            needed / 1e9, limit.what, limit.bytes / 1e9));
+  // about 1 GB/s to inflate and convert on the development machine
+  if (needed > 2e9)
+    announce(fmt::format("reading {:.3g} voxels from {}: about {}, {:.2g} GB", voxels, path,
+                         format_duration(needed / 1e9), needed / 1e9));
+}
+
 double unit_of(const std::string& unit) {
   if (unit == "m" || unit == "meter" || unit == "metre") return 1.0;
   if (unit == "um" || unit == "micron") return 1e-6;
@@ -30,6 +58,15 @@ double unit_of(const std::string& unit) {
 }
 
 void check_affine(const Eigen::Matrix4d& A, const std::string& path) {
+  // a voxel's edges: a spacing of 1e300 gave "inf lattice cells" later (issue 52)
+  for (int a = 0; a < 3; ++a) {
+    const double edge = A.col(a).head<3>().norm();
+    if (!(edge >= 1e-9 && edge <= 1e3))
+      throw Error(
+          fmt::format("{}: the voxels measure {:.3g} m along axis {}: a voxel spacing must lie in [1e-9, 1e3] m "
+                      "(after the file's units)",
+                      path, edge, a));
+  }
   if (!A.allFinite() || !(std::abs(A.topLeftCorner<3, 3>().determinant()) > 0))
     throw Error(fmt::format("{}: the voxel-to-world orientation is singular or not finite", path));
 }
@@ -45,6 +82,32 @@ VolumeImage read_nifti(const std::string& path) {
   if (static_cast<double>(header->nx) * static_cast<double>(header->ny) * static_cast<double>(header->nz) > max_voxels)
     throw Error(
         fmt::format("{}: {}x{}x{} voxels is more than this reader takes", path, header->nx, header->ny, header->nz));
+  check_image_memory(path, static_cast<double>(header->nvox), header->nbyper);
+  // where a single file's voxel data starts: after its header (348 bytes for NIfTI-1, 540 for NIfTI-2, then a
+  // 4-byte extension flag), and within the file when it is not compressed (0, -100, NaN or 1e30 passed: issue 52)
+  if (header->iname && header->fname && std::string(header->iname) == std::string(header->fname)) {
+    const double smallest = header->nifti_type >= NIFTI_FTYPE_NIFTI2_1 ? 544 : 352;
+    const double offset = static_cast<double>(header->iname_offset);
+    const double largest = ends_with(path, ".nii") ? static_cast<double>(std::filesystem::file_size(path)) : 1e12;
+    if (!(offset >= smallest && offset <= largest))
+      throw Error(
+          fmt::format("{}: vox_offset {} is out of range: the voxel data starts after the header, in [{:.0f}, "
+                      "{:.0f}] bytes",
+                      path, header->iname_offset, smallest, largest));
+  }
+  // a compressed file must inflate to what its header promises (its gzip trailer says, modulo 4 GiB) before it
+  // is inflated
+  if (ends_with(path, ".nii.gz")) {
+    const double declared =
+        static_cast<double>(header->iname_offset) + static_cast<double>(header->nvox) * header->nbyper;
+    const auto declared_mod = static_cast<std::uint32_t>(std::fmod(declared, 4294967296.0));
+    const std::uint32_t inflates = gzip_inflated_size(path);
+    if (inflates != declared_mod)
+      throw Error(
+          fmt::format("{}: the compressed file inflates to {} bytes (modulo 4 GiB), not the {:.0f} its header "
+                      "declares: truncated or corrupt",
+                      path, inflates, declared));
+  }
   // an uncompressed single file must hold what its header promises before that much memory is taken
   if (ends_with(path, ".nii") && header->iname && std::string(header->iname) == path) {
     const double needed =
@@ -107,6 +170,7 @@ void check_nrrd_header(const std::string& path) {
   if (voxels > max_voxels)
     throw Error(fmt::format("{}: the header declares {:.3g} voxels, more than this reader takes ({:.3g})", path, voxels,
                             max_voxels));
+  if (header->type != nrrdTypeBlock) check_image_memory(path, voxels, static_cast<double>(nrrdTypeSize[header->type]));
   // raw data in the same file must be there before that much memory is taken
   const bool attached = io->dataFNArr->len == 0;
   if (attached && io->encoding == nrrdEncodingRaw && header->type != nrrdTypeBlock) {
@@ -168,8 +232,10 @@ bool is_volume_file(const std::string& path) {
 VolumeImage read_volume(const std::string& path) {
   check_input_file(path, "volume image");
   VolumeImage image = ends_with(path, ".nrrd") || ends_with(path, ".nhdr") ? read_nrrd(path) : read_nifti(path);
-  for (float v : image.values)
-    if (!std::isfinite(v)) throw Error(fmt::format("{}: an intensity is not finite", path));
+  for (std::size_t v = 0; v < image.values.size(); ++v) {
+    if (v % 65536 == 0) throw_if_stop_requested("the image's intensities");
+    if (!std::isfinite(image.values[v])) throw Error(fmt::format("{}: an intensity is not finite", path));
+  }
   return image;
 }
 
@@ -184,7 +250,8 @@ PointCloud sample_volume(const VolumeImage& image, double low, double high, doub
   const Vec3 b = image.voxel_to_world.topRightCorner<3, 1>();
   std::size_t count = 0;
   for (index_t k = 0; k < image.nz; ++k)
-    for (index_t j = 0; j < image.ny; ++j)
+    for (index_t j = 0; j < image.ny; ++j) {
+      throw_if_stop_requested("the image's voxels");
       for (index_t i = 0; i < image.nx; ++i)
         if (in_window(image.at(i, j, k))) {
           const Vec3 x = A * Vec3(i, j, k) + b;
@@ -192,6 +259,7 @@ PointCloud sample_volume(const VolumeImage& image, double low, double high, doub
           hi = hi.cwiseMax(x);
           ++count;
         }
+    }
   if (count == 0) throw Error(fmt::format("{}: no voxel lies in the threshold window [{}, {}]", name, low, high));
   // half a voxel around the voxel centres
   const Vec3 half = 0.5 * A.cwiseAbs().rowwise().sum();
@@ -206,6 +274,7 @@ PointCloud sample_volume(const VolumeImage& image, double low, double high, doub
   std::vector<Vec3> points;
   std::vector<double> intensities;
   for (index_t c = 0; c < static_cast<index_t>(cells.prod()); ++c) {
+    if (c % 4096 == 0) throw_if_stop_requested("the image's lattice");
     const index_t ci = c % static_cast<index_t>(cells.x()),
                   cj = (c / static_cast<index_t>(cells.x())) % static_cast<index_t>(cells.y()),
                   ck = c / static_cast<index_t>(cells.x() * cells.y());
