@@ -132,8 +132,33 @@ PointCloud sample_shape(const Scene& scene) {
 
 }  // namespace
 
+namespace {
+
+// [[refine]] regions must not overlap (each refines the coarse sampling it finds): a point of a lattice over the
+// two regions' common bounds, at the finer spacing (at most 100 per axis), in both is an overlap (issue 52)
+void check_refine_regions_apart(const Scene& scene) {
+  for (std::size_t a = 0; a < scene.refine.size(); ++a)
+    for (std::size_t b = a + 1; b < scene.refine.size(); ++b) {
+      const RefineSpec &ra = scene.refine[a], &rb = scene.refine[b];
+      const Vec3 lo = ra.bounds().min.cwiseMax(rb.bounds().min), hi = ra.bounds().max.cwiseMin(rb.bounds().max);
+      if (!(lo.array() <= hi.array()).all()) continue;
+      const double step = std::max(std::min(ra.spacing, rb.spacing), (hi - lo).maxCoeff() / 100);
+      for (double x = lo.x(); x <= hi.x(); x += step)
+        for (double y = lo.y(); y <= hi.y(); y += step)
+          for (double z = lo.z(); z <= hi.z(); z += step)
+            if (ra.contains(Vec3(x, y, z), 0) && rb.contains(Vec3(x, y, z), 0))
+              throw Error(
+                  fmt::format("{}:{}: refine[{}] overlaps refine[{}] (line {}) at ({:.4g}, {:.4g}, {:.4g}): "
+                              "[[refine]] regions must not overlap (join them into one)",
+                              scene.path, rb.line, b, a, ra.line, x, y, z));
+    }
+}
+
+}  // namespace
+
 PointCloud sample_object(const Scene& scene) {
   const ObjectSpec& o = scene.object;
+  check_refine_regions_apart(scene);
   PointCloud cloud = sample_shape(scene);
   // [[refine]]: finer points where a tool presses, each with its own support
   const double support = scene.kernel.support > 0 ? scene.kernel.support : scene.kernel.support_factor * o.spacing;

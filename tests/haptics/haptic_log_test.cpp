@@ -53,6 +53,12 @@ TEST(HapticLog, BadLogsAreNamedErrors) {
   EXPECT_NE(error_of("1,0,0,0,0,0,0,0,0,0,0\n0.5,0,0,0,0,0,0,0,0,0,0\n").find("bad.csv:2: time does not increase"),
             std::string::npos);
   EXPECT_THROW(read_haptic_log("/nonexistent/log.csv"), Error);
+  // issue 52: a buttons column of -1, 1e30 or 0.5 is not a button mask (they were taken as pressed)
+  for (const char* buttons : {"-1", "1e30", "0.5", "65536"})
+    EXPECT_NE(error_of(std::string("0,0,0,0,0,0,0,") + buttons + ",0,0,0\n").find("is not a button mask"),
+              std::string::npos)
+        << buttons;
+  EXPECT_EQ(error_of("0,0,0,0,0,0,0,3,0,0,0\n"), "accepted");
 }
 
 }  // namespace

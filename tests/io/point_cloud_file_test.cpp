@@ -173,7 +173,10 @@ TEST(PointCloudFile, MalformedTruncatedAndHostileFilesAreNamedErrors) {
   has(error_of(text_cloud(' ', false) + "0.1 0.2 zero\n", ".xyz"), "\"zero\" is not a number");
   has(error_of("# nothing\n", ".xyz"), "no points");
   has(error_of("0 0 0 0 0 0 0\n", ".xyz"), "3 to 5 numbers");
-  has(error_of(text_cloud(',', true) + "0.3,0.3,0.3,0,-1\n", ".csv"), "volume -1 must be a positive");
+  has(error_of(text_cloud(',', true) + "0.3,0.3,0.3,0,-1\n", ".csv"), "volume -1 m^3 is out of range");
+  // issue 52: volumes of 1e-320 and 1e307 m^3 were taken, and the run "diverged"
+  has(error_of(text_cloud(',', true) + "0.3,0.3,0.3,0,1e-320\n", ".csv"), "volume 1e-320 m^3 is out of range");
+  has(error_of(text_cloud(',', true) + "0.3,0.3,0.3,0,1e307\n", ".csv"), "volume 1e+307 m^3 is out of range");
   // duplicates and degenerate clouds are reported, not simulated
   has(error_of(text_cloud(' ', false) + "0.01 0 0\n", ".xyz"), "coincide");
   has(error_of("0 0 0\n0.01 0 0\n0 0.01 0\n0.01 0.01 0\n0.02 0.01 0\n", ".xyz"), "lie on a plane");

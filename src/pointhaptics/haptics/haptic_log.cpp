@@ -56,6 +56,10 @@ std::vector<HapticLogRow> read_haptic_log(const std::string& path) {
       throw Error(
           fmt::format("{}:{}: expected 14 finite numbers (t,x,y,z,vx,vy,vz,buttons,fx,fy,fz,tx,ty,tz), or the first 11",
                       path, line_no));
+    // a bit mask per button: -1 and 1e30 were taken as pressed (issue 52), and their conversion was undefined
+    if (!(v[7] >= 0 && v[7] <= 65535 && v[7] == std::floor(v[7])))
+      throw Error(
+          fmt::format("{}:{}: buttons {} is not a button mask (an integer in [0, 65535])", path, line_no, v[7]));
     HapticLogRow r{v[0],
                    Vec3(v[1], v[2], v[3]),
                    Vec3(v[4], v[5], v[6]),

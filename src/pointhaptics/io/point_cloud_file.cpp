@@ -423,8 +423,14 @@ PointCloud checked(RawCloud raw, const std::string& name, double spacing) {
     if (raw.X[i].cwiseAbs().maxCoeff() > implausible)
       throw Error(fmt::format("{}: point {}: coordinate {:.3g} m is implausible (wrong endianness or units?)", name, i,
                               raw.X[i].cwiseAbs().maxCoeff()));
-    if (!raw.volume.empty() && !(raw.volume[i] > 0 && std::isfinite(raw.volume[i])))
-      throw Error(fmt::format("{}: point {}: volume {} must be a positive number (m^3)", name, i, raw.volume[i]));
+    // within a millionth to a million cells of the spacing: 1e-320 and 1e307 m^3 were taken, and the run then
+    // "diverged" (issue 52)
+    const double cell = spacing * spacing * spacing;
+    if (!raw.volume.empty() && !(raw.volume[i] >= 1e-6 * cell && raw.volume[i] <= 1e6 * cell))
+      throw Error(
+          fmt::format("{}: point {}: volume {:.3g} m^3 is out of range: must lie in [{:.3g}, {:.3g}] m^3 "
+                      "(1e-6 to 1e6 times spacing^3)",
+                      name, i, raw.volume[i], 1e-6 * cell, 1e6 * cell));
   }
   if (n < 4)
     throw Error(fmt::format("{}: {} points are no solid (4 or more, not all on a plane, are needed)", name, n));

@@ -50,6 +50,11 @@ struct OpenHapticsDevice::Api {
 
 OpenHapticsDevice::OpenHapticsDevice(const std::string& library, const std::string& device_name)
     : api_(std::make_unique<Api>()) {
+  // dlopen("") opens this program itself, and the message then blamed hdInitDevice (issue 52)
+  if (library.empty())
+    throw Error(
+        "OpenHaptics: device.library is empty: give the path of OpenHaptics' libHD.so (e.g. "
+        "\"/usr/lib/libHD.so\")");
   api_->library = ::dlopen(library.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (!api_->library)
     throw Error(
