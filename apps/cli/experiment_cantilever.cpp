@@ -182,8 +182,7 @@ int run_cantilever_experiment(const CantileverOptions& options) {
   namespace fs = std::filesystem;
   fs::create_directories(options.out);
   const fs::path out = options.out;
-  const int threads =
-      options.threads > 0 ? options.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const int threads = options.threads > 0 ? options.threads : available_cores();
   fem::find_ccx();  // fail early, with the installation hint
 
   std::vector<LoadCase> cases;

@@ -127,8 +127,7 @@ int run_contact_experiment(const ContactOptions& options) {
                     options.material));
   if (options.fem_per_radius.empty()) throw Error("experiment contact: --fem-meshes needs at least one element size");
   const Scene reference_scene = block_scene(R, *model, 0);
-  const int fem_threads =
-      options.threads > 0 ? options.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const int fem_threads = options.threads > 0 ? options.threads : available_cores();
 
   // CalculiX: the meshes, then at the finest two checks of the model itself (a tenfold contact penalty, and a
   // cylinder of the block's top area instead of its inscribed one)

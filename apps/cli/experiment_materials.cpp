@@ -201,8 +201,7 @@ int run_materials_experiment(const MaterialsOptions& options) {
   namespace fs = std::filesystem;
   fs::create_directories(options.out);
   const fs::path out = options.out;
-  const int threads =
-      options.threads > 0 ? options.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const int threads = options.threads > 0 ? options.threads : available_cores();
   fem::find_ccx();
   std::vector<MaterialModel> models = {MaterialModel::SVK, MaterialModel::NEO_HOOKEAN, MaterialModel::MOONEY_RIVLIN};
   if (!options.models.empty()) {

@@ -153,3 +153,21 @@ for ext in (".ply", ".obj", ".xyz", ".nii"):
     assert p.returncode == 1 and "not a regular file" in p.stderr, (ext, p.stderr)
     assert time.monotonic() - start < 5, ext
 print("links to /dev/zero refused at once")
+
+# on one core no third-party warning reaches stderr (TBB warned "the number of workers is currently limited to 0")
+calm = write("calm.toml", """
+[object]
+shape = "box"
+size = [0.15, 0.03, 0.03]
+spacing = 0.0075
+[solver]
+kind = "explicit"
+dt = 1e-3
+duration = 0.05
+[[fixed]]
+box = { min = [-1.0, -1.0, -1.0], max = [0.0, 1.0, 1.0] }
+""")
+p = subprocess.run([cli, "run", calm, "--quiet", "--threads", "2"], capture_output=True, text=True, timeout=120,
+                   preexec_fn=lambda: os.sched_setaffinity(0, {min(os.sched_getaffinity(0))}))
+assert p.returncode == 0 and p.stderr == "", (p.returncode, p.stderr)
+print("one core, two threads asked: stderr empty")

@@ -3,6 +3,8 @@
 #include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/task_arena.h>
 
+#include <sched.h>
+
 #include <algorithm>
 #include <thread>
 
@@ -13,8 +15,15 @@ struct Workspace::ThreadPool {
   tbb::task_arena arena;
 };
 
+int available_cores() {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  if (sched_getaffinity(0, sizeof set, &set) == 0) return std::max(1, CPU_COUNT(&set));
+  return static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+}
+
 Workspace::Workspace(const Model& model, int n_threads) : n_points_(model.n_points) {
-  if (n_threads <= 0) n_threads = std::max(1u, std::thread::hardware_concurrency());
+  if (n_threads <= 0) n_threads = available_cores();
   // a chunk per thread, but never a chunk without points
   n_threads_ = std::max(1, std::min<int>(n_threads, std::max<index_t>(1, model.n_points)));
   chunk_offset_.resize(n_threads_ + 1);
@@ -43,7 +52,10 @@ Workspace::Workspace(const Model& model, int n_threads) : n_points_(model.n_poin
   gradients = PaddedGradients::Zero(12, model.n_points);
   chunk_scalars.assign(static_cast<std::size_t>(n_threads_), 0.0);
   chunk_forces.assign(n_threads_, PaddedPoints::Zero(4, model.n_points));
-  if (n_threads_ > 1) pool_ = std::make_unique<ThreadPool>(n_threads_);
+  // the chunks (and so the sums' order) are as asked; the threads that run them are at most the cores this
+  // process may use: an arena wider than them made TBB warn "the number of workers is currently limited to 0"
+  // on one core (issue 52)
+  if (n_threads_ > 1) pool_ = std::make_unique<ThreadPool>(std::min(n_threads_, available_cores()));
 }
 
 Workspace::~Workspace() = default;

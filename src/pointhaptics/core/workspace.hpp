@@ -27,6 +27,9 @@ struct SolverScratch {
 /// Scratch buffers and the thread pool of the force evaluation and the solvers: the one owner of every
 /// buffer a step writes besides the state.
 /// Not shared between threads that step different simulations.
+/// The cores this process may run on (its CPU affinity: `taskset`, a container's cpuset), at least 1.
+int available_cores();
+
 class Workspace {
  public:
   /// Size every buffer for `model`; n_threads = 0 means all hardware threads.

@@ -40,7 +40,7 @@ void add_problem_blocks(const Model& model, const NewtonProblem& problem,
 bool NewtonSettings::refactor_in_background(int threads) const {
   if (preconditioner != Preconditioner::CHOLESKY) return false;
   if (refactorisation == Refactorisation::BACKGROUND) return true;
-  const auto cores = static_cast<long long>(std::thread::hardware_concurrency());
+  const auto cores = static_cast<long long>(available_cores());
   return refactorisation == Refactorisation::AUTO && real_time && cores >= threads + 2LL;
 }
 
