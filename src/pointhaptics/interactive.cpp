@@ -1,7 +1,7 @@
 #include <pointhaptics/interactive.hpp>
 
 #include <pointhaptics/core/run_control.hpp>
-#include <pointhaptics/haptics/haptic_log.hpp>
+#include <pointhaptics/io/haptic_log.hpp>
 #include <pointhaptics/haptics/local_model_stray.hpp>
 
 #include <fmt/format.h>

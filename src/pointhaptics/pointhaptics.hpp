@@ -11,7 +11,7 @@
 #include <pointhaptics/mechanics/energy.hpp>
 #include <pointhaptics/scene_builder.hpp>
 #include <pointhaptics/scene_session.hpp>
-#include <pointhaptics/haptics/haptic_log.hpp>
+#include <pointhaptics/io/haptic_log.hpp>
 #include <pointhaptics/interactive.hpp>
 #include <pointhaptics/simulation.hpp>
 #include <pointhaptics/vtk_output.hpp>

@@ -3,7 +3,7 @@
 #include <pointhaptics/haptics/devices/openhaptics_device.hpp>
 #include <pointhaptics/haptics/devices/replay_device.hpp>
 #include <pointhaptics/haptics/devices/virtual_device.hpp>
-#include <pointhaptics/haptics/haptic_log.hpp>
+#include <pointhaptics/io/haptic_log.hpp>
 #include <pointhaptics/io/scene_toml.hpp>
 #include <pointhaptics/object_surface.hpp>
 #include <pointhaptics/scene_builder.hpp>

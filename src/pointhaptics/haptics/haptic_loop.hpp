@@ -2,6 +2,7 @@
 /// @file The haptic loop: every tick (1 kHz) it reads the device, solves the probe against the latest
 /// local contact model the simulation published, renders the coupling force to the device, and
 /// publishes the probe for the simulation. It never waits on the simulation and never allocates.
+#include <pointhaptics/io/haptic_log.hpp>
 #include <pointhaptics/haptics/contact.hpp>
 #include <pointhaptics/haptics/exchange.hpp>
 #include <pointhaptics/haptics/force_rendering.hpp>
@@ -30,15 +31,6 @@ struct HapticFrame {
   Vec3 force = Vec3::Zero();                                        ///< force commanded to the device, N
   Vec3 torque = Vec3::Zero();                                       ///< torque commanded to the device, N m
   long long tick = 0;  ///< ticks so far, this one included (a reader's rate meter)
-};
-
-/// One row of the haptic log (the format replay reads): time, device position and velocity, buttons, force.
-struct HapticLogRow {
-  double t = 0;
-  Vec3 position = Vec3::Zero(), velocity = Vec3::Zero();
-  unsigned buttons = 0;
-  Vec3 force = Vec3::Zero();
-  Vec3 torque = Vec3::Zero();  ///< commanded, N m (zero on a device that renders none)
 };
 
 struct HapticStats {

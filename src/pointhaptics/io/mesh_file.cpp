@@ -13,14 +13,60 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
+#include <vector>
 #include <sstream>
 
 namespace pointhaptics {
 
+namespace {
+
+// assimp's PLY reader loops for ever on malformed headers (found by fuzz_mesh_ply: no end_header line, a
+// mangled property line): the header is checked here first, line by line, within a bound on its bytes
+void check_ply_header(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  auto bad = [&](int line_no, std::string_view why) {
+    return Error(fmt::format("{}:{}: not a PLY header line ({}): \"{}\"", path, line_no, why, line.substr(0, 80)));
+  };
+  auto is_type = [](const std::string& t) {
+    static const std::set<std::string> types = {"char",  "uchar",  "short",   "ushort", "int",   "uint",
+                                                "float", "double", "int8",    "uint8",  "int16", "uint16",
+                                                "int32", "uint32", "float32", "float64"};
+    return types.count(t) > 0;
+  };
+  int line_no = 0;
+  for (std::size_t read = 0; read < (1u << 24) && std::getline(in, line); read += line.size() + 1) {
+    ++line_no;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    std::istringstream words(line);
+    std::vector<std::string> w;
+    for (std::string word; words >> word;) w.push_back(word);
+    if (line_no == 1) {
+      if (line != "ply") throw bad(line_no, "a PLY file starts with \"ply\"");
+      continue;
+    }
+    if (w.empty()) throw bad(line_no, "empty");
+    if (w[0] == "end_header" && w.size() == 1) return;
+    if (w[0] == "comment" || w[0] == "obj_info") continue;
+    if (w[0] == "format" && w.size() == 3) continue;
+    if (w[0] == "element" && w.size() == 3 && w[2].find_first_not_of("0123456789") == std::string::npos) continue;
+    if (w[0] == "property" && w.size() == 3 && is_type(w[1])) continue;
+    if (w[0] == "property" && w.size() == 5 && w[1] == "list" && is_type(w[2]) && is_type(w[3])) continue;
+    throw bad(line_no, "expected format, element, property, comment or end_header");
+  }
+  throw Error(fmt::format("{}: the PLY header has no end_header line", path));
+}
+
+}  // namespace
+
 TriangleMesh read_mesh(const std::string& path) {
   check_input_file(path, "mesh file");
+  if (file_extension(path) == ".ply") check_ply_header(path);
   Assimp::Importer importer;
-  const aiScene* scene = importer.ReadFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
+  // no post-processing: assimp's steps abort the process on some malformed files (found by fuzz_mesh_ply), so
+  // polygons are split and duplicate vertices joined here, every index checked
+  const aiScene* scene = importer.ReadFile(path, 0);
   if (!scene) throw Error(fmt::format("{}: cannot read the mesh: {}", path, importer.GetErrorString()));
   TriangleMesh mesh;
   std::size_t n_vertices = 0;
@@ -29,19 +75,24 @@ TriangleMesh read_mesh(const std::string& path) {
   index_t base = 0;
   for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
     const aiMesh* am = scene->mMeshes[m];
+    if (am->mNumVertices > 0 && !am->mVertices) throw Error(fmt::format("{}: a mesh without its vertices", path));
     for (unsigned v = 0; v < am->mNumVertices; ++v)
       mesh.V.col(base + static_cast<index_t>(v)) = Vec3(am->mVertices[v].x, am->mVertices[v].y, am->mVertices[v].z);
     for (unsigned f = 0; f < am->mNumFaces; ++f) {
       const aiFace& face = am->mFaces[f];
-      if (face.mNumIndices != 3) continue;  // points and lines of a mixed file
-      mesh.F.push_back({base + static_cast<index_t>(face.mIndices[0]), base + static_cast<index_t>(face.mIndices[1]),
-                        base + static_cast<index_t>(face.mIndices[2])});
+      if (face.mNumIndices < 3 || !face.mIndices) continue;  // points and lines of a mixed file
+      for (unsigned k = 0; k < face.mNumIndices; ++k)
+        if (face.mIndices[k] >= am->mNumVertices)
+          throw Error(fmt::format("{}: face {} names vertex {} of {}", path, f, face.mIndices[k], am->mNumVertices));
+      // a polygon as a fan of triangles from its first vertex (the faces of mesh files are convex)
+      for (unsigned k = 1; k + 1 < face.mNumIndices; ++k)
+        mesh.F.push_back({base + static_cast<index_t>(face.mIndices[0]), base + static_cast<index_t>(face.mIndices[k]),
+                          base + static_cast<index_t>(face.mIndices[k + 1])});
     }
     base += static_cast<index_t>(am->mNumVertices);
   }
   if (mesh.F.empty()) throw Error(fmt::format("{}: the file holds no triangle", path));
-  // STL repeats every vertex per triangle; assimp's joining keeps them apart across meshes, so join
-  // exact duplicates here too, which the closedness check needs
+  // STL repeats every vertex per triangle: exact duplicates are joined, which the closedness check needs
   std::map<std::array<double, 3>, index_t> unique;
   std::vector<index_t> remap(static_cast<std::size_t>(mesh.V.cols()));
   Points joined(3, mesh.V.cols());

@@ -1,5 +1,6 @@
-// Tests for haptics/haptic_log: the log round-trips and bad logs are named errors.
-#include <pointhaptics/haptics/haptic_log.hpp>
+// Tests for io/haptic_log: the log round-trips and bad logs are named errors.
+#include <pointhaptics/core/error.hpp>
+#include <pointhaptics/io/haptic_log.hpp>
 
 #include <gtest/gtest.h>
 

@@ -1,5 +1,6 @@
-#include <pointhaptics/haptics/haptic_log.hpp>
+#include <pointhaptics/io/haptic_log.hpp>
 
+#include <pointhaptics/core/error.hpp>
 #include <pointhaptics/io/input_file.hpp>
 #include <pointhaptics/io/output_file.hpp>
 

@@ -1,13 +1,22 @@
 #pragma once
 /// @file The haptic log: one row per tick (time, device position and velocity, buttons, force), as CSV.
 /// The replay device reads the same format back.
-#include <pointhaptics/haptics/haptic_loop.hpp>
+#include <pointhaptics/core/types.hpp>
 #include <pointhaptics/io/output_file.hpp>
 
 #include <string>
 #include <vector>
 
 namespace pointhaptics {
+
+/// One row of the haptic log (the format replay reads): time, device position and velocity, buttons, force.
+struct HapticLogRow {
+  double t = 0;
+  Vec3 position = Vec3::Zero(), velocity = Vec3::Zero();
+  unsigned buttons = 0;
+  Vec3 force = Vec3::Zero();
+  Vec3 torque = Vec3::Zero();  ///< commanded, N m (zero on a device that renders none)
+};
 
 /// Header: t,x,y,z,vx,vy,vz,buttons,fx,fy,fz,tx,ty,tz (s, m, m/s, bit mask, N, N m; device frame). A log of
 /// the first 11 columns (before the torque's) reads with zero torque.
