@@ -143,6 +143,10 @@ extern "C" void on_interrupt(int) {
   ph::request_stop();
 }
 
+// `run`'s exit status (README, "Running a scene"): 0 a physical result; 1 an error, a solve that did not
+// converge, a failed output or device; 3 steps that ended with inverted neighbourhoods; 130 interrupted
+constexpr int exit_unphysical_steps = 3;
+
 // An output that fails (a full disk) is reported, and the others are still written
 struct OutputErrors {
   std::vector<std::string> messages;
@@ -358,6 +362,15 @@ int run_command(const RunOptions& opt) {
     fmt::print(stderr, "pointhaptics: {}: {}\n", opt.scene,
                summary.failure.empty() ? "the solver did not converge" : summary.failure);
     return 1;
+  }
+  // the exit status is the whole run's, not its last step's (issue 52: a press whose steps were inverted three
+  // times in four exited 0 or 1 by the chance of its last step)
+  if (summary.inverted_steps > 0) {
+    fmt::print(stderr,
+               "pointhaptics: {}: {} of {} steps ended with inverted neighbourhoods (det F <= 0): not a physical "
+               "result there (a finer spacing, a softer press, or the neo_hookean material)\n",
+               opt.scene, summary.inverted_steps, summary.steps);
+    return exit_unphysical_steps;
   }
   return 0;
 }

@@ -5,7 +5,9 @@
 - a set-up of 9261 points with 33,500 neighbours each is announced before it starts and a SIGTERM inside it is
   honoured at once, with a result JSON that says so although no model was built (it said nothing for minutes,
   and a SIGTERM left no result);
-- a closed mesh's points carry the volume it encloses (a 5 cm cube at 1 cm had 216 points and +73%).
+- a closed mesh's points carry the volume it encloses (a 5 cm cube at 1 cm had 216 points and +73%);
+- the memory check honours ulimit -v, bench checks its sizes, a link to /dev/zero is refused at once, no TBB
+  warning on one core, and the exit status counts every step with inverted neighbourhoods.
 The time limits below only tell a stop from none: a loop that ignored the signal would run for minutes.
 Usage: cli_interrupt.py CLI WORK
 """
@@ -171,3 +173,35 @@ p = subprocess.run([cli, "run", calm, "--quiet", "--threads", "2"], capture_outp
                    preexec_fn=lambda: os.sched_setaffinity(0, {min(os.sched_getaffinity(0))}))
 assert p.returncode == 0 and p.stderr == "", (p.returncode, p.stderr)
 print("one core, two threads asked: stderr empty")
+
+# the exit status is the whole run's: a deep press that inverts neighbourhoods and is then lifted ends with none
+# inverted, and exits 3, not 0 (it depended on the last step only)
+press = write("press.toml", """
+[object]
+shape = "half_sphere"
+radius = 0.05
+spacing = 0.01
+[material]
+model = "svk"
+young = 1e4
+poisson = 0.45
+density = 1000.0
+damping = 20.0
+[[fixed]]
+box = { min = [-1.0, -1.0, -1.0], max = [1.0, 0.0, 1.0] }
+[solver]
+kind = "explicit"
+dt = 1e-3
+duration = 2.0
+[probe]
+radius = 0.01
+keyframes = [[0.0, 0.0, 0.0, 0.0], [0.5, 0.0, -0.04, 0.0], [1.0, 0.0, -0.04, 0.0], [1.3, 0.0, 0.05, 0.0],
+             [2.0, 0.0, 0.05, 0.0]]
+""")
+json_path = os.path.join(work, "press.json")
+p = subprocess.run([cli, "run", press, "--deterministic", "--quiet", "--json", json_path], capture_output=True,
+                   text=True, timeout=300)
+solver = json.load(open(json_path))["solver"]
+assert solver["inverted"] == 0 and solver["inverted_steps"] > 0, solver
+assert p.returncode == 3 and "steps ended with inverted neighbourhoods" in p.stderr, (p.returncode, p.stderr)
+print("a press inverted", solver["inverted_steps"], "steps and was lifted: exit 3")
