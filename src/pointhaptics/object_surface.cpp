@@ -1,5 +1,7 @@
 #include <pointhaptics/object_surface.hpp>
 
+#include <pointhaptics/core/run_control.hpp>
+
 #include <pointhaptics/core/error.hpp>
 #include <pointhaptics/geometry/marching_tetrahedra.hpp>
 #include <pointhaptics/geometry/remesh.hpp>
@@ -40,6 +42,7 @@ TriangleMesh reconstruct_surface(const Model& model, double edge, double max_nod
   const index_t nx = field.nodes[0], ny = field.nodes[1];
   // each point adds its share V_j w(r, h_j) to the nodes within its support
   for (index_t j = 0; j < model.n_points; ++j) {
+    throw_if_stop_requested("the surface reconstruction");
     const double h = own_support ? model.support[j] : model.h;
     const Vec3 x = model.X.col(j);
     index_t first[3], last[3];

@@ -43,17 +43,29 @@ ModelEstimate estimate_model(double n_points, const KernelParams& kernel, double
 double estimated_points(const Scene& scene) {
   const ObjectSpec& o = scene.object;
   const double s = o.spacing;
+  double n = NAN;
+  Vec3 lo = o.origin, hi = o.origin;
   switch (o.shape) {
     case ShapeKind::BOX: {
-      double n = 1;
+      n = 1;
       for (int a = 0; a < 3; ++a) n *= std::floor(o.size[a] / s + 1e-9) + 1;
-      return n;
+      hi = o.origin + o.size;
+      break;
     }
-    case ShapeKind::SPHERE: return 4.0 / 3.0 * std::numbers::pi * std::pow(o.radius / s, 3);
-    case ShapeKind::HALF_SPHERE: return 2.0 / 3.0 * std::numbers::pi * std::pow(o.radius / s, 3);
+    case ShapeKind::SPHERE: n = 4.0 / 3.0 * std::numbers::pi * std::pow(o.radius / s, 3); break;
+    case ShapeKind::HALF_SPHERE: n = 2.0 / 3.0 * std::numbers::pi * std::pow(o.radius / s, 3); break;
     case ShapeKind::FILE: return NAN;
   }
-  return NAN;
+  if (o.shape != ShapeKind::BOX) {
+    lo.array() -= o.radius;
+    hi.array() += o.radius;
+  }
+  // [[refine]] regions add their fine points: the part of their bounds within the object's, at their spacing
+  for (const RefineSpec& r : scene.refine) {
+    const Vec3 extent = (r.bounds().max.cwiseMin(hi) - r.bounds().min.cwiseMax(lo)).cwiseMax(0.0);
+    n += (extent.array() / r.spacing + 1).prod();
+  }
+  return n;
 }
 
 void check_model_fits(double n_points, const Scene& scene, double max_memory, bool announce_setup) {
@@ -172,6 +184,8 @@ PointCloud sample_object(const Scene& scene) {
                     Refinement{[&r](const Vec3& x, double grow) { return r.contains(x, grow); },
                                fine_lattice(o, r.spacing, bounds)},
                     object_inside(o), support);
+    } catch (const Interrupted&) {
+      throw;  // a stop, not an error of this table
     } catch (const Error& e) {
       throw Error(fmt::format("{}:{}: {}", scene.path, r.line, e.what()));
     }
@@ -250,10 +264,13 @@ void apply_stiffness_map(const Scene& scene, PointCloud& cloud) {
 
 Model build_scene_model(const Scene& scene, double max_memory) {
   // too big for the machine: refused before anything is allocated (files once they are read)
-  check_model_fits(estimated_points(scene), scene, max_memory, false);
+  // announced from the estimate when there is one (a refinement's fine points take long to sample), else once the
+  // file's points are known
+  const double estimate = estimated_points(scene);
+  check_model_fits(estimate, scene, max_memory, true);
   PointCloud cloud = sample_object(scene);
   apply_stiffness_map(scene, cloud);
-  check_model_fits(static_cast<double>(cloud.X.cols()), scene, max_memory);
+  check_model_fits(static_cast<double>(cloud.X.cols()), scene, max_memory, std::isnan(estimate));
   std::vector<MaterialParams> materials;
   std::vector<std::uint8_t> material_of;
   assign_region_materials(scene, cloud.X, materials, material_of);

@@ -1,5 +1,7 @@
 #include <pointhaptics/geometry/marching_tetrahedra.hpp>
 
+#include <pointhaptics/core/run_control.hpp>
+
 #include <algorithm>
 #include <unordered_map>
 
@@ -55,7 +57,8 @@ TriangleMesh marching_tetrahedra(const GridField& field, double level) {
     else mesh.F.push_back({p, r, q});
   };
   for (index_t k = 0; k + 1 < nz; ++k)
-    for (index_t j = 0; j + 1 < ny; ++j)
+    for (index_t j = 0; j + 1 < ny; ++j) {
+      throw_if_stop_requested("the surface reconstruction");
       for (index_t i = 0; i + 1 < nx; ++i) {
         std::uint64_t corner[8];
         int above = 0;
@@ -84,6 +87,7 @@ TriangleMesh marching_tetrahedra(const GridField& field, double level) {
           }
         }
       }
+    }
   mesh.V.resize(3, static_cast<Eigen::Index>(vertices.size()));
   for (std::size_t v = 0; v < vertices.size(); ++v) mesh.V.col(static_cast<Eigen::Index>(v)) = vertices[v];
   return mesh;
