@@ -24,10 +24,12 @@
 namespace pointhaptics {
 
 namespace {
-// the set-up's seconds per point per neighbour^1.5 (a pair's work grows with the neighbourhood's size: the
-// stencil fits and the stable step's tangent products), measured on the 2-core development machine: a 0.2 m
-// box at 1 cm with support_factor 6 (904 neighbours, 7.7 s) and 10 (4188 neighbours, 76 s) (issue 52)
-constexpr double setup_seconds_per_point = 3.05e-8;
+// the set-up's seconds: per point (sampling, surface, stable step, active set: the 104k-point half-sphere of
+// scenes/half_sphere_100k_lod.toml took 7.7 s) and per point per neighbour^1.5 (a pair's work grows with the
+// neighbourhood's size: the stencil fits and the tangent products), measured on the 2-core development machine:
+// a 0.2 m box at 1 cm with support_factor 6 (904 neighbours, 7.7 s) and 10 (4188 neighbours, 76 s) (issue 52)
+constexpr double setup_seconds_per_point = 7e-5;
+constexpr double setup_seconds_per_point_neighbour = 3.05e-8;
 }  // namespace
 
 ModelEstimate estimate_model(double n_points, const KernelParams& kernel, double spacing) {
@@ -36,7 +38,8 @@ ModelEstimate estimate_model(double n_points, const KernelParams& kernel, double
   e.points = n_points;
   e.neighbours_per_point = std::max(0.0, 4.0 / 3.0 * std::numbers::pi * ratio * ratio * ratio - 1);
   e.bytes = 20e6 + n_points * (400 + 50 * e.neighbours_per_point);
-  e.setup_seconds = setup_seconds_per_point * n_points * std::pow(e.neighbours_per_point, 1.5);
+  e.setup_seconds = n_points * (setup_seconds_per_point +
+                                 setup_seconds_per_point_neighbour * std::pow(e.neighbours_per_point, 1.5));
   return e;
 }
 

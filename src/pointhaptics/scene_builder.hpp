@@ -9,8 +9,7 @@ namespace pointhaptics {
 /// What a model of n points will take, estimated before anything is built: neighbours per point from the
 /// support (4/3 pi (h / spacing)^3 on a lattice) and bytes (measured: about 400 B per point and 50 B per
 /// neighbour pair, model, state and solver scratch together; 2 kB per point at h = 2 spacings) and the
-/// set-up's seconds (measured on 2 cores: 3e-8 s per point per neighbour^1.5, from the search to the stable
-/// step).
+/// set-up's seconds (measured on 2 cores: 7e-5 s per point plus 3e-8 s per point per neighbour^1.5).
 struct ModelEstimate {
   double points = 0;
   double neighbours_per_point = 0;
