@@ -38,8 +38,8 @@ ModelEstimate estimate_model(double n_points, const KernelParams& kernel, double
   e.points = n_points;
   e.neighbours_per_point = std::max(0.0, 4.0 / 3.0 * std::numbers::pi * ratio * ratio * ratio - 1);
   e.bytes = 20e6 + n_points * (400 + 50 * e.neighbours_per_point);
-  e.setup_seconds = n_points * (setup_seconds_per_point +
-                                 setup_seconds_per_point_neighbour * std::pow(e.neighbours_per_point, 1.5));
+  e.setup_seconds =
+      n_points * (setup_seconds_per_point + setup_seconds_per_point_neighbour * std::pow(e.neighbours_per_point, 1.5));
   return e;
 }
 
