@@ -390,10 +390,7 @@ names the problem.)doc")
       .def(
           "run",
           [](PySimulation& p, double duration) {
-            {
-              const auto lock = locked(p);
-              p.sim->steps_in(duration);  // a duration that is not one, or too long, is refused before anything runs
-            }
+            // (a duration that is not one, or too long, is refused by run() before it steps)
             long_call(p, [&] {
               p.sim->run(duration);
               return false;

@@ -103,6 +103,16 @@ void expect_sphere(const PointCloud& c, const std::string& what) {
       << what << ": centroid " << mean.transpose();  // metres, orientation honoured
 }
 
+// the message of the Error f throws, or "accepted"
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "accepted";
+}
+
 class VolumeFile : public ::testing::Test {
  protected:
   void SetUp() override { std::filesystem::create_directories(dir); }
@@ -188,14 +198,6 @@ TEST_F(VolumeFile, AStiffnessMapGivesEachPointTheYoungsModulusOfItsIntensity) {
 TEST_F(VolumeFile, BadVolumesAreNamedErrors) {
   const Grid g;
   const std::vector<float> v = voxels(g, sphere);
-  auto error_of = [](const std::function<void()>& f) {
-    try {
-      f();
-    } catch (const Error& e) {
-      return std::string(e.what());
-    }
-    return std::string("accepted");
-  };
   EXPECT_NE(error_of([] { read_volume("/nonexistent/brain.nii"); }).find("/nonexistent/brain.nii"), std::string::npos);
   const std::string junk = dir + "/junk.nii";
   std::ofstream(junk) << "this is not an image";
@@ -243,14 +245,6 @@ TEST_F(VolumeFile, BadVolumesAreNamedErrors) {
 TEST_F(VolumeFile, OffsetsSpacingsAndCompressedSizesAreCheckedBeforeTheData) {
   const Grid g;
   const std::vector<float> v = voxels(g, sphere);
-  auto error_of = [](const std::function<void()>& f) {
-    try {
-      f();
-    } catch (const Error& e) {
-      return std::string(e.what());
-    }
-    return std::string("accepted");
-  };
   for (const float offset : {0.0f, -100.0f, 1e30f, NAN}) {
     const std::string path = write_nifti("offset.nii", g, v);
     std::fstream file(path, std::ios::binary | std::ios::in | std::ios::out);

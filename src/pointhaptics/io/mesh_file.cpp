@@ -21,48 +21,70 @@ namespace pointhaptics {
 
 namespace {
 
-// assimp's PLY reader loops for ever on malformed headers (found by fuzz_mesh_ply: no end_header line, a
-// mangled property line): the header is checked here first, line by line, within a bound on its bytes
-void check_ply_header(const std::string& path) {
+// A PLY file's header, read once, within a bound on its bytes: whether it declares faces (then it is a surface
+// mesh, else a point cloud), and its first malformed line, if any. assimp's PLY reader loops for ever on
+// malformed headers (found by fuzz_mesh_ply: no end_header line, a mangled property line), so a mesh's header is
+// checked here before assimp reads it.
+struct PlyHeader {
+  bool faces = false;
+  std::string problem;  ///< empty: a well-formed header
+};
+
+PlyHeader scan_ply_header(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::string line;
-  auto bad = [&](int line_no, std::string_view why) {
-    return Error(fmt::format("{}:{}: not a PLY header line ({}): \"{}\"", path, line_no, why, line.substr(0, 80)));
+  PlyHeader header;
+  const auto note = [&](int line_no, std::string_view why) {
+    if (header.problem.empty())
+      header.problem = fmt::format("{}:{}: not a PLY header line ({}): \"{}\"", path, line_no, why, line.substr(0, 80));
   };
-  auto is_type = [](const std::string& t) {
+  const auto is_type = [](const std::string& t) {
     static const std::set<std::string> types = {"char",  "uchar",  "short",   "ushort", "int",   "uint",
                                                 "float", "double", "int8",    "uint8",  "int16", "uint16",
                                                 "int32", "uint32", "float32", "float64"};
     return types.count(t) > 0;
   };
   int line_no = 0;
+  // however many comment or property lines it has (a mesh with over 1000 was taken for a cloud)
   for (std::size_t read = 0; read < (1u << 24) && std::getline(in, line); read += line.size() + 1) {
     ++line_no;
     if (!line.empty() && line.back() == '\r') line.pop_back();
     std::istringstream words(line);
     std::vector<std::string> w;
     for (std::string word; words >> word;) w.push_back(word);
+    if (line.rfind("end_header", 0) == 0) {
+      if (w.size() != 1 || w[0] != "end_header") note(line_no, "expected end_header alone");
+      return header;
+    }
     if (line_no == 1) {
-      if (line != "ply") throw bad(line_no, "a PLY file starts with \"ply\"");
+      if (line != "ply") note(line_no, "a PLY file starts with \"ply\"");
       continue;
     }
-    if (w.empty()) throw bad(line_no, "empty");
-    if (w[0] == "end_header" && w.size() == 1) return;
-    if (w[0] == "comment" || w[0] == "obj_info") continue;
-    if (w[0] == "format" && w.size() == 3) continue;
-    if (w[0] == "element" && w.size() == 3 && w[2].find_first_not_of("0123456789") == std::string::npos) continue;
-    if (w[0] == "property" && w.size() == 3 && is_type(w[1])) continue;
-    if (w[0] == "property" && w.size() == 5 && w[1] == "list" && is_type(w[2]) && is_type(w[3])) continue;
-    throw bad(line_no, "expected format, element, property, comment or end_header");
+    if (w.size() >= 3 && w[0] == "element" && w[1] == "face") {
+      try {
+        header.faces = header.faces || std::stoll(w[2]) > 0;
+      } catch (...) {
+        // not a count: noted below
+      }
+    }
+    if (w.empty()) note(line_no, "empty");
+    else if (w[0] == "comment" || w[0] == "obj_info") continue;
+    else if (w[0] == "format" && w.size() == 3) continue;
+    else if (w[0] == "element" && w.size() == 3 && w[2].find_first_not_of("0123456789") == std::string::npos) continue;
+    else if (w[0] == "property" && w.size() == 3 && is_type(w[1])) continue;
+    else if (w[0] == "property" && w.size() == 5 && w[1] == "list" && is_type(w[2]) && is_type(w[3])) continue;
+    else note(line_no, "expected format, element, property, comment or end_header");
   }
-  throw Error(fmt::format("{}: the PLY header has no end_header line", path));
+  if (header.problem.empty()) header.problem = fmt::format("{}: the PLY header has no end_header line", path);
+  return header;
 }
 
 }  // namespace
 
 TriangleMesh read_mesh(const std::string& path) {
   check_input_file(path, "mesh file");
-  if (file_extension(path) == ".ply") check_ply_header(path);
+  if (file_extension(path) == ".ply")
+    if (const PlyHeader header = scan_ply_header(path); !header.problem.empty()) throw Error(header.problem);
   Assimp::Importer importer;
   // no post-processing: assimp's steps abort the process on some malformed files (found by fuzz_mesh_ply), so
   // polygons are split and duplicate vertices joined here, every index checked
@@ -150,19 +172,7 @@ void write_mesh(const std::string& path, const TriangleMesh& mesh, std::string_v
 
 bool ply_has_faces(const std::string& path) {
   check_input_file(path, "PLY file");
-  std::ifstream in(path, std::ios::binary);
-  std::string line;
-  // the header only, however many comment or property lines it has (a mesh with over 1000 was taken for a
-  // cloud), within a bound on its bytes
-  for (std::size_t read = 0; read < (1u << 24) && std::getline(in, line); read += line.size() + 1) {
-    if (line.rfind("end_header", 0) == 0) break;
-    std::istringstream words(line);
-    std::string keyword, element;
-    long long count = 0;
-    words >> keyword >> element >> count;
-    if (keyword == "element" && element == "face" && count > 0) return true;
-  }
-  return false;
+  return scan_ply_header(path).faces;
 }
 
 }  // namespace pointhaptics
