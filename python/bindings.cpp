@@ -8,6 +8,7 @@
 #include <pointhaptics/mechanics/model_builder.hpp>
 #include <pointhaptics/mechanics/viscoelasticity.hpp>
 #include <pointhaptics/pointhaptics.hpp>
+#include <pointhaptics/core/stoppable_call.hpp>
 
 #include <fmt/format.h>
 #include <pybind11/numpy.h>
@@ -16,11 +17,13 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <memory>
 #include <csignal>
 #include <mutex>
 #include <optional>
+#include <thread>
 
 namespace py = pybind11;
 namespace ph = pointhaptics;
@@ -296,6 +299,13 @@ PYBIND11_MODULE(_pointhaptics, m) {
   (void)py::array_t<bool>(0);
   InterruptibleCall::main_thread_ident =
       py::module_::import("threading").attr("main_thread")().attr("ident").cast<unsigned long>();
+  // a Ctrl-C leaves an uninterruptible library call (CHOLMOD's factorisation) ending on a thread of its own
+  // (core/stoppable_call.hpp): the interpreter waits for it before it exits, so that no static destructor (the
+  // BLAS's buffers) runs under it
+  py::module_::import("atexit").attr("register")(py::cpp_function([] {
+    const py::gil_scoped_release unlocked;
+    while (ph::abandoned_work_running() > 0) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }));
 
   m.attr("__version__") = "0.1.0";
   m.def(

@@ -86,9 +86,17 @@ TEST(StopRequest, EndsNewtonKeepingTheImplicitStepStartAndTheNextStepConverges) 
   }
   EXPECT_EQ(sim.time(), 0);
   EXPECT_EQ(sim.state().u.norm(), 0);
+  // the state is not a step's result: the summary, whatever front end asks, never calls it converged
+  const RunSummary stopped = sim.summary();
+  EXPECT_FALSE(stopped.converged);
+  EXPECT_TRUE(stopped.interrupted);
+  EXPECT_EQ(stopped.failure, "interrupted during Newton iterations");
   EXPECT_NE(sim.step().status, StepStatus::FAILED);
   EXPECT_NEAR(sim.time(), 1e-2, 1e-12);
   EXPECT_GT(sim.state().u.norm(), 0);
+  const RunSummary stepped = sim.summary();
+  EXPECT_TRUE(stepped.converged);
+  EXPECT_FALSE(stepped.interrupted);
 }
 
 TEST(StopRequest, EndsAStaticSolveAtItsLastEquilibrium) {

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <functional>
 #include <string>
+#include <string_view>
 #include <unistd.h>
 
 namespace pointhaptics::cli {
@@ -48,12 +49,13 @@ class ProgressBar {
 };
 
 /// The library's long loops on the command line: a set-up phase shows a bar named after it, an announcement is
-/// printed, and during the steps a long step's sub-steps are handed to `within_step` (the run's own bar).
+/// printed, and during the steps a long step's sub-steps are handed to `within_step` (the run's own bar); other
+/// phases inside a step (a long factorisation) show their own bar.
 class PhaseProgress : public ProgressSink {
  public:
   PhaseProgress(std::string scene, bool enabled) : scene_(std::move(scene)), bar_(enabled) {}
   void progress(const char* phase, double fraction) override {
-    if (within_step) {
+    if (within_step && std::string_view(phase) == substep_phase) {
       within_step(fraction);
       return;
     }
@@ -63,8 +65,8 @@ class PhaseProgress : public ProgressSink {
     }
     bar_.update(fraction, phase_);
   }
-  void finished(const char* /*phase*/) override {
-    if (!within_step) bar_.finish();
+  void finished(const char* phase) override {
+    if (!within_step || std::string_view(phase) != substep_phase) bar_.finish();
   }
   void announce(const std::string& message) override {
     bar_.finish();

@@ -1,6 +1,7 @@
 #include <pointhaptics/simulation.hpp>
 
 #include <pointhaptics/core/error.hpp>
+#include <pointhaptics/core/run_control.hpp>
 #include <pointhaptics/mechanics/energy.hpp>
 #include <pointhaptics/mechanics/forces.hpp>
 #include <pointhaptics/mechanics/inversion.hpp>
@@ -25,6 +26,16 @@ Simulation& Simulation::operator=(Simulation&&) noexcept = default;
 // ---- the step pipeline: the active set here, the rest in ModelSimulation::step() -----------------------
 
 const StepReport& Simulation::step() {
+  interrupted_step_.clear();
+  try {
+    return run_step_stages();
+  } catch (const Interrupted& e) {
+    interrupted_step_ = e.what();
+    throw;
+  }
+}
+
+const StepReport& Simulation::run_step_stages() {
   const auto start = std::chrono::steady_clock::now();
   // the inputs were filled by the caller (inputs()); the active set follows the last step's contact
   if (lod_) lod_->follow_probe();
@@ -304,8 +315,9 @@ RunSummary Simulation::summary() {
   const StepDiagnostics& d = sim.diagnostics();
   RunSummary s;
   s.solver_kind = std::string(to_string(sim.solver().kind));
-  s.converged = state.u.allFinite() && !d.failed;
-  s.failure = d.failure;
+  s.converged = state.u.allFinite() && !d.failed && interrupted_step_.empty();
+  s.failure = interrupted_step_.empty() ? d.failure : interrupted_step_;
+  s.interrupted = !interrupted_step_.empty();
   s.steps = d.steps;
   s.substeps = d.substeps;
   s.iterations = d.iterations;

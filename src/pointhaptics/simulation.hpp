@@ -28,7 +28,8 @@ class Simulation {
   /// set. Dynamics: dt (explicit: sub-stepped below the stable step); static: the equilibrium under the full
   /// load (later calls start from the last solution). Never throws for a step that fails numerically: the
   /// report says FAILED and why, diagnostics() keeps it, and the state is not a result. Throws Error for a
-  /// step after a failed one.
+  /// step after a failed one. Throws Interrupted for a stop requested inside it (run_control.hpp): until the next
+  /// step completes, summary() says interrupted and not converged, with the loop it stopped in.
   const StepReport& step();
   /// Dynamics: step until time() reaches `duration` (ceil(duration / dt) steps); static: one solve.
   /// Stops at a failed step (diagnostics().failed says so). after_step(step, n_steps), if given, is called
@@ -133,6 +134,11 @@ class Simulation {
   };
   std::vector<ScriptedCut> scripted_cuts_;
   void apply_scripted_cuts();
+  /// step()'s stages; step() notes a stop inside them
+  const StepReport& run_step_stages();
+  /// What the last step was stopped in (a stop request inside it), else empty: the state is then not a step's
+  /// result, and summary() never reports it as converged
+  std::string interrupted_step_;
 };
 
 }  // namespace pointhaptics

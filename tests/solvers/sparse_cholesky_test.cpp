@@ -2,6 +2,7 @@
 // tangent over the free points, refuses a matrix that is not positive definite, and as a preconditioner it
 // gives the block-Jacobi solution with far fewer CG iterations, lagging across implicit steps. The same for the
 // two-level preconditioner (solvers/coarse_correction.hpp), whose coarse level is such a factor.
+#include <pointhaptics/core/run_control.hpp>
 #include <pointhaptics/mechanics/tangent.hpp>
 #include <pointhaptics/scene_builder.hpp>
 #include <pointhaptics/io/scene_toml.hpp>
@@ -112,6 +113,47 @@ TEST(SparseCholesky, RefusesAMatrixThatIsNotPositiveDefinite) {
   // and recovers when the matrix is good again
   Eigen::Map<Mat3>(K.values.data() + 9 * static_cast<std::size_t>(K.diagonal[free])) *= -1.0;
   EXPECT_TRUE(chol.factorise(K));
+}
+
+// CHOLMOD cannot be interrupted: a long analysis or factorisation runs on a thread of its own, which a stop
+// leaves behind (core/stoppable_call.hpp). The factor is then unanalysed, and analysed again on demand.
+TEST(SparseCholesky, AStopRequestEndsALongAnalysisOrFactorisationAndLeavesItUnanalysed) {
+  struct ClearStop {
+    ~ClearStop() { clear_stop_request(); }
+  } clear;
+  const Model model = cantilever(1e5, 0.004);  // 2432 points, 3 GFlop a factorisation: CHOLMOD runs apart
+  const TangentMatrix K = tangent_at_rest(model);
+  SparseCholesky chol;
+  request_stop();
+  EXPECT_THROW(chol.analyse(model, K), Interrupted);
+  EXPECT_FALSE(chol.analysed_for(model));
+  clear_stop_request();
+  chol.analyse(model, K);
+  ASSERT_TRUE(chol.factorise(K));
+  const double factorise_s = chol.stats().factorise_s;
+  ASSERT_GT(chol.stats().factorisation_flops, 1e9);
+  // a stop requested a tenth of the way into a factorisation is honoured long before its end
+  using Clock = std::chrono::steady_clock;
+  const auto delay = std::chrono::duration<double>(factorise_s / 10);
+  const auto start = Clock::now();
+  std::thread stopper([delay] {
+    std::this_thread::sleep_for(delay);
+    request_stop();
+  });
+  EXPECT_THROW(chol.factorise(K), Interrupted);
+  const double honoured_s = std::chrono::duration<double>(Clock::now() - start).count();
+  stopper.join();
+  EXPECT_LT(honoured_s, factorise_s / 2) << "a full factorisation takes " << factorise_s << " s";
+  EXPECT_FALSE(chol.factorised());
+  EXPECT_FALSE(chol.analysed_for(model));
+  clear_stop_request();
+  // and it serves again as before
+  chol.analyse(model, K);
+  ASSERT_TRUE(chol.factorise(K));
+  const Points b = Points::Random(3, model.n_points);
+  Points x(3, model.n_points);
+  chol.solve(b, x);
+  EXPECT_TRUE(x.allFinite());
 }
 
 // the static equilibrium with block-Jacobi (k = 0) and with `other` (k = 1): their stats and displacements

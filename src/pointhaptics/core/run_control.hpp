@@ -35,6 +35,9 @@ class ProgressSink {
   /// Work expected to be long is about to start: `message` says what and how long (one line, no newline).
   virtual void announce(const std::string& /*message*/) {}
 };
+/// The phase whose progress is the share of a step done: a long explicit step's sub-steps (other phases inside a
+/// step, a sparse factorisation, are parts of it of unknown share).
+inline constexpr const char* substep_phase = "explicit sub-steps";
 /// The sink every Progress reports to (nullptr: none, the default). The caller keeps it alive while set.
 void set_progress_sink(ProgressSink* sink) noexcept;
 /// Tell the sink, if any, that long work starts (a set-up estimated to take more than 2 s).

@@ -94,7 +94,7 @@ Model build_model(const PointCloud& cloud, const MaterialParams& material, const
   const Csr& nbr = model.neighbours;
   const index_t n_pairs = nbr.n_entries();
   // each pair's reverse; the forces and the tangent rely on the lists being symmetric (and sorted)
-  model.reverse_pair.resize(n_pairs);
+  resize_polled(model.reverse_pair, static_cast<std::size_t>(n_pairs), "the neighbour pairs");
   std::atomic<std::int64_t> one_sided{-1};
   parallel_for_polled("the neighbour pairs", n, [&](index_t i) {
     for (index_t e = nbr.begin(i); e < nbr.end(i); ++e) {

@@ -151,10 +151,10 @@ StepReport explicit_step(const Model& model, State& state, Workspace& ws, double
   // a stiff object can need millions of sub-steps in one step: they are polled (a stop leaves the state at the
   // last sub-step, a consistent state at its time) and, when many, shown as progress
   std::optional<Progress> progress;
-  if (n_sub >= many_substeps) progress.emplace("explicit sub-steps", n_sub);
+  if (n_sub >= many_substeps) progress.emplace(substep_phase, n_sub);
   for (int sub = 0; sub < n_sub; ++sub) {
     if (progress) progress->reach(sub);
-    else throw_if_stop_requested("explicit sub-steps");
+    else throw_if_stop_requested(substep_phase);
     if (sub > 0) compute_internal_forces(model, state.u, ws);
     if (forces) {
       ws.acceleration.setZero();  // scratch for the dynamic forces

@@ -1,6 +1,9 @@
 #include <pointhaptics/solvers/sparse_cholesky.hpp>
 
+#include <pointhaptics/core/stoppable_call.hpp>
+
 #include <cholmod.h>
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <atomic>
@@ -14,6 +17,15 @@ namespace pointhaptics {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+// CHOLMOD's analysis and numeric factorisation run on a thread of their own, so that a stop is honoured while
+// they run, when they are expected to take more than a few ms: above these sizes (a thread costs ~50 us)
+constexpr std::size_t stoppable_analysis_entries = 100'000;  // of A's lower triangle (~300 points)
+constexpr double stoppable_factorisation_flops = 2e7;        // CHOLMOD's count for L (~5 ms)
+// CHOLMOD's supernodal factorisation (OpenBLAS on 2 cores), flop/s: 2e10 on an 11,016-point box (224 GFlop in
+// 11 s; 7e9 on the 1,519-point cantilever's smaller supernodes). A factorisation expected to take more than 2 s is
+// announced, and its progress shown
+constexpr double factorisation_rate = 2e10;
 
 // a numeric factorisation that succeeded: CHOLMOD reports a failure (not positive definite) by L->minor < n
 bool positive_definite(int ok, const cholmod_common& common, const cholmod_factor* L) {
@@ -40,12 +52,19 @@ struct SparseCholesky::Factor {
   std::vector<std::size_t> source;                         // A's values: their places in TangentMatrix::values
   const Model* model = nullptr;
   index_t n_points = 0, n_pairs = 0, n_free = 0;
+  double flops = 0;   // of a numeric factorisation, CHOLMOD's count from the analysis
   bool good = false;  // L holds a positive definite factor
 
   // K's values into A (this factor's, or the worker's copy of it: the same pattern)
   void copy_values(const TangentMatrix& K, cholmod_sparse* target) const {
     double* x = static_cast<double*>(target->x);
     for (std::size_t p = 0; p < source.size(); ++p) x[p] = K.values[source[p]];
+  }
+
+  // L from A's values (on whatever thread: this factor's common serves it)
+  void factorise_values() {
+    const int ok = cholmod_factorize(A, L, &common);
+    good = positive_definite(ok, common, L);
   }
 
   Factor() {
@@ -107,6 +126,13 @@ struct SparseCholesky::Background {
     std::unique_lock lock(mutex);
     finished.wait(lock, [this] { return !running.load(std::memory_order_acquire); });
   }
+  // ... unless a stop is requested first (then Interrupted; the job stays pending)
+  void wait_stoppable() {
+    std::unique_lock lock(mutex);
+    while (!finished.wait_for(lock, std::chrono::milliseconds(5),
+                              [this] { return !running.load(std::memory_order_acquire); }))
+      throw_if_stop_requested("a background factorisation");
+  }
   void run() {
     for (;;) {
       {
@@ -129,8 +155,11 @@ struct SparseCholesky::Background {
   }
 };
 
-SparseCholesky::SparseCholesky() : factor_(std::make_unique<Factor>()) {}
-SparseCholesky::~SparseCholesky() = default;
+SparseCholesky::SparseCholesky() : factor_(std::make_shared<Factor>()) {}
+SparseCholesky::~SparseCholesky() {
+  // a stopped run does not wait for a background factorisation to end
+  if (background_ && stop_requested()) destroy_in_background(std::move(background_));
+}
 SparseCholesky::SparseCholesky(SparseCholesky&&) noexcept = default;
 SparseCholesky& SparseCholesky::operator=(SparseCholesky&&) noexcept = default;
 
@@ -143,6 +172,10 @@ bool SparseCholesky::factorised() const { return factor_->good; }
 
 void SparseCholesky::drop_background() {
   if (!background_) return;
+  if (background_->running.load(std::memory_order_acquire) && stop_requested()) {
+    destroy_in_background(std::move(background_));
+    throw Interrupted("interrupted during a background factorisation");
+  }
   background_->wait();
   background_->release();  // copies of the old analysis
   background_->pending = false;
@@ -193,7 +226,20 @@ void SparseCholesky::analyse(const Model& model, const TangentMatrix& K) {
   } else {
     f.common.nmethods = 0;  // CHOLMOD's default strategy
   }
-  f.L = cholmod_analyze(f.A, &f.common);
+  if (rows.size() < stoppable_analysis_entries) {
+    f.L = cholmod_analyze(f.A, &f.common);
+  } else {
+    std::shared_ptr<Factor> owner = factor_;
+    try {
+      call_stoppable("the sparse factorisation's analysis",
+                     [owner] { owner->L = cholmod_analyze(owner->A, &owner->common); });
+    } catch (const Interrupted&) {
+      factor_ = std::make_shared<Factor>();  // the abandoned one is freed when CHOLMOD is done with it
+      stats_ = {};
+      throw;
+    }
+  }
+  f.flops = f.common.fl;
   f.b.assign(dofs, 0.0);
   f.model = &model;
   f.n_points = n;
@@ -201,6 +247,7 @@ void SparseCholesky::analyse(const Model& model, const TangentMatrix& K) {
   f.n_free = dofs / 3;
   stats_ = {};
   stats_.factor_nonzeros = f.common.lnz;
+  stats_.factorisation_flops = f.flops;
   stats_.analyse_s = std::chrono::duration<double>(Clock::now() - start).count();
 }
 
@@ -209,9 +256,24 @@ bool SparseCholesky::factorise(const TangentMatrix& K) {
   if (!f.L) return false;
   const auto start = Clock::now();
   f.copy_values(K, f.A);
-  const int ok = cholmod_factorize(f.A, f.L, &f.common);
-  // a failed factorisation leaves L incomplete (minor < n) but reusable by the next attempt
-  f.good = positive_definite(ok, f.common, f.L);
+  const double expected_s = f.flops / factorisation_rate;
+  if (expected_s > 2 && stats_.factorisations == 0)
+    announce(fmt::format("the sparse factorisation: {} unknowns, {:.3g} GFlop, about {} per factorisation",
+                         f.n_free * 3, f.flops * 1e-9, format_duration(expected_s)));
+  if (f.flops < stoppable_factorisation_flops) {
+    f.factorise_values();
+  } else {
+    std::shared_ptr<Factor> owner = factor_;
+    try {
+      call_stoppable(
+          "the sparse factorisation", [owner] { owner->factorise_values(); }, expected_s);
+    } catch (const Interrupted&) {
+      factor_ = std::make_shared<Factor>();
+      stats_ = {};
+      throw;
+    }
+  }
+  // (a failed factorisation leaves L incomplete, minor < n, but reusable by the next attempt)
   ++stats_.factorisations;
   stats_.factorise_s = std::chrono::duration<double>(Clock::now() - start).count();
   if (f.good) {
@@ -257,7 +319,7 @@ bool SparseCholesky::background_ready() const {
 bool SparseCholesky::take_background() {
   if (!background_pending()) return false;
   Background& b = *background_;
-  b.wait();
+  b.wait_stoppable();
   b.pending = false;
   if (!b.good) return false;
   Factor& f = *factor_;

@@ -11,10 +11,11 @@
 namespace pointhaptics {
 
 struct CholeskyStats {
-  double factor_nonzeros = 0;  ///< entries of L
-  double factor_bytes = 0;     ///< L's values and indices, bytes
-  double analyse_s = 0;        ///< the ordering and symbolic factor, s
-  double factorise_s = 0;      ///< the last numeric factorisation, s (in the background: on the worker)
+  double factor_nonzeros = 0;      ///< entries of L
+  double factor_bytes = 0;         ///< L's values and indices, bytes
+  double factorisation_flops = 0;  ///< of one numeric factorisation (CHOLMOD's count from the analysis)
+  double analyse_s = 0;            ///< the ordering and symbolic factor, s
+  double factorise_s = 0;          ///< the last numeric factorisation, s (in the background: on the worker)
   long long factorisations = 0;
   long long background_factorisations = 0;  ///< of them, made on the worker thread and taken up
   double background_bytes = 0;  ///< the worker's copy of A and L (0 until a background factorisation), bytes
@@ -28,7 +29,9 @@ class SparseCholesky {
   SparseCholesky& operator=(SparseCholesky&&) noexcept;
 
   /// Order and analyse K's pattern over the points that are not held (Model::fixed). Call again when the model
-  /// (its points, stencils or held points) changes.
+  /// (its points, stencils or held points) changes. This and factorise() honour a stop request within 5 ms
+  /// when they are long (CHOLMOD cannot be interrupted: it is left to end on a thread of its own, and this is
+  /// left unanalysed), and throw Interrupted.
   void analyse(const Model& model, const TangentMatrix& K);
   /// The model analyse() was called for (its address, points, pairs and free points), else false.
   bool analysed_for(const Model& model) const;
@@ -62,7 +65,7 @@ class SparseCholesky {
   struct Background;  // the worker thread and its copy of A and L
   /// Wait for a background factorisation that is running and drop it (a new analysis is made).
   void drop_background();
-  std::unique_ptr<Factor> factor_;
+  std::shared_ptr<Factor> factor_;  // shared with a stoppable call (core/stoppable_call.hpp) while it runs
   std::unique_ptr<Background> background_;
   CholeskyStats stats_;
 };
