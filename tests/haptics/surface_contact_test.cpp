@@ -66,8 +66,62 @@ std::vector<ToolCase> tools() {
   ToolShape capsule{ToolKind::CAPSULE, 0.006, 0.02};
   // the capsule lies across the top face, tilted, its axis off the block's centre
   const Eigen::Quaterniond tilted(Eigen::AngleAxisd(1.3, Vec3(0.2, 0.1, 1).normalized()));
+  // a rounded box turned so that an edge and a corner press into the top face 1.5 mm deep (obstacles)
+  ToolShape box{ToolKind::BOX, 0.002, 0, Vec3(0.006, 0.004, 0.005)};
+  const Eigen::Quaterniond turned(Eigen::AngleAxisd(0.3, Vec3(1, 0, 0.5).normalized()));
+  const Eigen::Matrix3d R = turned.toRotationMatrix();
+  const double box_below = box.radius + R.row(1).cwiseAbs().dot(box.half_core);
+  // a plane tilted over the top face, its normal down: the half-space above holds part of the face
+  ToolShape plane{ToolKind::PLANE, 0.01, 0};
+  const Eigen::Quaterniond facing_down =
+      Eigen::Quaterniond::FromTwoVectors(Vec3::UnitZ(), Vec3(0.1, -1, 0.05).normalized());
   return {{"sphere", sphere, {Vec3(0.02, 0.02 + 0.01 - 0.0015, 0.02), Eigen::Quaterniond::Identity()}},
-          {"capsule", capsule, {Vec3(0.018, 0.02 + 0.006 - 0.001, 0.021), tilted}}};
+          {"capsule", capsule, {Vec3(0.018, 0.02 + 0.006 - 0.001, 0.021), tilted}},
+          {"box", box, {Vec3(0.021, 0.02 + box_below - 0.0015, 0.019), turned}},
+          {"plane", plane, {Vec3(0.02, 0.0195, 0.02), facing_down}}};
+}
+
+// The obstacles' shapes: a plane's penetration is the depth below it; a box's, out through its nearest face
+// inside, and from its rounded edges and corners outside, with the normal the penetration's gradient.
+TEST(ToolDistance, PlanesAndBoxesGiveTheirDepthAndOutwardNormal) {
+  const ToolShape plane{ToolKind::PLANE, 0.01, 0};
+  const ToolPose table{Vec3(0, 0.1, 0), Eigen::Quaterniond::FromTwoVectors(Vec3::UnitZ(), Vec3::UnitY())};
+  ToolDistance d = tool_distance(plane, table, Vec3(3, 0.097, -2));
+  EXPECT_NEAR(d.penetration, 0.003, 1e-12);
+  EXPECT_LT((d.normal - Vec3::UnitY()).norm(), 1e-12);
+  EXPECT_LT((d.core - Vec3(3, 0.1, -2)).norm(), 1e-12);
+  EXPECT_EQ(d.curvature, 0);
+  EXPECT_NEAR(tool_distance(plane, table, Vec3(0, 0.25, 0)).penetration, -0.15, 1e-12);
+
+  const ToolShape box{ToolKind::BOX, 0.001, 0, Vec3(0.02, 0.01, 0.03)};
+  const ToolPose at{Vec3(1, 2, 3), Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Vec3(1, 2, 0.5).normalized()))};
+  const auto world = [&](const Vec3& local) { return Vec3(at.position + at.orientation * local); };
+  // inside the core, nearest the +y face: 4 mm to it, plus the rounding
+  d = tool_distance(box, at, world(Vec3(0.005, 0.006, -0.01)));
+  EXPECT_NEAR(d.penetration, 0.004 + 0.001, 1e-12);
+  EXPECT_LT((d.normal - at.orientation * Vec3::UnitY()).norm(), 1e-12);
+  // outside a face, an edge and a corner
+  d = tool_distance(box, at, world(Vec3(0.0, 0.0105, 0.0)));
+  EXPECT_NEAR(d.penetration, 0.0005, 1e-12);
+  EXPECT_EQ(d.curvature, 0);
+  d = tool_distance(box, at, world(Vec3(0.0203, 0.0104, 0.0)));
+  EXPECT_NEAR(d.penetration, 0.001 - 0.0005, 1e-12);
+  EXPECT_NEAR(d.curvature, 1 / 0.0005, 1e-6);
+  EXPECT_LT((d.axis.cwiseAbs() - (at.orientation * Vec3::UnitZ()).cwiseAbs()).norm(), 1e-12);
+  d = tool_distance(box, at, world(Vec3(-0.0206, -0.0108, 0.0300)));
+  EXPECT_NEAR(d.penetration, 0.001 - 0.001, 1e-12);
+  EXPECT_EQ(d.axis.norm(), 0);
+  // the normal is the penetration's gradient (central differences), wherever the point is
+  for (const Vec3& local : {Vec3(0.005, 0.006, -0.01), Vec3(0.0203, 0.0104, 0.0), Vec3(0.01, -0.0104, 0.0302)}) {
+    const Vec3 p = world(local);
+    const ToolDistance at_p = tool_distance(box, at, p);
+    Vec3 gradient;
+    for (int a = 0; a < 3; ++a) {
+      const Vec3 e = 1e-7 * Vec3::Unit(a);
+      gradient[a] = (tool_distance(box, at, p - e).penetration - tool_distance(box, at, p + e).penetration) / 2e-7;
+    }
+    EXPECT_LT((gradient - at_p.normal).norm(), 1e-6) << local.transpose();
+  }
 }
 
 // Forces are the energy's gradient (central differences of the energy) and the exact tangent their
@@ -293,7 +347,7 @@ TEST(SurfaceContact, CapsuleTorqueIsTheMomentOfItsForces) {
   const Points& y = contact.vertices();
   for (index_t v = 0; v < y.cols(); ++v) {
     const ToolDistance d = tool_distance(t.shape, t.pose, y.col(v));
-    const double g = d.penetration(t.shape);
+    const double g = d.penetration;
     if (g <= 0) continue;
     torque += (d.core - t.pose.position).cross(-g * d.normal);
   }

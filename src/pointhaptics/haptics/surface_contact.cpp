@@ -153,7 +153,7 @@ double SurfaceContact::energy(const Model&, const Points& u) {
   for (index_t v = 0; v < y_.cols(); ++v) {
     const double lambda = lambda_[static_cast<std::size_t>(v)], k = penalty_[static_cast<std::size_t>(v)];
     if (lambda == 0 && (y_.col(v) - pose_.position).squaredNorm() > far * far) continue;
-    const double t = std::max(lambda + k * tool_distance(shape_, pose_, y_.col(v)).penetration(shape_), 0.0);
+    const double t = std::max(lambda + k * tool_distance(shape_, pose_, y_.col(v)).penetration, 0.0);
     e += (t * t - lambda * lambda) / (2 * k);
   }
   // friction: quadratic in the trial force inside the cone, linear beyond it (so a slide is one minimisation,
@@ -201,8 +201,8 @@ ToolLoad SurfaceContact::for_each_pressing(const Pressing& pressing) const {
     const double lambda = lambda_[static_cast<std::size_t>(v)], k = penalty_[static_cast<std::size_t>(v)];
     if (lambda == 0 && (y_.col(v) - pose_.position).squaredNorm() > far * far) continue;
     const ToolDistance d = tool_distance(shape_, pose_, y_.col(v));
-    out.penetration = std::max(out.penetration, d.penetration(shape_));
-    const double pressure = lambda + k * d.penetration(shape_);
+    out.penetration = std::max(out.penetration, d.penetration);
+    const double pressure = lambda + k * d.penetration;
     if (!(pressure > 0)) continue;
     const Vec3 on_tool = -pressure * d.normal;
     out.force += on_tool;
@@ -242,10 +242,10 @@ void SurfaceContact::linearise(const Model&, const Points& u, TangentMode mode) 
   for_each_pressing([&](index_t v, const ToolDistance& d, double pressure) {
     // d2E/dy2 = k n n^T - p dn/dy: the second part (the tool's curvature, negative) only in the exact tangent
     Mat3 hessian = penalty_[static_cast<std::size_t>(v)] * d.normal * d.normal.transpose();
-    if (mode == TangentMode::EXACT && d.from_core > 0) {
+    if (mode == TangentMode::EXACT && d.curvature > 0) {
       const Mat3 off_normal = Mat3::Identity() - d.normal * d.normal.transpose();
       const Mat3 along = Mat3::Identity() - d.axis * d.axis.transpose();
-      hessian -= (pressure / d.from_core) * off_normal * along;
+      hessian -= (pressure * d.curvature) * off_normal * along;
     }
     active_.push_back(
         {v, d.normal, pressure, hessian, penalty_[static_cast<std::size_t>(v)] * d.normal * d.normal.transpose()});
@@ -312,7 +312,7 @@ bool SurfaceContact::update_multipliers(const Model& model, const Points& u) {
     if (!a.held) {
       // pressing without an anchor (a multiplier, or only the penalty at the contact's rim): anchor it first
       met = met && lambda_[static_cast<std::size_t>(v)] == 0 &&
-            !(tool_distance(shape_, pose_, y_.col(v)).penetration(shape_) > 0);
+            !(tool_distance(shape_, pose_, y_.col(v)).penetration > 0);
       continue;
     }
     const double k = tangential_penalty(v);
@@ -320,7 +320,7 @@ bool SurfaceContact::update_multipliers(const Model& model, const Points& u) {
     // a sticking vertex is done on its anchor, a sliding one when its force stopped changing; and its cone,
     // friction x lambda, is its pressure to 1% (lambda + k g: a penetration within the tolerance still made
     // the penalty's part of the pressure as large as lambda, and the friction 5% short of mu x pressure)
-    const double g = std::max(tool_distance(shape_, pose_, y_.col(v)).penetration(shape_), 0.0);
+    const double g = std::max(tool_distance(shape_, pose_, y_.col(v)).penetration, 0.0);
     met = met && (clamped - a.tau).norm() <= k * tolerance_ &&
           penalty_[static_cast<std::size_t>(v)] * g <= 0.01 * lambda_[static_cast<std::size_t>(v)];
     // beyond the cone the anchor follows the vertex (the slide so far), the force unchanged
@@ -331,7 +331,7 @@ bool SurfaceContact::update_multipliers(const Model& model, const Points& u) {
     double& lambda = lambda_[static_cast<std::size_t>(v)];
     const double k = penalty_[static_cast<std::size_t>(v)];
     const ToolDistance d = tool_distance(shape_, pose_, y_.col(v));
-    lambda = std::max(lambda + k * d.penetration(shape_), 0.0);
+    lambda = std::max(lambda + k * d.penetration, 0.0);
     advance_anchor(v, d);
   }
   return false;
@@ -400,7 +400,7 @@ ToolLoad SurfaceContact::advance_multipliers(double rate, double max_force) {
     double& lambda = lambda_[static_cast<std::size_t>(v)];
     if (lambda == 0 && (y_.col(v) - pose_.position).squaredNorm() > far * far) continue;
     const ToolDistance d = tool_distance(shape_, pose_, y_.col(v));
-    lambda = std::max(lambda + rate * penalty_[static_cast<std::size_t>(v)] * d.penetration(shape_), 0.0);
+    lambda = std::max(lambda + rate * penalty_[static_cast<std::size_t>(v)] * d.penetration, 0.0);
     pressing += lambda * d.normal;
   }
   if (pressing.norm() > max_force)
