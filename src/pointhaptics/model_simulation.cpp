@@ -200,7 +200,7 @@ const StepReport& ModelSimulation::step() {
   place_tools();
   const auto placed = clock::now();
   // the solver: internal, external and tool forces, time integration or equilibrium, held points
-  DynamicForces* tools = probe_ ? static_cast<DynamicForces*>(&probe_->tool) : held_tool_.get();
+  DynamicForces* tools = forces_this_step();
   solver_impl_->set_real_time(probe_ && probe_->asynchronous_lod);
   report_ = solver_impl_->step(model_, state_, ws_, tools);
   if (tools && report_.status != StepStatus::FAILED) tools->after_step(model_, state_, ws_);
@@ -213,6 +213,15 @@ const StepReport& ModelSimulation::step() {
   diagnostics_.solve_seconds += seconds(placed, solved);
   record(report_, seconds(start, clock::now()));
   return report_;
+}
+
+DynamicForces* ModelSimulation::forces_this_step() {
+  DynamicForces* tool = probe_ ? static_cast<DynamicForces*>(&probe_->tool) : held_tool_.get();
+  if (obstacles_.empty()) return tool;
+  forces_.clear();
+  if (tool) forces_.add_member(tool);
+  for (Obstacle& o : obstacles_) forces_.add_member(&o.contact);
+  return &forces_;
 }
 
 void ModelSimulation::place_tools() {

@@ -13,6 +13,7 @@
 #include <pointhaptics/object_surface.hpp>
 
 #include <future>
+#include <pointhaptics/solvers/force_set.hpp>
 #include <pointhaptics/solvers/solver.hpp>
 
 #include <array>
@@ -87,6 +88,13 @@ SurfaceContact probe_surface_contact(const ObjectSurface& surface, const Surface
 SurfaceContact probe_surface_contact(ActiveSurface part, const SurfaceContactParams& params, const ToolShape& shape,
                                      const Model& model, const ActiveSet& active);
 
+/// A static rigid body the object rests on or is pressed against (a table, a bone): a held tool that never
+/// moves, named for its reported force.
+struct Obstacle {
+  std::string name;
+  HeldTool contact;
+};
+
 class ModelSimulation {
  public:
   /// Take the model (never written again) and prepare the solver; n_threads = 0: all hardware threads.
@@ -136,6 +144,9 @@ class ModelSimulation {
   /// A tool held at a pose the program sets (a static indentation); at most one of it and the probe.
   std::unique_ptr<HeldTool>& held_tool() { return held_tool_; }
   const HeldTool* held_tool() const { return held_tool_.get(); }
+  /// The obstacles, pressed on by the object beside its tool.
+  std::vector<Obstacle>& obstacles() { return obstacles_; }
+  const std::vector<Obstacle>& obstacles() const { return obstacles_; }
 
  private:
   friend class LevelsOfDetail;  // takes the object's model, state, diagnostics and probe over
@@ -146,6 +157,11 @@ class ModelSimulation {
   void count_inverted_neighbourhoods();
   void record(const StepReport& report, double seconds);
 
+  /// what acts on the model beside its material this step: the probe or held tool, and the obstacles
+  /// (rebuilt each step from them; no allocation once it has held them all)
+  DynamicForces* forces_this_step();
+  ForceSet forces_;
+  std::vector<Obstacle> obstacles_;
   Model model_;
   SolverSpec solver_;
   State state_;

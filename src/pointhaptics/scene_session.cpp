@@ -1,5 +1,6 @@
 #include <pointhaptics/scene_session.hpp>
 
+#include <pointhaptics/core/run_control.hpp>
 #include <pointhaptics/haptics/devices/openhaptics_device.hpp>
 #include <pointhaptics/haptics/devices/replay_device.hpp>
 #include <pointhaptics/haptics/devices/virtual_device.hpp>
@@ -10,9 +11,53 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
+#include <optional>
+#include <utility>
 
 namespace pointhaptics {
+namespace {
+
+// an [[obstacle]] as the rigid shape its contact presses on; a box's edges are rounded by a quarter of the
+// object's spacing (or of its thinnest half size), below what the surface resolves
+std::pair<ToolShape, ToolPose> obstacle_shape(const ObstacleSpec& o, double spacing) {
+  ToolShape shape;
+  ToolPose pose;
+  switch (o.shape) {
+    case ObstacleShape::PLANE:
+      shape.kind = ToolKind::PLANE;
+      shape.radius = spacing;
+      pose.position = o.point;
+      pose.orientation = Eigen::Quaterniond::FromTwoVectors(Vec3::UnitZ(), o.normal);
+      break;
+    case ObstacleShape::BOX: {
+      const Vec3 half = 0.5 * (o.box.max - o.box.min);
+      shape.kind = ToolKind::BOX;
+      shape.radius = 0.25 * std::min(spacing, half.minCoeff());
+      shape.half_core = half.array() - shape.radius;
+      pose.position = 0.5 * (o.box.max + o.box.min);
+      break;
+    }
+    case ObstacleShape::SPHERE:
+      shape.kind = ToolKind::SPHERE;
+      shape.radius = o.radius;
+      pose.position = o.centre;
+      break;
+    case ObstacleShape::CAPSULE: {
+      const Vec3 axis = o.ends[1] - o.ends[0];
+      shape.kind = axis.norm() > 0 ? ToolKind::CAPSULE : ToolKind::SPHERE;
+      shape.radius = o.radius;
+      shape.length = axis.norm();
+      pose.position = 0.5 * (o.ends[0] + o.ends[1]);
+      if (axis.norm() > 0) pose.orientation = Eigen::Quaterniond::FromTwoVectors(Vec3::UnitZ(), axis);
+      break;
+    }
+  }
+  return {shape, pose};
+}
+
+}  // namespace
 
 SceneSession open_scene(Scene scene, const SessionOptions& options) {
   const auto start = std::chrono::steady_clock::now();
@@ -21,9 +66,32 @@ SceneSession open_scene(Scene scene, const SessionOptions& options) {
       std::make_unique<Simulation>(build_scene_model(scene, options.max_memory), scene.solver, options.threads);
   if (scene.lod.present) s.simulation->enable_lod(scene.lod.params, scene_lod_contact(scene, s.simulation->model()));
   for (const CutSpec& cut : scene.cuts) s.simulation->add_scripted_cut(cut);
+  std::optional<ObjectSurface> object_surface;
+  const auto surface_of_object = [&]() -> const ObjectSurface& {
+    if (!object_surface) object_surface.emplace(build_object_surface(scene, s.simulation->model()));
+    return *object_surface;
+  };
+  for (std::size_t k = 0; k < scene.obstacles.size(); ++k) {
+    const ObstacleSpec& o = scene.obstacles[k];
+    // static rigid bodies the object's surface presses on
+    const double spacing = s.simulation->model().spacing;
+    const auto [shape, pose] = obstacle_shape(o, spacing);
+    SurfaceContactParams contact;
+    contact.friction = o.friction;
+    contact.sample_spacing = spacing;
+    contact.tolerance = 1e-3 * spacing;  // at rest inside it by at most a thousandth of the spacing
+    const ObjectSurface& surface = surface_of_object();
+    try {
+      s.simulation->add_obstacle(o.name, shape, pose, surface.mesh, surface.map, contact);
+    } catch (const Interrupted&) {
+      throw;
+    } catch (const Error& e) {
+      throw Error(fmt::format("{}:{}: obstacle[{}]: {}", scene.path, o.line, k, e.what()));
+    }
+  }
   if (scene.probe.held()) {
     // a tool held at a position, touching the object's surface
-    const ObjectSurface surface = build_object_surface(scene, s.simulation->model());
+    const ObjectSurface& surface = surface_of_object();
     ToolShape shape;
     shape.kind = scene.probe.capsule ? ToolKind::CAPSULE : ToolKind::SPHERE;
     shape.radius = scene.probe.radius;

@@ -191,6 +191,28 @@ void Simulation::hold_tool(const ToolShape& shape, const ToolPose& pose, const T
   sim.held_tool()->set_pose(pose);
 }
 
+void Simulation::add_obstacle(std::string name, const ToolShape& shape, const ToolPose& pose, const TriangleMesh& mesh,
+                              SurfaceMap map, const SurfaceContactParams& params) {
+  if (lod_) throw Error("obstacle: not yet with levels of detail (an active set carries only part of the surface)");
+  ModelSimulation& sim = core();
+  for (const Obstacle& o : sim.obstacles())
+    if (o.name == name) throw Error(fmt::format("\"{}\" is already the name of an obstacle", name));
+  SurfaceContactParams contact = params;
+  // explicit steps: as a held tool's (hold_tool())
+  if (sim.solver().kind == SolverKind::EXPLICIT && contact.max_point_stiffness <= 0)
+    contact.max_point_stiffness = sim.model().material.young * sim.model().spacing;
+  HeldTool held(SurfaceContact(sim.model(), mesh, std::move(map), shape, contact));
+  held.set_pose(pose);
+  // it may not start inside the object: its surface's vertices (the reference ones) stay out of it
+  const ToolLoad at_rest = held.load(sim.model(), Points::Zero(3, sim.model().n_points));
+  if (at_rest.penetration > held.contact().tolerance())
+    throw Error(
+        fmt::format("\"{}\" starts inside the object: its surface lies up to {:.3g} m inside it "
+                    "(move it out, or the object)",
+                    name, at_rest.penetration));
+  sim.obstacles().push_back(Obstacle{std::move(name), std::move(held)});
+}
+
 void Simulation::set_tool_pose(const ToolPose& pose) {
   if (!core().held_tool()) throw Error("tool: no held tool to move");
   core().held_tool()->set_pose(pose);
@@ -270,7 +292,15 @@ void check_physical(const Model& model, Workspace& ws, const StepDiagnostics& d,
 
 namespace {
 
-const char* tool_kind_name(const ToolShape& shape) { return shape.kind == ToolKind::CAPSULE ? "capsule" : "sphere"; }
+const char* tool_kind_name(const ToolShape& shape) {
+  switch (shape.kind) {
+    case ToolKind::CAPSULE: return "capsule";
+    case ToolKind::BOX: return "box";
+    case ToolKind::PLANE: return "plane";
+    case ToolKind::SPHERE: break;
+  }
+  return "sphere";
+}
 
 }  // namespace
 
@@ -335,6 +365,7 @@ RunSummary Simulation::summary() {
   // a held tool's contact is one of the forces in balance (the probe's, in dynamics, is reported below)
   HeldTool* tool = sim.held_tool().get();
   if (tool) tool->add(model, state, ws.f_int);
+  for (Obstacle& o : sim.obstacles()) o.contact.add(model, state, ws.f_int);
   s.reactions = support_reactions(model, ws.f_int);
   check_physical(model, ws, d, s);
   // dynamics is out of balance by the inertia; its Newton residual includes it
@@ -350,6 +381,12 @@ RunSummary Simulation::summary() {
   s.solve_s = d.solve_seconds;
   if (lod_) lod_->fill(s.lod);
   s.tool = tool_summary();
+  for (Obstacle& o : sim.obstacles()) {
+    const ToolLoad load = o.contact.load(model, state.u);
+    s.obstacles.emplace_back(
+        o.name, ToolSummary{true, tool_kind_name(o.contact.shape()), o.contact.pose().position, load.force, load.torque,
+                            load.contacts, load.penetration, load.friction});
+  }
   if (d.cuts > 0 || !scripted_cuts_.empty()) {
     // the object's cut (with levels of detail every cut of an active set reaches it)
     const Model& object = lod_ ? lod_->settled_object_model() : model;

@@ -79,6 +79,12 @@ class Simulation {
   /// steps. Throws Error with levels of detail or a probe (one tool at a time).
   void hold_tool(const ToolShape& shape, const ToolPose& pose, const TriangleMesh& mesh, SurfaceMap map,
                  const SurfaceContactParams& params = {});
+  /// A static rigid obstacle touching the object's surface (`mesh`, carried by `map`), by name: a plane, box,
+  /// sphere or capsule (ToolShape) at `pose`. Its contact is a held tool's (hold_tool()); its force is in
+  /// summary().obstacles. Throws Error for a name already taken, with levels of detail, or when it starts inside
+  /// the object (its surface deeper in it than the contact's tolerance).
+  void add_obstacle(std::string name, const ToolShape& shape, const ToolPose& pose, const TriangleMesh& mesh,
+                    SurfaceMap map, const SurfaceContactParams& params = {});
   void set_tool_pose(const ToolPose& pose);
   /// The held tool (nullptr without one).
   HeldTool* held_tool();

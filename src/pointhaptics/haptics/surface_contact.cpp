@@ -307,6 +307,7 @@ bool SurfaceContact::add_to_matrix(TangentMatrix& K) const {
 
 bool SurfaceContact::update_multipliers(const Model& model, const Points& u) {
   bool met = load(model, u).penetration <= tolerance_;
+  double penalty_pressure = 0, anchored_lambda = 0;  // over the anchored vertices, N
   for (index_t v = 0; v < static_cast<index_t>(anchors_.size()); ++v) {
     Anchor& a = anchors_[static_cast<std::size_t>(v)];
     if (!a.held) {
@@ -317,15 +318,19 @@ bool SurfaceContact::update_multipliers(const Model& model, const Points& u) {
     }
     const double k = tangential_penalty(v);
     const Vec3 t = friction_trial(v), clamped = friction_force(v);
-    // a sticking vertex is done on its anchor, a sliding one when its force stopped changing; and its cone,
-    // friction x lambda, is its pressure to 1% (lambda + k g: a penetration within the tolerance still made
-    // the penalty's part of the pressure as large as lambda, and the friction 5% short of mu x pressure)
+    // a sticking vertex is done on its anchor, a sliding one when its force stopped changing; and the cones,
+    // friction x lambda, are the pressure to 1% together (lambda + k g: a penetration within the tolerance
+    // still made the penalty's part of the pressure as large as lambda, and the friction 5% short of mu x
+    // pressure). Together, not each: at the rim of a resting body's base a vertex's lambda is small, and
+    // its own 1% took Uzawa's updates past their limit (issue 47: a block resting on a table)
     const double g = std::max(tool_distance(shape_, pose_, y_.col(v)).penetration, 0.0);
-    met = met && (clamped - a.tau).norm() <= k * tolerance_ &&
-          penalty_[static_cast<std::size_t>(v)] * g <= 0.01 * lambda_[static_cast<std::size_t>(v)];
+    met = met && (clamped - a.tau).norm() <= k * tolerance_;
+    penalty_pressure += penalty_[static_cast<std::size_t>(v)] * g;
+    anchored_lambda += lambda_[static_cast<std::size_t>(v)];
     // beyond the cone the anchor follows the vertex (the slide so far), the force unchanged
     if ((t - clamped).squaredNorm() > 0) a.local += pose_.orientation.conjugate() * Vec3((t - clamped) / k);
   }
+  met = met && penalty_pressure <= 0.01 * anchored_lambda;
   if (met) return true;
   for (index_t v = 0; v < y_.cols(); ++v) {
     double& lambda = lambda_[static_cast<std::size_t>(v)];

@@ -93,6 +93,15 @@ std::string result_json(const Model& model, const State& state, const RunSummary
                    {"penetration", t.penetration},
                    {"friction", vec(t.friction)}};
   }
+  if (!s.obstacles.empty()) {
+    nlohmann::json& obstacles = doc["obstacles"] = nlohmann::json::object();
+    for (const auto& [name, o] : s.obstacles)
+      obstacles[name] = {{"kind", o.kind},
+                         {"force", vec(o.force)},
+                         {"contacts", o.contacts},
+                         {"penetration", o.penetration},
+                         {"friction", vec(o.friction)}};
+  }
   if (s.cut.present) {
     const CutSummary& c = s.cut;
     doc["cut"] = {{"sweeps", c.sweeps},

@@ -100,6 +100,8 @@ struct RunSummary {
   LocalModelSummary local_model;
   LodSummary lod;
   ToolSummary tool;
+  /// The obstacles by name: what the object does to each (`kind` its shape, `position` its pose's origin).
+  std::vector<std::pair<std::string, ToolSummary>> obstacles;
   CutSummary cut;
 };
 

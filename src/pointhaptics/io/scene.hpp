@@ -180,6 +180,23 @@ struct CutSpec {
   int line = 0;
 };
 
+/// [[obstacle]]: a static rigid body the object rests on or is pressed against (issue 47): a plane (the
+/// half-space below it, a table), a box, a sphere or a capsule. Its contact is on the object's surface, met as
+/// a held tool's is (an augmented Lagrangian in static solves, a penalty in dynamics), with Coulomb friction.
+enum class ObstacleShape { PLANE, BOX, SPHERE, CAPSULE };
+struct ObstacleSpec {
+  std::string name;
+  ObstacleShape shape = ObstacleShape::PLANE;
+  Vec3 point = Vec3::Zero();                             ///< plane: a point on it, m
+  Vec3 normal = Vec3::UnitY();                           ///< plane: unit, out of the obstacle
+  Aabb box;                                              ///< box: its corners, m (scene axes)
+  Vec3 centre = Vec3::Zero();                            ///< sphere
+  std::array<Vec3, 2> ends{Vec3::Zero(), Vec3::Zero()};  ///< capsule: its axis segment's ends, m
+  double radius = 0;                                     ///< sphere, capsule, m
+  double friction = 0;                                   ///< Coulomb's coefficient with the object
+  int line = 0;
+};
+
 struct Scene {
   std::string path;  ///< the scene file ("<string>" when parsed from text), for messages
   ObjectSpec object;
@@ -190,6 +207,7 @@ struct Scene {
   std::vector<RefineSpec> refine;
   std::vector<LoadSpec> loads;
   std::vector<CutSpec> cuts;
+  std::vector<ObstacleSpec> obstacles;
   SolverSpec solver;
   ProbeSpec probe;
   DeviceSpec device;

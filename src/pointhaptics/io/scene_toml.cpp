@@ -548,6 +548,58 @@ CutSpec read_cut(TableReader& r) {
   return c;
 }
 
+// name = "...", exactly one of plane = { point, normal }, box = { min, max }, sphere = { centre, radius } or
+// capsule = { ends = [[x, y, z], [x, y, z]], radius }, and friction
+ObstacleSpec read_obstacle(TableReader& r) {
+  ObstacleSpec o;
+  o.line = r.line();
+  o.name = r.string("name", "");
+  if (o.name.empty()) r.fail_table("name", "an [[obstacle]] needs a name = \"...\" (its forces are reported by it)");
+  const int shapes = (r.find("plane") != nullptr) + (r.find("box") != nullptr) + (r.find("sphere") != nullptr) +
+                     (r.find("capsule") != nullptr);
+  if (shapes != 1)
+    r.fail_table("plane",
+                 "give exactly one of plane = { point, normal }, box = { min, max }, sphere = { centre, "
+                 "radius } or capsule = { ends = [[x, y, z], [x, y, z]], radius }");
+  const auto radius_of = [](TableReader& t) {
+    if (!t.find("radius")) t.fail_table("radius", "missing (m)");
+    return t.number(
+        "radius", 0.0, [](double x) { return x > 0 && x <= 1e6; }, "must lie in (0, 1e6] (m)");
+  };
+  if (const toml::table* t = r.subtable("plane")) {
+    TableReader p(r.context(), *t, r.name("plane"));
+    o.shape = ObstacleShape::PLANE;
+    o.point = p.vec3("point", o.point);
+    if (!p.find("normal")) p.fail_table("normal", "a plane needs normal = [x, y, z] (out of the obstacle)");
+    const Vec3 normal = p.vec3("normal", o.normal);
+    if (!(normal.norm() > 0)) p.fail_at(*p.find("normal"), "normal", "must not be zero");
+    o.normal = normal.normalized();
+    p.finish();
+  } else if (r.find("box")) {
+    o.shape = ObstacleShape::BOX;
+    o.box = r.box("box", true);
+    if (!((o.box.max - o.box.min).minCoeff() > 0)) r.fail_table("box", "the box has no volume (min = max somewhere)");
+  } else if (const toml::table* t = r.subtable("sphere")) {
+    TableReader p(r.context(), *t, r.name("sphere"));
+    o.shape = ObstacleShape::SPHERE;
+    o.centre = p.vec3("centre", o.centre);
+    o.radius = radius_of(p);
+    p.finish();
+  } else if (const toml::table* t = r.subtable("capsule")) {
+    TableReader p(r.context(), *t, r.name("capsule"));
+    o.shape = ObstacleShape::CAPSULE;
+    const toml::node* node = p.find("ends");
+    const toml::array* ends = node ? node->as_array() : nullptr;
+    if (!ends || ends->size() != 2) p.fail_table("ends", "a capsule needs ends = [[x, y, z], [x, y, z]] (its axis, m)");
+    o.ends = {p.as_vec3(*ends->get(0), "ends"), p.as_vec3(*ends->get(1), "ends")};
+    o.radius = radius_of(p);
+    p.finish();
+  }
+  o.friction = r.number(
+      "friction", o.friction, [](double mu) { return mu >= 0 && mu <= 10; }, "must lie in [0, 10]");
+  return o;
+}
+
 LoadSpec read_load(TableReader& r) {
   LoadSpec l;
   l.line = r.line();
@@ -797,6 +849,19 @@ Scene parse_scene(std::string_view text, const std::string& name, const std::str
   read_array_of_tables(top, "region", [&](TableReader& r) { scene.regions.push_back(read_region(r)); });
   read_array_of_tables(top, "load", [&](TableReader& r) { scene.loads.push_back(read_load(r)); });
   read_array_of_tables(top, "cut", [&](TableReader& r) { scene.cuts.push_back(read_cut(r)); });
+  read_array_of_tables(top, "obstacle", [&](TableReader& r) { scene.obstacles.push_back(read_obstacle(r)); });
+  for (std::size_t a = 0; a < scene.obstacles.size(); ++a)
+    for (std::size_t b = 0; b < a; ++b)
+      if (scene.obstacles[a].name == scene.obstacles[b].name)
+        throw Error(
+            fmt::format("{}:{}: obstacle[{}].name: \"{}\" is already the name of obstacle[{}] (names are "
+                        "unique)",
+                        name, scene.obstacles[a].line, a, scene.obstacles[a].name, b));
+  if (!scene.obstacles.empty() && scene.lod.present)
+    throw Error(
+        fmt::format("{}:{}: obstacle: not yet with levels of detail (an active set carries only part of the "
+                    "surface)",
+                    name, scene.obstacles.front().line));
   if (scene.probe.cut && scene.probe.held())
     throw Error(fmt::format("{}:{}: probe.mode: a blade cuts as the device moves it, not held at a position", name,
                             scene.probe.line));

@@ -28,18 +28,19 @@ StepReport ImplicitSolver::step(const Model& model, State& state, Workspace& ws,
   problem.load = &model.f_ext;
   problem.inertia = k;
   problem.anchor = &anchor;
-  if (forces && forces->energy_term()) {
-    problem.term = forces->energy_term();  // a contact minimised with the rest: its stiffness fully implicit
-  } else if (forces) {
+  if (forces) {
+    problem.term = forces->energy_term();  // contacts minimised with the rest: their stiffness fully implicit
+    // the rest (a probe's springs): its forces at the step's start as a load, its springs linearly implicit
     tool_forces.setZero();
-    forces->add(model, state, tool_forces);
-    load = model.f_ext + tool_forces;
-    problem.load = &load;
-    springs.setZero();
-    if (forces->add_stiffness(model, state, springs)) {
-      start = state.u;
-      problem.springs = &springs;
-      problem.spring_anchor = &start;
+    if (forces->add_beyond_energy(model, state, tool_forces)) {
+      load = model.f_ext + tool_forces;
+      problem.load = &load;
+      springs.setZero();
+      if (forces->add_stiffness(model, state, springs)) {
+        start = state.u;
+        problem.springs = &springs;
+        problem.spring_anchor = &start;
+      }
     }
   }
   // a viscoelastic material over this step: relaxed shear modulus and the history's overstress

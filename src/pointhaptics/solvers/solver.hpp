@@ -29,6 +29,13 @@ class DynamicForces {
   /// The forces as a term of the energy, which the Newton solvers (static, implicit) minimise with the
   /// material's instead of calling add() and add_stiffness(); nullptr if they have none.
   virtual EnergyTerm* energy_term() { return nullptr; }
+  /// The forces that are not in energy_term(), added into f at `state` (the Newton solvers take them as loads,
+  /// with add_stiffness()'s springs): true if there were any. By default all of add() when there is no term.
+  virtual bool add_beyond_energy(const Model& model, const State& state, Points& f) {
+    if (energy_term()) return false;
+    add(model, state, f);
+    return true;
+  }
   /// Once per step, after it, at the state it reached (a probe's local contact model for the haptic side);
   /// `ws` is the step's workspace (its threads; what it holds is the solver's, for the next step).
   virtual void after_step(const Model&, const State&, Workspace&) {}
