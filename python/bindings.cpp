@@ -605,6 +605,25 @@ names the problem.)doc")
           },
           "Energies of the simulated points now, a dict: strain (the elastic energy whose gradient the forces are) and "
           "kinetic (J)")
+      .def_property_readonly(
+          "obstacles",
+          [](PySimulation& p) {
+            const auto lock = locked(p);
+            const ph::RunSummary summary = p.sim->summary();
+            py::dict d;
+            for (const auto& [name, o] : summary.obstacles) {
+              py::dict block;
+              block["kind"] = o.kind;
+              block["force"] = std::array<double, 3>{o.force.x(), o.force.y(), o.force.z()};
+              block["contacts"] = o.contacts;
+              block["penetration"] = o.penetration;
+              block["friction"] = std::array<double, 3>{o.friction.x(), o.friction.y(), o.friction.z()};
+              d[py::str(name)] = block;
+            }
+            return d;
+          },
+          "The scene's [[obstacle]] bodies by name, each a dict as the result JSON's obstacles block: kind, force (what "
+          "the object exerts on it now, N), contacts, penetration (m), friction (N)")
       .def(
           "summary",
           [](PySimulation& p) {
