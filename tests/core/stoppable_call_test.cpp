@@ -29,6 +29,16 @@ void wait_for(const std::atomic<bool>& flag) {
   ASSERT_TRUE(flag.load());
 }
 
+// work left running is counted until it ends (released here)
+void expect_counted_until_released(Blocker& blocker) {
+  EXPECT_FALSE(blocker.ended.load());
+  EXPECT_EQ(abandoned_work_running(), 1);
+  blocker.release = true;
+  wait_for(blocker.ended);
+  for (int k = 0; k < 10'000 && abandoned_work_running() > 0; ++k) std::this_thread::sleep_for(1ms);
+  EXPECT_EQ(abandoned_work_running(), 0);
+}
+
 TEST(StoppableCall, WaitsForTheWorkAndRethrowsItsError) {
   int result = 0;
   call_stoppable("a sum", [&result] { result = 2 + 3; });
@@ -55,13 +65,8 @@ TEST(StoppableCall, AStopInsideTheWorkLeavesItToEndByItself) {
     EXPECT_STREQ(e.what(), "interrupted during a library call");
   }
   stopper.join();
-  // the caller went on while the work still runs, and it is counted until it ends
-  EXPECT_FALSE(blocker->ended.load());
-  EXPECT_EQ(abandoned_work_running(), 1);
-  blocker->release = true;
-  wait_for(blocker->ended);
-  for (int k = 0; k < 10'000 && abandoned_work_running() > 0; ++k) std::this_thread::sleep_for(1ms);
-  EXPECT_EQ(abandoned_work_running(), 0);
+  // the caller went on while the work still runs
+  expect_counted_until_released(*blocker);
 }
 
 TEST(StoppableCall, ARequestMadeBeforeStartsNothing) {
@@ -85,12 +90,7 @@ TEST(StoppableCall, DestroysInTheBackgroundWithoutWaiting) {
   auto owned = std::make_unique<SlowToDestroy>();
   owned->blocker = blocker;
   destroy_in_background(std::move(owned));
-  EXPECT_FALSE(blocker->ended.load());
-  EXPECT_EQ(abandoned_work_running(), 1);
-  blocker->release = true;
-  wait_for(blocker->ended);
-  for (int k = 0; k < 10'000 && abandoned_work_running() > 0; ++k) std::this_thread::sleep_for(1ms);
-  EXPECT_EQ(abandoned_work_running(), 0);
+  expect_counted_until_released(*blocker);
 }
 
 }  // namespace
