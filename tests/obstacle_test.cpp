@@ -105,6 +105,10 @@ box = { min = [0.0, -0.05, 0.0], max = [0.1, -0.02, 0.1] })"));
   fails("name = \"t\"\nplane = { normal = [0.0, 1.0, 0.0] }\nfriction = -1",
         "obstacle[0].friction: -1 is out of range: must lie in [0, 10]");
   fails("name = \"t\"\nplane = { normal = [0.0, 1.0, 0.0] }\ncolour = 1", "obstacle[0].colour: unknown key");
+  fails("name = \"t\"\nplane = { normal = [0.0, 1.0, 0.0] }\nkeyframes = [[0.0, 0.0, 0.0, 0.0], [0.0, 0.0, -1.0, 0.0]]",
+        "obstacle[0].keyframes: times must increase");
+  fails("name = \"t\"\nplane = { normal = [0.0, 1.0, 0.0] }\nkeyframes = [[0.0, 0.0, 0.0]]",
+        "obstacle[0].keyframes: each keyframe is [t, dx, dy, dz]");
   fails(
       "name = \"t\"\nplane = { normal = [0.0, 1.0, 0.0] }\n[[obstacle]]\nname = \"t\"\nplane = { normal = [0.0, 1.0, 0.0] }",
       "scene.toml:18: obstacle[1].name: \"t\" is already the name of obstacle[0]");
@@ -177,6 +181,27 @@ TEST(Obstacle, ADevicesProbePressingTheBlockIsCarriedByTheTableInBothSolvers) {
     ASSERT_GT(r.tool.force.y(), 0.2 * weight);  // (the probe's block: the interactive run's)
     EXPECT_NEAR(obstacle(summary, "table").force.y(), -(weight + r.tool.force.y()), 0.01 * weight);
   }
+}
+
+// a plate keyframed 1.1 mm down onto the block's top squeezes it against the table: the table carries the
+// weight and the plate's push, and the plate is where its keyframes put it
+TEST(Obstacle, AKeyframedPlateSqueezesTheBlockOntoTheTable) {
+  SceneSession s = open_scene(
+      parse_scene(
+          block_on("name = \"table\"\nfriction = 0.5\nplane = { normal = [0.0, 1.0, 0.0] }",
+                   "kind = \"implicit\"\ndt = 2e-3\nduration = 0.4",
+                   "[[obstacle]]\nname = \"plate\"\nbox = { min = [-0.01, 0.0201, -0.01], max = [0.05, 0.03, 0.05] }\n"
+                   "keyframes = [[0.0, 0.0, 0.0, 0.0], [0.2, 0.0, -0.0011, 0.0]]")),
+      two_threads());
+  s.simulation->run(0.4);
+  const RunSummary summary = s.simulation->summary();
+  ASSERT_TRUE(summary.converged) << summary.failure;
+  const ToolSummary& plate = obstacle(summary, "plate");
+  const ToolSummary& table = obstacle(summary, "table");
+  EXPECT_NEAR(plate.position.y(), 0.5 * (0.0201 + 0.03) - 0.0011, 1e-12);  // the box's centre, moved
+  EXPECT_GT(plate.force.y(), 10 * weight);                                 // the block pushes it up
+  EXPECT_NEAR(table.force.y(), -(weight + plate.force.y()), 0.01 * (weight + plate.force.y()));
+  EXPECT_LT(std::max(table.penetration, plate.penetration), 0.01 * spacing);
 }
 
 // dropped from 2 mm above the table, in dynamics: it lands and comes to rest on it (explicit and implicit)

@@ -225,6 +225,13 @@ DynamicForces* ModelSimulation::forces_this_step() {
 }
 
 void ModelSimulation::place_tools() {
+  // keyframed obstacles where they are at the step's end (the time the implicit and static solves are at)
+  for (Obstacle& o : obstacles_) {
+    if (o.path.keyframes().empty()) continue;
+    ToolPose pose = o.start;
+    pose.position += o.path.position(state_.time + (solver_.kind == SolverKind::STATIC ? 0.0 : solver_.dt));
+    o.contact.set_pose(pose);
+  }
   if (!probe_) return;
   ProbeTool& tool = probe_->tool;
   tool.place(model_, state_, inputs_.device, inputs_.button, inputs_.orientation);

@@ -6,6 +6,7 @@
 #include <pointhaptics/core/workspace.hpp>
 #include <pointhaptics/haptics/held_tool.hpp>
 #include <pointhaptics/haptics/probe_tool.hpp>
+#include <pointhaptics/haptics/trajectory.hpp>
 #include <pointhaptics/lod/active_set.hpp>
 #include <pointhaptics/lod/active_surface.hpp>
 #include <pointhaptics/mechanics/cut.hpp>
@@ -93,6 +94,9 @@ SurfaceContact probe_surface_contact(ActiveSurface part, const SurfaceContactPar
 struct Obstacle {
   std::string name;
   HeldTool contact;
+  /// Keyframed: its translation over time from `start` (empty keyframes: static)
+  Trajectory path;
+  ToolPose start;
 };
 
 class ModelSimulation {

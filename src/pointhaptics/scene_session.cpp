@@ -82,7 +82,10 @@ SceneSession open_scene(Scene scene, const SessionOptions& options) {
     contact.tolerance = 1e-3 * spacing;  // at rest inside it by at most a thousandth of the spacing
     const ObjectSurface& surface = surface_of_object();
     try {
-      s.simulation->add_obstacle(o.name, shape, pose, surface.mesh, surface.map, contact);
+      std::vector<Keyframe> frames;
+      for (const auto& k : o.keyframes) frames.push_back({k[0], Vec3(k[1], k[2], k[3]), false});
+      s.simulation->add_obstacle(o.name, shape, pose, surface.mesh, surface.map, contact,
+                                 frames.empty() ? Trajectory() : Trajectory(std::move(frames)));
     } catch (const Interrupted&) {
       throw;
     } catch (const Error& e) {

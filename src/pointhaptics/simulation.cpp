@@ -192,7 +192,7 @@ void Simulation::hold_tool(const ToolShape& shape, const ToolPose& pose, const T
 }
 
 void Simulation::add_obstacle(std::string name, const ToolShape& shape, const ToolPose& pose, const TriangleMesh& mesh,
-                              SurfaceMap map, const SurfaceContactParams& params) {
+                              SurfaceMap map, const SurfaceContactParams& params, const Trajectory& path) {
   if (lod_) throw Error("obstacle: not yet with levels of detail (an active set carries only part of the surface)");
   ModelSimulation& sim = core();
   for (const Obstacle& o : sim.obstacles())
@@ -202,7 +202,9 @@ void Simulation::add_obstacle(std::string name, const ToolShape& shape, const To
   if (sim.solver().kind == SolverKind::EXPLICIT && contact.max_point_stiffness <= 0)
     contact.max_point_stiffness = sim.model().material.young * sim.model().spacing;
   HeldTool held(SurfaceContact(sim.model(), mesh, std::move(map), shape, contact));
-  held.set_pose(pose);
+  ToolPose now = pose;
+  if (!path.keyframes().empty()) now.position += path.position(sim.state().time);
+  held.set_pose(now);
   // it may not start inside the object: its surface's vertices (the reference ones) stay out of it
   const ToolLoad at_rest = held.load(sim.model(), Points::Zero(3, sim.model().n_points));
   if (at_rest.penetration > held.contact().tolerance())
@@ -210,7 +212,7 @@ void Simulation::add_obstacle(std::string name, const ToolShape& shape, const To
         fmt::format("\"{}\" starts inside the object: its surface lies up to {:.3g} m inside it "
                     "(move it out, or the object)",
                     name, at_rest.penetration));
-  sim.obstacles().push_back(Obstacle{std::move(name), std::move(held)});
+  sim.obstacles().push_back(Obstacle{std::move(name), std::move(held), path, pose});
 }
 
 void Simulation::set_tool_pose(const ToolPose& pose) {

@@ -82,9 +82,10 @@ class Simulation {
   /// A static rigid obstacle touching the object's surface (`mesh`, carried by `map`), by name: a plane, box,
   /// sphere or capsule (ToolShape) at `pose`. Its contact is a held tool's (hold_tool()); its force is in
   /// summary().obstacles. Throws Error for a name already taken, with levels of detail, or when it starts inside
-  /// the object (its surface deeper in it than the contact's tolerance).
+  /// the object (its surface deeper in it than the contact's tolerance). `path`: its translation from `pose`
+  /// over time, applied at each step's end (empty: static).
   void add_obstacle(std::string name, const ToolShape& shape, const ToolPose& pose, const TriangleMesh& mesh,
-                    SurfaceMap map, const SurfaceContactParams& params = {});
+                    SurfaceMap map, const SurfaceContactParams& params = {}, const Trajectory& path = {});
   void set_tool_pose(const ToolPose& pose);
   /// The held tool (nullptr without one).
   HeldTool* held_tool();

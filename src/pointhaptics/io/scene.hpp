@@ -194,6 +194,9 @@ struct ObstacleSpec {
   std::array<Vec3, 2> ends{Vec3::Zero(), Vec3::Zero()};  ///< capsule: its axis segment's ends, m
   double radius = 0;                                     ///< sphere, capsule, m
   double friction = 0;                                   ///< Coulomb's coefficient with the object
+  /// Moved along keyframes (t, dx, dy, dz): its translation from where the shape puts it, m, linear in between
+  /// and held after the last (empty: static)
+  std::vector<std::array<double, 4>> keyframes;
   int line = 0;
 };
 

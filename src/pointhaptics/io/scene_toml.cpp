@@ -597,6 +597,24 @@ ObstacleSpec read_obstacle(TableReader& r) {
   }
   o.friction = r.number(
       "friction", o.friction, [](double mu) { return mu >= 0 && mu <= 10; }, "must lie in [0, 10]");
+  if (const toml::node* node = r.find("keyframes")) {
+    const toml::array* rows = node->as_array();
+    if (!rows || rows->empty()) r.fail_at(*node, "keyframes", "expected keyframes = [[t, dx, dy, dz], ...]");
+    double last_t = -1;
+    for (const toml::node& row : *rows) {
+      const toml::array* k = row.as_array();
+      if (!k || k->size() != 4) r.fail_at(row, "keyframes", "each keyframe is [t, dx, dy, dz] (s, m)");
+      std::array<double, 4> frame{};
+      for (std::size_t a = 0; a < 4; ++a) frame[a] = r.as_number(*k->get(a), "keyframes");
+      if (!(frame[0] > last_t) || frame[0] > 1e6)
+        r.fail_at(row, "keyframes", "times must increase, from 0 s, and stay within 1e6 s");
+      if (!(std::max({std::abs(frame[1]), std::abs(frame[2]), std::abs(frame[3])}) <= 1e6))
+        r.fail_at(row, "keyframes", "a translation must lie within 1e6 m");
+      last_t = frame[0];
+      o.keyframes.push_back(frame);
+    }
+    if (o.keyframes.front()[0] < 0) r.fail_at(*node, "keyframes", "times must start at 0 s or later");
+  }
   return o;
 }
 
