@@ -163,6 +163,18 @@ SparseCholesky::~SparseCholesky() {
 SparseCholesky::SparseCholesky(SparseCholesky&&) noexcept = default;
 SparseCholesky& SparseCholesky::operator=(SparseCholesky&&) noexcept = default;
 
+void SparseCholesky::call_on_factor(const char* where, void (*work)(Factor&), double expected_s) {
+  std::shared_ptr<Factor> owner = factor_;
+  try {
+    call_stoppable(
+        where, [owner, work] { work(*owner); }, expected_s);
+  } catch (const Interrupted&) {
+    factor_ = std::make_shared<Factor>();  // the abandoned one is freed when CHOLMOD is done with it
+    stats_ = {};
+    throw;
+  }
+}
+
 bool SparseCholesky::analysed_for(const Model& model) const {
   const Factor& f = *factor_;
   if (!f.L || f.model != &model || f.n_points != model.n_points || f.n_pairs != model.n_pairs()) return false;
@@ -226,19 +238,9 @@ void SparseCholesky::analyse(const Model& model, const TangentMatrix& K) {
   } else {
     f.common.nmethods = 0;  // CHOLMOD's default strategy
   }
-  if (rows.size() < stoppable_analysis_entries) {
-    f.L = cholmod_analyze(f.A, &f.common);
-  } else {
-    std::shared_ptr<Factor> owner = factor_;
-    try {
-      call_stoppable("the sparse factorisation's analysis",
-                     [owner] { owner->L = cholmod_analyze(owner->A, &owner->common); });
-    } catch (const Interrupted&) {
-      factor_ = std::make_shared<Factor>();  // the abandoned one is freed when CHOLMOD is done with it
-      stats_ = {};
-      throw;
-    }
-  }
+  const auto order = [](Factor& g) { g.L = cholmod_analyze(g.A, &g.common); };
+  if (rows.size() < stoppable_analysis_entries) order(f);
+  else call_on_factor("the sparse factorisation's analysis", order);
   f.flops = f.common.fl;
   f.b.assign(dofs, 0.0);
   f.model = &model;
@@ -260,19 +262,9 @@ bool SparseCholesky::factorise(const TangentMatrix& K) {
   if (expected_s > 2 && stats_.factorisations == 0)
     announce(fmt::format("the sparse factorisation: {} unknowns, {:.3g} GFlop, about {} per factorisation",
                          f.n_free * 3, f.flops * 1e-9, format_duration(expected_s)));
-  if (f.flops < stoppable_factorisation_flops) {
-    f.factorise_values();
-  } else {
-    std::shared_ptr<Factor> owner = factor_;
-    try {
-      call_stoppable(
-          "the sparse factorisation", [owner] { owner->factorise_values(); }, expected_s);
-    } catch (const Interrupted&) {
-      factor_ = std::make_shared<Factor>();
-      stats_ = {};
-      throw;
-    }
-  }
+  const auto factorise_values = [](Factor& g) { g.factorise_values(); };
+  if (f.flops < stoppable_factorisation_flops) factorise_values(f);
+  else call_on_factor("the sparse factorisation", factorise_values, expected_s);
   // (a failed factorisation leaves L incomplete, minor < n, but reusable by the next attempt)
   ++stats_.factorisations;
   stats_.factorise_s = std::chrono::duration<double>(Clock::now() - start).count();

@@ -63,6 +63,9 @@ class SparseCholesky {
  private:
   struct Factor;      // CHOLMOD's objects, kept out of this header
   struct Background;  // the worker thread and its copy of A and L
+  /// CHOLMOD's `work` on the factor in a stoppable call (core/stoppable_call.hpp): on a stop the factor is left
+  /// to it, and this one starts again unanalysed.
+  void call_on_factor(const char* where, void (*work)(Factor&), double expected_s = 0);
   /// Wait for a background factorisation that is running and drop it (a new analysis is made).
   void drop_background();
   std::shared_ptr<Factor> factor_;  // shared with a stoppable call (core/stoppable_call.hpp) while it runs
