@@ -96,6 +96,20 @@ StepReport StaticSolver::step(const Model& model, State& state, Workspace& ws, D
   report.coarse_points = newton_.coarse_points();
   report.residual = stats.residual;
   report.failure = stats.failure;
+  // an object that nothing holds (no held point; an obstacle's friction only once it presses) has rigid-body
+  // modes that the first minimisation does not fix, and round-off can slide it along them: a block pressed by a
+  // tool onto a table slid 412 m aside in one build and "converged" there. Not a result: said so
+  if (report.status == StepStatus::CONVERGED &&
+      std::none_of(model.fixed.begin(), model.fixed.end(), [](auto f) { return f != 0; })) {
+    const double slide = state.u.rowwise().mean().norm();
+    if (slide > model.extent) {
+      report.status = StepStatus::FAILED;
+      report.failure = fmt::format(
+          "static solver: the object slid {:.3g} m as a rigid body (more than its size): nothing holds it in place "
+          "(hold points with [[fixed]], or run it in dynamics, where its inertia does)",
+          slide);
+    }
+  }
   return report;
 }
 
