@@ -13,7 +13,7 @@
 
 #include <algorithm>
 #include <chrono>
-#include <optional>
+#include <memory>
 #include <utility>
 
 namespace pointhaptics {
@@ -66,10 +66,12 @@ SceneSession open_scene(Scene scene, const SessionOptions& options) {
       std::make_unique<Simulation>(build_scene_model(scene, options.max_memory), scene.solver, options.threads);
   if (scene.lod.present) s.simulation->enable_lod(scene.lod.params, scene_lod_contact(scene, s.simulation->model()));
   for (const CutSpec& cut : scene.cuts) s.simulation->add_scripted_cut(cut);
-  std::optional<ObjectSurface> object_surface;
-  const auto surface_of_object = [&]() -> const ObjectSurface& {
-    if (!object_surface) object_surface.emplace(build_object_surface(scene, s.simulation->model()));
-    return *object_surface;
+  // the object's surface, built once for the obstacles, a held tool and a device's probe alike
+  std::shared_ptr<const ObjectSurface> object_surface;
+  const auto surface_of_object = [&]() -> const std::shared_ptr<const ObjectSurface>& {
+    if (!object_surface)
+      object_surface = std::make_shared<const ObjectSurface>(build_object_surface(scene, s.simulation->model()));
+    return object_surface;
   };
   for (std::size_t k = 0; k < scene.obstacles.size(); ++k) {
     const ObstacleSpec& o = scene.obstacles[k];
@@ -80,7 +82,7 @@ SceneSession open_scene(Scene scene, const SessionOptions& options) {
     contact.friction = o.friction;
     contact.sample_spacing = spacing;
     contact.tolerance = 1e-3 * spacing;  // at rest inside it by at most a thousandth of the spacing
-    const ObjectSurface& surface = surface_of_object();
+    const ObjectSurface& surface = *surface_of_object();
     try {
       std::vector<Keyframe> frames;
       for (const auto& k : o.keyframes) frames.push_back({k[0], Vec3(k[1], k[2], k[3]), false});
@@ -94,7 +96,7 @@ SceneSession open_scene(Scene scene, const SessionOptions& options) {
   }
   if (scene.probe.held()) {
     // a tool held at a position, touching the object's surface
-    const ObjectSurface& surface = surface_of_object();
+    const ObjectSurface& surface = *surface_of_object();
     ToolShape shape;
     shape.kind = scene.probe.capsule ? ToolKind::CAPSULE : ToolKind::SPHERE;
     shape.radius = scene.probe.radius;
@@ -109,7 +111,7 @@ SceneSession open_scene(Scene scene, const SessionOptions& options) {
   } else if (scene.probe.present) {
     s.interactive = scene_interactive_options(scene, s.simulation->model());
     // the probe pushes on the object's surface (with levels of detail, on the part the active set carries)
-    s.interactive.surface = std::make_shared<const ObjectSurface>(build_object_surface(scene, s.simulation->model()));
+    s.interactive.surface = surface_of_object();
     if (options.make_device) s.device = make_scene_device(scene);
   }
   s.scene = std::move(scene);
