@@ -7,8 +7,6 @@
 #include <pointhaptics/object_surface.hpp>
 #include <pointhaptics/scene_builder.hpp>
 
-#include "support/tbb_under_tsan.hpp"
-
 #include <gtest/gtest.h>
 
 #include <atomic>

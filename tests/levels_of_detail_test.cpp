@@ -6,8 +6,6 @@
 #include <pointhaptics/lod/active_surface.hpp>
 #include <pointhaptics/pointhaptics.hpp>
 
-#include "support/tbb_under_tsan.hpp"
-
 #include <gtest/gtest.h>
 
 namespace pointhaptics {

@@ -5,8 +5,6 @@
 
 #include <pointhaptics/io/scene_toml.hpp>
 
-#include "support/tbb_under_tsan.hpp"
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
