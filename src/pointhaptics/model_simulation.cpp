@@ -217,10 +217,11 @@ const StepReport& ModelSimulation::step() {
 
 DynamicForces* ModelSimulation::forces_this_step() {
   DynamicForces* tool = probe_ ? static_cast<DynamicForces*>(&probe_->tool) : held_tool_.get();
-  if (obstacles_.empty()) return tool;
+  if (obstacles_.empty() && !body_contact_) return tool;
   forces_.clear();
   if (tool) forces_.add_member(tool);
   for (Obstacle& o : obstacles_) forces_.add_member(&o.contact);
+  if (body_contact_) forces_.add_member(body_contact_.get());
   return &forces_;
 }
 

@@ -4,6 +4,7 @@
 /// (levels_of_detail.hpp) drives one of these over the active model. Most users want Simulation.
 #include <pointhaptics/core/state.hpp>
 #include <pointhaptics/core/workspace.hpp>
+#include <pointhaptics/contact/body_contact.hpp>
 #include <pointhaptics/haptics/held_tool.hpp>
 #include <pointhaptics/haptics/probe_tool.hpp>
 #include <pointhaptics/haptics/trajectory.hpp>
@@ -151,6 +152,8 @@ class ModelSimulation {
   /// The obstacles, pressed on by the object beside its tool.
   std::vector<Obstacle>& obstacles() { return obstacles_; }
   const std::vector<Obstacle>& obstacles() const { return obstacles_; }
+  /// Contact between the model's bodies (several [[object]] tables); nullptr with one body.
+  std::unique_ptr<BodyContact>& body_contact() { return body_contact_; }
 
  private:
   friend class LevelsOfDetail;  // takes the object's model, state, diagnostics and probe over
@@ -161,11 +164,13 @@ class ModelSimulation {
   void count_inverted_neighbourhoods();
   void record(const StepReport& report, double seconds);
 
-  /// what acts on the model beside its material this step: the probe or held tool, and the obstacles
+  /// what acts on the model beside its material this step: the probe or held tool, the obstacles and the
+  /// contact between the bodies
   /// (rebuilt each step from them; no allocation once it has held them all)
   DynamicForces* forces_this_step();
   ForceSet forces_;
   std::vector<Obstacle> obstacles_;
+  std::unique_ptr<BodyContact> body_contact_;
   Model model_;
   SolverSpec solver_;
   State state_;

@@ -4,6 +4,7 @@
 
 #include <pointhaptics/core/error.hpp>
 #include <pointhaptics/geometry/marching_tetrahedra.hpp>
+#include <pointhaptics/geometry/mesh_distance.hpp>
 #include <pointhaptics/geometry/remesh.hpp>
 #include <pointhaptics/geometry/shape_surfaces.hpp>
 #include <pointhaptics/io/mesh_file.hpp>
@@ -65,8 +66,10 @@ TriangleMesh reconstruct_surface(const Model& model, double edge, double max_nod
   return marching_tetrahedra(field, 0.5);
 }
 
-ObjectSurface build_object_surface(const Scene& scene, const Model& model) {
-  const ObjectSpec& o = scene.object;
+namespace {
+
+// the object's closed surface, and what it was built from
+ObjectSurface object_mesh(const ObjectSpec& o, const Model& model) {
   const double edge = o.surface_edge > 0 ? o.surface_edge : 0.5 * o.spacing;
   ObjectSurface surface;
   switch (o.shape) {
@@ -99,6 +102,81 @@ ObjectSurface build_object_surface(const Scene& scene, const Model& model) {
       break;
     }
   }
+  return surface;
+}
+
+// a body's surface vertex inside another body by more than a hundredth of the finer spacing: the scene's bodies
+// start interpenetrating
+void check_bodies_apart(const Scene& scene, const Model& model, const ObjectSurface& surface) {
+  const std::size_t n = scene.bodies.size();
+  for (std::size_t b = 0; b < n; ++b) {
+    TriangleMesh other;
+    const index_t v0 = surface.body_vertex_start[b], v1 = surface.body_vertex_start[b + 1];
+    other.V = surface.mesh.V.middleCols(v0, v1 - v0);
+    for (index_t f = surface.body_face_start[b]; f < surface.body_face_start[b + 1]; ++f) {
+      const auto& t = surface.mesh.F[static_cast<std::size_t>(f)];
+      other.F.push_back({t[0] - v0, t[1] - v0, t[2] - v0});
+    }
+    const MeshDistance inside_b(other);
+    const double tolerance = 1e-2 * model.spacing;
+    for (std::size_t a = 0; a < n; ++a) {
+      if (a == b) continue;
+      for (index_t v = surface.body_vertex_start[a]; v < surface.body_vertex_start[a + 1]; ++v) {
+        const Vec3 y = surface.mesh.V.col(v);
+        const double depth = -inside_b.signed_distance(y);
+        if (depth > tolerance)
+          throw Error(
+              fmt::format("{}:{}: object[{}]: \"{}\" starts inside object[{}] \"{}\": its surface at "
+                          "[{:.4g}, {:.4g}, {:.4g}] lies {:.3g} m inside it (move one of them)",
+                          scene.path, scene.bodies[a].object.line, a, scene.bodies[a].name, b, scene.bodies[b].name,
+                          y.x(), y.y(), y.z(), depth));
+      }
+    }
+  }
+}
+
+// every body's surface, each carried by its own points
+ObjectSurface bodies_surface(const Scene& scene, const Model& model) {
+  ObjectSurface joined;
+  joined.mesh.V.resize(3, 0);
+  joined.body_vertex_start.push_back(0);
+  joined.body_face_start.push_back(0);
+  for (std::size_t k = 0; k < scene.bodies.size(); ++k) {
+    const BodySpec& body = scene.bodies[k];
+    const std::string name = fmt::format("{}:{}: object[{}] \"{}\"", scene.path, body.object.line, k, body.name);
+    if (body.object.shape == ShapeKind::FILE &&
+        (is_point_cloud_file(body.object.file) || is_volume_file(body.object.file)))
+      throw Error(
+          fmt::format("{}: a point cloud or a volume image is not yet one of several objects (its surface "
+                      "is reconstructed from the points around it); give a surface mesh or a shape",
+                      name));
+    ObjectSurface part = object_mesh(body.object, model);
+    check_closed_manifold(part.mesh, name + "'s surface");
+    const auto own = static_cast<index_t>(k);
+    const SurfaceMap map =
+        build_surface_map(model, part.mesh.V, nullptr, [&](index_t, index_t j) { return model.body_of(j) == own; });
+    const index_t v0 = static_cast<index_t>(joined.mesh.V.cols());
+    joined.mesh.V.conservativeResize(3, v0 + part.mesh.V.cols());
+    joined.mesh.V.rightCols(part.mesh.V.cols()) = part.mesh.V;
+    for (const auto& t : part.mesh.F) joined.mesh.F.push_back({t[0] + v0, t[1] + v0, t[2] + v0});
+    const index_t e0 = joined.map.points.n_entries();
+    for (index_t v = 0; v < map.n_vertices(); ++v) joined.map.points.offset.push_back(e0 + map.points.offset[v + 1]);
+    joined.map.points.index.insert(joined.map.points.index.end(), map.points.index.begin(), map.points.index.end());
+    joined.map.weight.insert(joined.map.weight.end(), map.weight.begin(), map.weight.end());
+    joined.map.widened += map.widened;
+    joined.body_vertex_start.push_back(static_cast<index_t>(joined.mesh.V.cols()));
+    joined.body_face_start.push_back(static_cast<index_t>(joined.mesh.F.size()));
+    joined.source += fmt::format("{}\"{}\": {}", k ? "; " : "", body.name, part.source);
+  }
+  check_bodies_apart(scene, model, joined);
+  return joined;
+}
+
+}  // namespace
+
+ObjectSurface build_object_surface(const Scene& scene, const Model& model) {
+  if (scene.bodies.size() > 1) return bodies_surface(scene, model);
+  ObjectSurface surface = object_mesh(scene.object, model);
   return carried_surface(std::move(surface.mesh), std::move(surface.source), model,
                          fmt::format("{}: the object's surface", scene.path));
 }

@@ -16,6 +16,10 @@ struct ObjectSurface {
   SurfaceMap map;         ///< y = Y + W u
   std::string source;     ///< what it was built from, for the summary ("exact box boundary, edge 3.75 mm", ...)
   index_t cut_faces = 0;  ///< the last cut_faces triangles of mesh.F are the faces of cuts (cut_surface.hpp)
+  /// Several bodies (Model::body_start): body k's vertices are [body_vertex_start[k], body_vertex_start[k + 1])
+  /// and its triangles [body_face_start[k], body_face_start[k + 1]), each body's surface carried by its own
+  /// points only. Both empty: one body.
+  std::vector<index_t> body_vertex_start, body_face_start;
 };
 
 /// The surface of a solid known only by its points (a point cloud, a volume image): the half level of their
@@ -31,7 +35,10 @@ ObjectSurface carried_surface(TriangleMesh mesh, std::string source, const Model
 /// (default half the spacing): the exact boundary of a box, sphere or half-sphere; a mesh file's own
 /// surface as it is (its edges may differ from the asked length: `source` says by how much); for a point
 /// cloud or a volume image, reconstruct_surface() of the model's points. Throws Error naming the scene for a
-/// surface that is not closed.
+/// surface that is not closed. With several [[object]] tables, every body's surface in the model's order, and
+/// an Error naming the two bodies when one's surface starts inside the other's by more than a hundredth of
+/// the finer spacing (a point cloud or volume image is then not yet an object: its surface would be
+/// reconstructed from every body's points).
 ObjectSurface build_object_surface(const Scene& scene, const Model& model);
 
 /// The deformed surface's vertices y = Y + W u.

@@ -1,5 +1,7 @@
 #include <pointhaptics/scene_builder.hpp>
 
+#include <pointhaptics/mechanics/join_models.hpp>
+
 #include <pointhaptics/core/error.hpp>
 #include <pointhaptics/core/memory_limit.hpp>
 #include <pointhaptics/core/run_control.hpp>
@@ -265,7 +267,41 @@ void apply_stiffness_map(const Scene& scene, PointCloud& cloud) {
 
 }  // namespace
 
+namespace {
+
+// The scene with body k as its one object (its own object, material, held points and loads; the rest as given).
+Scene body_scene(const Scene& scene, std::size_t k) {
+  Scene body = scene;
+  body.bodies = {scene.bodies[k]};
+  body.object = scene.bodies[k].object;
+  body.material = scene.bodies[k].material;
+  return body;
+}
+
+// Whether a [[fixed]] or [[load]] naming `object` (empty: none) applies to the scene's object: with [[object]]
+// tables, the build sees one body at a time (body_scene)
+bool applies(const Scene& scene, const std::string& object) {
+  return object.empty() || scene.bodies.empty() || object == scene.bodies.front().name;
+}
+
+// the object a message speaks of
+std::string the_object(const Scene& scene) {
+  return scene.bodies.empty() ? std::string("the object") : fmt::format("object \"{}\"", scene.bodies.front().name);
+}
+
+}  // namespace
+
 Model build_scene_model(const Scene& scene, double max_memory) {
+  if (scene.bodies.size() > 1) {
+    // several bodies: each built alone, then joined (no neighbour list crosses between them)
+    std::vector<Model> bodies;
+    std::vector<std::string> names;
+    for (std::size_t k = 0; k < scene.bodies.size(); ++k) {
+      bodies.push_back(build_scene_model(body_scene(scene, k), max_memory));
+      names.push_back(scene.bodies[k].name);
+    }
+    return join_models(std::move(bodies), std::move(names));
+  }
   // too big for the machine: refused before anything is allocated (files once they are read)
   // announced from the estimate when there is one (a refinement's fine points take long to sample), else once the
   // file's points are known
@@ -282,14 +318,15 @@ Model build_scene_model(const Scene& scene, double max_memory) {
   // held points, one group per [[fixed]] table
   for (size_t k = 0; k < scene.fixed.size(); ++k) {
     const FixedSpec& spec = scene.fixed[k];
+    if (!applies(scene, spec.object)) continue;
     FixedGroup group;
     group.name = fmt::format("fixed[{}]", k);
     group.displacement = spec.displacement;
     group.ramp = spec.ramp;
     group.points = points_in(model.X, spec, region_tolerance(model));
     if (group.points.empty())
-      throw Error(
-          fmt::format("{}:{}: fixed[{}].{}: holds no point of the object", scene.path, spec.line, k, spec.key()));
+      throw Error(fmt::format("{}:{}: fixed[{}].{}: holds no point of {}", scene.path, spec.line, k, spec.key(),
+                              the_object(scene)));
     for (index_t i : group.points) model.fixed[i] = 1;
     model.fixed_groups.push_back(std::move(group));
   }
@@ -301,6 +338,7 @@ Model build_scene_model(const Scene& scene, double max_memory) {
   // constant external loads
   for (size_t k = 0; k < scene.loads.size(); ++k) {
     const LoadSpec& load = scene.loads[k];
+    if (!applies(scene, load.object)) continue;
     switch (load.kind) {
       case LoadKind::GRAVITY:
         for (index_t i = 0; i < model.n_points; ++i) model.f_ext.col(i) += model.mass[i] * load.g;
@@ -308,7 +346,8 @@ Model build_scene_model(const Scene& scene, double max_memory) {
       case LoadKind::TRACTION: {
         const std::vector<index_t> loaded = points_in(model, load.box);
         if (loaded.empty())
-          throw Error(fmt::format("{}:{}: load[{}].box: holds no point of the object", scene.path, load.line, k));
+          throw Error(
+              fmt::format("{}:{}: load[{}].box: holds no point of {}", scene.path, load.line, k, the_object(scene)));
         double total_volume = 0;
         for (index_t i : loaded) total_volume += model.volume[i];
         for (index_t i : loaded) model.f_ext.col(i) += load.total * (model.volume[i] / total_volume);
@@ -316,8 +355,8 @@ Model build_scene_model(const Scene& scene, double max_memory) {
       }
       case LoadKind::POINT:
         if (load.point >= model.n_points)
-          throw Error(fmt::format("{}:{}: load[{}].point: {} is out of range (the object has {} points)", scene.path,
-                                  load.line, k, load.point, model.n_points));
+          throw Error(fmt::format("{}:{}: load[{}].point: {} is out of range ({} has {} points)", scene.path, load.line,
+                                  k, load.point, the_object(scene), model.n_points));
         model.f_ext.col(static_cast<index_t>(load.point)) += load.force;
         break;
     }

@@ -73,6 +73,8 @@ SceneSession open_scene(Scene scene, const SessionOptions& options) {
       object_surface = std::make_shared<const ObjectSurface>(build_object_surface(scene, s.simulation->model()));
     return object_surface;
   };
+  // several bodies touch on their surfaces (each carried by its own points)
+  if (s.simulation->model().n_bodies() > 1) s.simulation->add_body_contact(*surface_of_object());
   for (std::size_t k = 0; k < scene.obstacles.size(); ++k) {
     const ObstacleSpec& o = scene.obstacles[k];
     // static rigid bodies the object's surface presses on

@@ -215,6 +215,20 @@ void Simulation::add_obstacle(std::string name, const ToolShape& shape, const To
   sim.obstacles().push_back(Obstacle{std::move(name), std::move(held), path, pose});
 }
 
+void Simulation::add_body_contact(const ObjectSurface& surface, const BodyContactParams& params) {
+  ModelSimulation& sim = core();
+  if (lod_) throw Error("body contact: not yet with levels of detail (an active set is one body's)");
+  if (sim.model().n_bodies() < 2) throw Error("body contact: the model has one body");
+  if (sim.body_contact()) throw Error("body contact: already on");
+  BodyContactParams contact = params;
+  if (sim.solver().kind == SolverKind::EXPLICIT && contact.max_point_stiffness <= 0)
+    contact.max_point_stiffness = sim.model().material.young * sim.model().spacing;
+  sim.body_contact() = std::make_unique<BodyContact>(sim.model(), surface.mesh, surface.map, surface.body_vertex_start,
+                                                     surface.body_face_start, contact);
+}
+
+BodyContact* Simulation::body_contact() { return core().body_contact().get(); }
+
 void Simulation::set_tool_pose(const ToolPose& pose) {
   if (!core().held_tool()) throw Error("tool: no held tool to move");
   core().held_tool()->set_pose(pose);
@@ -339,6 +353,39 @@ ToolSummary Simulation::tool_summary() {
   return {};
 }
 
+namespace {
+
+// each body's block: its points, mass, motion, held groups and what the others do to it
+void body_summaries(const Model& model, const State& state, const BodyContact* contact, RunSummary& s) {
+  const BodyLoads loads = contact ? contact->loads(model, state.u) : BodyLoads{};
+  for (index_t k = 0; k < model.n_bodies(); ++k) {
+    BodySummary b;
+    b.name = model.body_names[static_cast<std::size_t>(k)];
+    const index_t first = model.body_start[static_cast<std::size_t>(k)],
+                  end = model.body_start[static_cast<std::size_t>(k) + 1];
+    b.points = end - first;
+    b.mass = model.mass.segment(first, end - first).sum();
+    Vec3 moment = Vec3::Zero();
+    for (index_t i = first; i < end; ++i) {
+      moment += model.mass[i] * state.u.col(i);
+      b.max_displacement = std::max(b.max_displacement, state.u.col(i).norm());
+    }
+    b.mean_displacement = b.mass > 0 ? Vec3(moment / b.mass) : Vec3::Zero();
+    if (contact) b.contact_force = loads.force[static_cast<std::size_t>(k)];
+    for (std::size_t g = 0; g < model.fixed_groups.size(); ++g)
+      if (!model.fixed_groups[g].points.empty() && model.body_of(model.fixed_groups[g].points.front()) == k)
+        b.constraints.push_back(static_cast<int>(g));
+    s.bodies.push_back(std::move(b));
+  }
+  if (contact) {
+    s.body_contact.pairs = contact->pairs();
+    s.body_contact.contacts = loads.contacts;
+    s.body_contact.penetration = loads.penetration;
+  }
+}
+
+}  // namespace
+
 RunSummary Simulation::summary() {
   ModelSimulation& sim = core();
   const Model& model = sim.model();
@@ -368,6 +415,7 @@ RunSummary Simulation::summary() {
   HeldTool* tool = sim.held_tool().get();
   if (tool) tool->add(model, state, ws.f_int);
   for (Obstacle& o : sim.obstacles()) o.contact.add(model, state, ws.f_int);
+  if (sim.body_contact()) sim.body_contact()->add(model, state, ws.f_int);
   s.reactions = support_reactions(model, ws.f_int);
   check_physical(model, ws, d, s);
   // dynamics is out of balance by the inertia; its Newton residual includes it
@@ -389,6 +437,7 @@ RunSummary Simulation::summary() {
         o.name, ToolSummary{true, tool_kind_name(o.contact.shape()), o.contact.pose().position, load.force, load.torque,
                             load.contacts, load.penetration, load.friction});
   }
+  if (model.n_bodies() > 1) body_summaries(model, state, sim.body_contact().get(), s);
   if (d.cuts > 0 || !scripted_cuts_.empty()) {
     // the object's cut (with levels of detail every cut of an active set reaches it)
     const Model& object = lod_ ? lod_->settled_object_model() : model;

@@ -86,6 +86,12 @@ class Simulation {
   /// over time, applied at each step's end (empty: static).
   void add_obstacle(std::string name, const ToolShape& shape, const ToolPose& pose, const TriangleMesh& mesh,
                     SurfaceMap map, const SurfaceContactParams& params = {}, const Trajectory& path = {});
+  /// Contact between the model's bodies (Model::body_start) on their surfaces (`surface`, with its bodies'
+  /// vertices and triangles): contact/body_contact.hpp. Explicit steps lower its penalty to E x spacing per point,
+  /// as a held tool's. Throws Error with one body, with levels of detail, or when it is already on.
+  void add_body_contact(const ObjectSurface& surface, const BodyContactParams& params = {});
+  /// The contact between the bodies (nullptr without one).
+  BodyContact* body_contact();
   void set_tool_pose(const ToolPose& pose);
   /// The held tool (nullptr without one).
   HeldTool* held_tool();

@@ -70,6 +70,17 @@ struct Model {
   /// which completes the neighbourhoods (M_i, d_ij) of the held points next to the simulated ones.
   index_t n_passive = 0;
 
+  /// Several deformable bodies in one model (issue 47; mechanics/join_models.hpp): body k's points are
+  /// [body_start[k], body_start[k + 1]) and no neighbour list leaves a body. Both empty: one body.
+  std::vector<index_t> body_start;
+  std::vector<std::string> body_names;
+  index_t n_bodies() const { return body_start.empty() ? 1 : static_cast<index_t>(body_start.size()) - 1; }
+  /// The body point i belongs to (0 with one body).
+  index_t body_of(index_t i) const {
+    if (body_start.empty()) return 0;
+    return static_cast<index_t>(std::upper_bound(body_start.begin(), body_start.end(), i) - body_start.begin()) - 1;
+  }
+
   /// The material of point i.
   const MaterialParams& material_at(index_t i) const {
     return material_of.empty() ? material : point_materials[material_of[i]];

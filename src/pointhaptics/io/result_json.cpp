@@ -102,6 +102,27 @@ std::string result_json(const Model& model, const State& state, const RunSummary
                          {"penetration", o.penetration},
                          {"friction", vec(o.friction)}};
   }
+  if (!s.bodies.empty()) {
+    nlohmann::json& bodies = doc["bodies"] = nlohmann::json::object();
+    for (const BodySummary& b : s.bodies) {
+      json held = json::array();
+      for (int g : b.constraints)
+        held.push_back({{"index", g},
+                        {"points", model.fixed_groups[static_cast<std::size_t>(g)].points.size()},
+                        {"reaction", static_cast<std::size_t>(g) < s.reactions.size()
+                                         ? vec(s.reactions[static_cast<std::size_t>(g)])
+                                         : vec(Vec3::Zero())}});
+      bodies[b.name] = {{"points", b.points},
+                        {"mass", b.mass},
+                        {"mean_displacement", vec(b.mean_displacement)},
+                        {"max_displacement", b.max_displacement},
+                        {"contact_force", vec(b.contact_force)},
+                        {"constraints", held}};
+    }
+    doc["body_contact"] = {{"pairs", s.body_contact.pairs},
+                           {"contacts", s.body_contact.contacts},
+                           {"penetration", s.body_contact.penetration}};
+  }
   if (s.cut.present) {
     const CutSummary& c = s.cut;
     doc["cut"] = {{"sweeps", c.sweeps},

@@ -60,6 +60,22 @@ struct LocalModelSummary {
   double held_object_mean_n = 0, held_object_max_n = 0;
 };
 
+/// One of several bodies (issue 47): the `bodies` block of the result, keyed by its name.
+struct BodySummary {
+  std::string name;
+  long long points = 0;
+  double mass = 0;                        ///< kg
+  Vec3 mean_displacement = Vec3::Zero();  ///< of its centre of mass, m
+  double max_displacement = 0;            ///< m
+  Vec3 contact_force = Vec3::Zero();      ///< what the other bodies exert on it, N
+  std::vector<int> constraints;           ///< its [[fixed]] groups (indices into `constraints`)
+};
+/// The contact between the bodies: its vertex-triangle pairs, pressing vertices, and deepest vertex.
+struct BodyContactSummary {
+  long long pairs = 0, contacts = 0;
+  double penetration = 0;  ///< m
+};
+
 struct RunSummary {
   std::string solver_kind;
   bool converged = false;
@@ -102,6 +118,9 @@ struct RunSummary {
   ToolSummary tool;
   /// The obstacles by name: what the object does to each (`kind` its shape, `position` its pose's origin).
   std::vector<std::pair<std::string, ToolSummary>> obstacles;
+  /// With several bodies, each one's block, in the model's order (empty with one body).
+  std::vector<BodySummary> bodies;
+  BodyContactSummary body_contact;
   CutSummary cut;
 };
 

@@ -86,6 +86,7 @@ struct PointSelector {
 struct FixedSpec : PointSelector {
   Vec3 displacement = Vec3::Zero();  ///< prescribed displacement, m
   double ramp = 0;                   ///< ramp-in time, s
+  std::string object;                ///< the [[object]] it holds, by name (empty: the scene's only object)
   int line = 0;                      ///< line of the [[fixed]] table, for messages
 };
 
@@ -116,8 +117,10 @@ struct LoadSpec {
   Aabb box;                    ///< traction: the loaded points
   Vec3 total = Vec3::Zero();   ///< traction: total force, N
   Vec3 g = Vec3(0, -9.81, 0);  ///< gravity, m/s^2
-  long long point = 0;         ///< point load: point index
+  long long point = 0;         ///< point load: point index (within its object)
   Vec3 force = Vec3::Zero();   ///< point load: force, N
+  /// the [[object]] it loads, by name (empty: the scene's only object; gravity: every object)
+  std::string object;
   int line = 0;
 };
 
@@ -200,8 +203,18 @@ struct ObstacleSpec {
   int line = 0;
 };
 
+/// [[object]]: one of several deformable bodies (issue 47). Its keys are [object]'s, with a `name` and an optional
+/// `material` table (the keys it omits are the scene's [material]'s).
+struct BodySpec {
+  std::string name;
+  ObjectSpec object;
+  MaterialParams material;
+};
+
 struct Scene {
   std::string path;  ///< the scene file ("<string>" when parsed from text), for messages
+  /// With [[object]] tables, every body (`object` and `material` are then the first's); empty with one [object].
+  std::vector<BodySpec> bodies;
   ObjectSpec object;
   MaterialParams material;
   KernelParams kernel;

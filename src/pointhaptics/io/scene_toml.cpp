@@ -492,9 +492,26 @@ void read_selector(TableReader& r, PointSelector& f) {
   }
 }
 
+// [[object]]: an [object] table's keys, a name and an optional material = { ... } over the scene's [material]
+BodySpec read_body(TableReader& r, const MaterialParams& scene_material, const Context& ctx) {
+  BodySpec b;
+  b.name = r.string("name", "");
+  if (b.name.empty())
+    r.fail_table("name", "an [[object]] needs a name = \"...\" (with several objects, its outputs are keyed by it)");
+  read_object(r, b.object, ctx);
+  b.material = scene_material;
+  if (const toml::table* t = r.subtable("material")) {
+    TableReader m(r.context(), *t, r.name("material"));
+    read_material(m, b.material);
+    m.finish();
+  }
+  return b;
+}
+
 FixedSpec read_fixed(TableReader& r) {
   FixedSpec f;
   f.line = r.line();
+  f.object = r.string("object", "");
   read_selector(r, f);
   f.displacement = r.vec3("displacement", f.displacement);
   f.ramp = r.number("ramp", 0.0, non_negative_up_to(1e6), "must lie in [0, 1e6] (s)");
@@ -621,6 +638,7 @@ ObstacleSpec read_obstacle(TableReader& r) {
 LoadSpec read_load(TableReader& r) {
   LoadSpec l;
   l.line = r.line();
+  l.object = r.string("object", "");
   l.kind = r.enumeration("kind", l.kind);
   if (l.kind == LoadKind::TRACTION) {
     l.box = r.box("box", true);
@@ -788,6 +806,52 @@ void read_lod(TableReader& r, LodSpec& l) {
   if (r.find("contact")) l.contact = r.vec3("contact", l.contact);
 }
 
+// Each [[fixed]] and [[load]] names an [[object]] (optional with one, and for gravity, which loads every one), and
+// what does not yet work with several objects is refused by name
+void check_body_names(const Scene& scene) {
+  const auto known = [&](const std::string& object) {
+    return std::any_of(scene.bodies.begin(), scene.bodies.end(), [&](const BodySpec& b) { return b.name == object; });
+  };
+  const auto check = [&](const std::string& object, std::string_view key, std::size_t k, int line, bool optional) {
+    const std::string where = fmt::format("{}:{}: {}[{}].object", scene.path, line, key, k);
+    if (object.empty()) {
+      if (scene.bodies.size() > 1 && !optional)
+        throw Error(
+            fmt::format("{}: missing: with several [[object]] tables, name the one it applies to "
+                        "(object = \"NAME\")",
+                        where));
+      return;
+    }
+    if (scene.bodies.empty())
+      throw Error(
+          fmt::format("{}: \"{}\" names an [[object]], but the scene has one [object] (leave it out)", where, object));
+    if (!known(object)) {
+      std::string names;
+      for (const BodySpec& b : scene.bodies) names += (names.empty() ? "\"" : ", \"") + b.name + "\"";
+      throw Error(fmt::format("{}: no [[object]] is named \"{}\" (the objects: {})", where, object, names));
+    }
+  };
+  for (std::size_t k = 0; k < scene.fixed.size(); ++k)
+    check(scene.fixed[k].object, "fixed", k, scene.fixed[k].line, false);
+  for (std::size_t k = 0; k < scene.loads.size(); ++k)
+    check(scene.loads[k].object, "load", k, scene.loads[k].line, scene.loads[k].kind == LoadKind::GRAVITY);
+  if (scene.bodies.size() < 2) return;
+  // not yet: each carries one object's points (a level of detail's active set, a refinement's sampling, a cut's
+  // surface, a region's material)
+  const auto refuse = [&](bool present, int line, std::string_view key, std::string_view why) {
+    if (present)
+      throw Error(fmt::format("{}:{}: {}: not yet with several [[object]] tables ({})", scene.path, line, key, why));
+  };
+  refuse(scene.lod.present, scene.lod.line, "lod", "an active set is one object's");
+  refuse(!scene.refine.empty(), scene.refine.empty() ? 0 : scene.refine.front().line, "refine",
+         "a refinement resamples one object");
+  refuse(!scene.cuts.empty(), scene.cuts.empty() ? 0 : scene.cuts.front().line, "cut",
+         "a cut's surface is built on one object's");
+  refuse(scene.probe.cut, scene.probe.line, "probe.mode", "a blade cuts one object's surface");
+  refuse(!scene.regions.empty(), scene.regions.empty() ? 0 : scene.regions.front().line, "region",
+         "give each [[object]] its own material = { ... }");
+}
+
 // [[name]] arrays of tables
 template <class Read>
 void read_array_of_tables(TableReader& root, std::string_view key, Read read) {
@@ -834,9 +898,22 @@ Scene parse_scene(std::string_view text, const std::string& name, const std::str
       r.finish();
     }
   };
-  if (!root.get("object")) throw Error(fmt::format("{}:1: object: missing [object] section", name));
-  section("object", [&](TableReader& r) { read_object(r, scene.object, ctx); });
-  section("material", [&](TableReader& r) { read_material(r, scene.material); });
+  const toml::node* objects = root.get("object");
+  if (!objects) throw Error(fmt::format("{}:1: object: missing [object] section", name));
+  section("material", [&](TableReader& r) { read_material(r, scene.material); });  // [[object]]s start from it
+  if (objects->is_array_of_tables()) {
+    read_array_of_tables(top, "object",
+                         [&](TableReader& r) { scene.bodies.push_back(read_body(r, scene.material, ctx)); });
+    for (std::size_t a = 0; a < scene.bodies.size(); ++a)
+      for (std::size_t b = 0; b < a; ++b)
+        if (scene.bodies[a].name == scene.bodies[b].name)
+          throw Error(fmt::format("{}:{}: object[{}].name: \"{}\" is already the name of object[{}] (names are unique)",
+                                  name, scene.bodies[a].object.line, a, scene.bodies[a].name, b));
+    scene.object = scene.bodies.front().object;
+    scene.material = scene.bodies.front().material;
+  } else {
+    section("object", [&](TableReader& r) { read_object(r, scene.object, ctx); });
+  }
   section("kernel", [&](TableReader& r) { read_kernel(r, scene.kernel); });
   section("solver", [&](TableReader& r) { read_solver(r, scene.solver); });
   section("probe", [&](TableReader& r) { read_probe(r, scene.probe, ctx); });
@@ -888,6 +965,7 @@ Scene parse_scene(std::string_view text, const std::string& name, const std::str
     throw Error(fmt::format("{}:{}: refine: not yet with levels of detail ([lod] thins a uniform sampling)", name,
                             scene.refine.front().line));
   top.finish();
+  check_body_names(scene);
   if (scene.lod.present && !scene.probe.present && !scene.lod.contact.allFinite()) {
     int point_loads = 0;
     for (const LoadSpec& l : scene.loads) point_loads += l.kind == LoadKind::POINT;

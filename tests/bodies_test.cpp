@@ -1,0 +1,203 @@
+// Several deformable bodies (issue 47): [[object]] tables with named errors, one model whose neighbour lists never
+// cross between bodies, bodies that start inside each other refused, contact between them that conserves
+// momentum, and a block resting on a block on a table, each carrying what is above it.
+#include <pointhaptics/io/scene_toml.hpp>
+#include <pointhaptics/mechanics/energy.hpp>
+#include <pointhaptics/scene_builder.hpp>
+#include <pointhaptics/scene_session.hpp>
+#include <pointhaptics/simulation.hpp>
+
+#include <gtest/gtest.h>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <string>
+
+using namespace pointhaptics;
+
+namespace {
+
+constexpr double spacing = 0.005;
+
+// a 4 x 2 x 4 cm lower block from the origin and a 2 x 2 x 2 cm upper block centred on it, `gap` above it
+std::string two_blocks(double gap, const std::string& solver, const std::string& more = "") {
+  return fmt::format(R"(
+[material]
+young = 1e5
+poisson = 0.3
+density = 1000.0
+damping = 20.0
+[[object]]
+name = "lower"
+shape = "box"
+size = [0.04, 0.02, 0.04]
+spacing = {}
+[[object]]
+name = "upper"
+shape = "box"
+origin = [0.01, {}, 0.01]
+size = [0.02, 0.02, 0.02]
+spacing = {}
+material = {{ young = 2e5, density = 2000.0 }}
+[solver]
+{}
+{}
+)",
+                     spacing, 0.02 + gap, spacing, solver, more);
+}
+
+constexpr double lower_weight = 0.04 * 0.02 * 0.04 * 1000.0 * 9.81;  // N
+constexpr double upper_weight = 0.02 * 0.02 * 0.02 * 2000.0 * 9.81;  // N
+
+SessionOptions two_threads() {
+  SessionOptions options;
+  options.threads = 2;
+  return options;
+}
+
+std::string error_of(const std::string& text, bool open = true) {
+  try {
+    Scene scene = parse_scene(text, "scene.toml");
+    if (open) SceneSession s = open_scene(std::move(scene), two_threads());
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+const BodySummary& body(const RunSummary& s, const std::string& name) {
+  for (const BodySummary& b : s.bodies)
+    if (b.name == name) return b;
+  throw Error("no body " + name);
+}
+
+TEST(Bodies, TablesAreReadAndTheirMistakesNamed) {
+  const Scene scene = parse_scene(two_blocks(0.0, "kind = \"static\"",
+                                             "[[fixed]]\nobject = \"lower\"\nbox = { min = [-1.0, -1.0, -1.0], max = "
+                                             "[1.0, 0.0, 1.0] }\n[[load]]\nkind = \"gravity\""),
+                                  "scene.toml");
+  ASSERT_EQ(scene.bodies.size(), 2u);
+  EXPECT_EQ(scene.bodies[1].name, "upper");
+  EXPECT_EQ(scene.bodies[1].material.young, 2e5);
+  EXPECT_EQ(scene.bodies[1].material.poisson, 0.3) << "the keys it leaves out are [material]'s";
+  EXPECT_EQ(scene.bodies[0].material.young, 1e5);
+  EXPECT_EQ(scene.fixed[0].object, "lower");
+  const auto fails = [](const std::string& text, const std::string& expected) {
+    const std::string message = error_of(text, false);
+    EXPECT_NE(message.find(expected), std::string::npos) << message;
+  };
+  fails("[[object]]\nshape = \"box\"\nsize = [0.01, 0.01, 0.01]",
+        "scene.toml:1: object[0].name: an [[object]] needs a name");
+  fails("[[object]]\nname = \"a\"\nsize = [0.01, 0.01, 0.01]\n[[object]]\nname = \"a\"\nsize = [0.01, 0.01, 0.01]",
+        "scene.toml:4: object[1].name: \"a\" is already the name of object[0]");
+  fails(two_blocks(0.0, "kind = \"static\"", "[[fixed]]\nbox = { min = [0.0, 0.0, 0.0], max = [1.0, 0.0, 1.0] }"),
+        "fixed[0].object: missing: with several [[object]] tables, name the one it applies to");
+  fails(two_blocks(0.0, "kind = \"static\"",
+                   "[[fixed]]\nobject = \"middle\"\nbox = { min = [0.0, 0.0, 0.0], max = [1.0, 0.0, 1.0] }"),
+        "fixed[0].object: no [[object]] is named \"middle\" (the objects: \"lower\", \"upper\")");
+  fails(two_blocks(0.0, "kind = \"static\"", "[[load]]\nkind = \"point\"\npoint = 0\nforce = [0.0, 1.0, 0.0]"),
+        "load[0].object: missing");
+  fails("[object]\nsize = [0.01, 0.01, 0.01]\n[[load]]\nkind = \"gravity\"\nobject = \"a\"",
+        "load[0].object: \"a\" names an [[object]], but the scene has one [object]");
+  fails(two_blocks(0.0, "kind = \"explicit\"", "[lod]\ncontact = [0.0, 0.0, 0.0]"),
+        "lod: not yet with several [[object]] tables");
+  std::string coloured = two_blocks(0.0, "kind = \"static\"");
+  coloured.replace(coloured.find("material = {"), 12, "material = { colour = 1,");
+  fails(coloured, "object[1].material.colour: unknown key");
+}
+
+// each body is built alone: its own spacing, material and held points; no neighbour pair crosses; the point load
+// indexes its own body's points
+TEST(Bodies, TheModelJoinsThemWithoutANeighbourAcross) {
+  const Scene scene = parse_scene(two_blocks(0.0, "kind = \"static\"",
+                                             "[[fixed]]\nobject = \"upper\"\nbox = { min = [-1.0, 0.039, -1.0], max = "
+                                             "[1.0, 1.0, 1.0] }\n[[load]]\nkind = \"point\"\nobject = \"upper\"\n"
+                                             "point = 0\nforce = [0.0, -1.0, 0.0]"),
+                                  "scene.toml");
+  const Model model = build_scene_model(scene);
+  ASSERT_EQ(model.n_bodies(), 2);
+  const index_t lower = model.body_start[1], upper = model.n_points - lower;
+  EXPECT_EQ(lower, 9 * 5 * 9);
+  EXPECT_EQ(upper, 5 * 5 * 5);
+  for (index_t i = 0; i < model.n_points; ++i)
+    for (index_t e = model.neighbours.begin(i); e < model.neighbours.end(i); ++e) {
+      const index_t j = model.neighbours.index[e];
+      ASSERT_EQ(model.body_of(i), model.body_of(j)) << i << " " << j;
+      ASSERT_EQ(model.neighbours.index[model.reverse_pair[e]], i);
+    }
+  EXPECT_NEAR(model.mass.head(lower).sum(), lower_weight / 9.81, 1e-9);
+  EXPECT_NEAR(model.mass.tail(upper).sum(), upper_weight / 9.81, 1e-9);
+  EXPECT_EQ(model.young_at(0), 1e5);
+  EXPECT_EQ(model.young_at(lower), 2e5);
+  ASSERT_EQ(model.fixed_groups.size(), 1u);
+  for (index_t i : model.fixed_groups[0].points) EXPECT_EQ(model.body_of(i), 1);
+  EXPECT_EQ(model.f_ext.col(lower), Vec3(0, -1, 0)) << "the point load is on the upper body's point 0";
+  EXPECT_EQ(model.f_ext.col(0), Vec3::Zero());
+}
+
+TEST(Bodies, ThatStartInsideEachOtherAreRefusedByName) {
+  const std::string message = error_of(two_blocks(-0.003, "kind = \"static\""));
+  EXPECT_NE(message.find("object[1]: \"upper\" starts inside object[0] \"lower\""), std::string::npos) << message;
+  EXPECT_EQ(error_of(two_blocks(0.0, "kind = \"static\"")), "no error") << "touching is not inside";
+}
+
+// two free blocks thrown at each other, without gravity or damping: the contact's forces are equal and opposite,
+// so the total momentum stays what it was while each body's changes
+TEST(Bodies, AFreeCollisionConservesMomentum) {
+  std::string text = two_blocks(0.002, "kind = \"explicit\"\ndt = 1e-4");
+  text.replace(text.find("damping = 20.0"), 14, "damping = 0.0");
+  SceneSession s = open_scene(parse_scene(text, "scene.toml"), two_threads());
+  const Model& model = s.simulation->model();
+  State state = s.simulation->state();
+  const index_t lower = model.body_start[1];
+  for (index_t i = 0; i < model.n_points; ++i)
+    state.velocity.col(i) = i < lower ? Vec3(0, 0.1, 0) : Vec3(0.02, -0.4, 0);
+  s.simulation->set_state(state);
+  const auto momentum = [&](index_t first, index_t end) {
+    Vec3 p = Vec3::Zero();
+    for (index_t i = first; i < end; ++i) p += model.mass[i] * s.simulation->state().velocity.col(i);
+    return p;
+  };
+  const Vec3 before = momentum(0, model.n_points), upper_before = momentum(lower, model.n_points);
+  Vec3 largest_change = Vec3::Zero();
+  int touching = 0;
+  for (int k = 0; k < 200; ++k) {
+    ASSERT_NE(s.simulation->step().status, StepStatus::FAILED);
+    largest_change = largest_change.cwiseMax((momentum(lower, model.n_points) - upper_before).cwiseAbs());
+    touching += s.simulation->body_contact()->loads(model, s.simulation->state().u).contacts > 0;
+  }
+  EXPECT_GT(touching, 0);
+  EXPECT_GT(largest_change.y(), 0.3 * std::abs(upper_before.y())) << "the blocks met and pushed each other";
+  EXPECT_LT((momentum(0, model.n_points) - before).norm(), 1e-9 * before.norm());
+}
+
+// the lower block on a table, the upper on it, under gravity, run to rest: the upper block carried by the lower,
+// the table carrying both, the bodies apart by at most a hundredth of the spacing; the result has a block per body
+TEST(Bodies, ABlockOnABlockOnATableEachCarriesWhatIsAboveIt) {
+  SceneSession s = open_scene(parse_scene(two_blocks(0.0, "kind = \"implicit\"\ndt = 2e-3\nduration = 0.5",
+                                                     "[[load]]\nkind = \"gravity\"\n[[obstacle]]\nname = \"table\"\n"
+                                                     "friction = 0.5\nplane = { normal = [0.0, 1.0, 0.0] }"),
+                                          "scene.toml"),
+                              two_threads());
+  s.simulation->run(0.5);
+  const RunSummary summary = s.simulation->summary();
+  ASSERT_TRUE(summary.converged) << summary.failure;
+  ASSERT_EQ(summary.bodies.size(), 2u);
+  EXPECT_NEAR(body(summary, "upper").contact_force.y(), upper_weight, 0.005 * upper_weight);
+  EXPECT_NEAR(body(summary, "lower").contact_force.y(), -upper_weight, 0.005 * upper_weight);
+  EXPECT_LT(std::hypot(body(summary, "upper").contact_force.x(), body(summary, "upper").contact_force.z()),
+            1e-3 * upper_weight);
+  ASSERT_EQ(summary.obstacles.size(), 1u);
+  EXPECT_NEAR(summary.obstacles[0].second.force.y(), -(lower_weight + upper_weight),
+              0.005 * (lower_weight + upper_weight));
+  EXPECT_LT(summary.body_contact.penetration, 0.01 * spacing);
+  EXPECT_GT(summary.body_contact.contacts, 0);
+  const nlohmann::json doc = nlohmann::json::parse(result_json(s.simulation->model(), s.simulation->state(), summary));
+  EXPECT_EQ(doc["bodies"]["upper"]["points"], 125);
+  EXPECT_NEAR(doc["bodies"]["upper"]["mass"].get<double>(), upper_weight / 9.81, 1e-9);
+  EXPECT_LT(doc["bodies"]["upper"]["mean_displacement"][1].get<double>(), 0.0) << "it settled down";
+  EXPECT_GT(doc["body_contact"]["contacts"].get<int>(), 0);
+}
+
+}  // namespace
