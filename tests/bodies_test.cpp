@@ -201,3 +201,19 @@ TEST(Bodies, ABlockOnABlockOnATableEachCarriesWhatIsAboveIt) {
 }
 
 }  // namespace
+
+namespace {
+
+// the shipped scene opens with its two layers, apart, in contact with each other and the table at the start
+TEST(Bodies, TheShippedLayersSceneOpensWithTwoBodiesInContact) {
+  SceneSession s = open_scene_file(PH_SCENES "/layers_on_table.toml", two_threads());
+  const Model& model = s.simulation->model();
+  ASSERT_EQ(model.n_bodies(), 2);
+  EXPECT_EQ(model.body_names, (std::vector<std::string>{"lower", "upper"}));
+  ASSERT_NE(s.simulation->body_contact(), nullptr);
+  EXPECT_GT(s.simulation->body_contact()->loads(model, s.simulation->state().u).force.size(), 1u);
+  s.simulation->body_contact()->refresh(model, s.simulation->state().u);
+  EXPECT_GT(s.simulation->body_contact()->pairs(), 0) << "the layers' faces are paired from the start";
+}
+
+}  // namespace

@@ -2,6 +2,7 @@
 
 #include <pointhaptics/core/error.hpp>
 #include <pointhaptics/geometry/mesh_distance.hpp>
+#include <pointhaptics/mechanics/tangent_matrix.hpp>
 
 #include <fmt/format.h>
 
@@ -218,6 +219,21 @@ void BodyContact::add_diagonal_blocks(Eigen::Matrix<double, 9, Eigen::Dynamic>& 
       Eigen::Map<Mat3>(blocks.col(j).data()) += c * c * nn;
     }
   }
+}
+
+bool BodyContact::add_to_matrix(TangentMatrix& K) const {
+  for (std::size_t k = 0; k < pairs_.size(); ++k) {
+    if (!pressing_[k]) continue;
+    const Pair& p = pairs_[k];
+    const Mat3 nn = p.stiffness * p.normal * p.normal.transpose();
+    for (index_t e = p.first; e < p.last; ++e)
+      for (index_t f = e; f < p.last; ++f) {
+        const auto& [i, ci] = coefficient_[static_cast<std::size_t>(e)];
+        const auto& [j, cj] = coefficient_[static_cast<std::size_t>(f)];
+        add_coupling(K, i, j, ci * cj, nn);
+      }
+  }
+  return true;
 }
 
 bool BodyContact::update_multipliers(const Model& model, const Points& u) {

@@ -74,6 +74,9 @@ class BodyContact final : public DynamicForces, public EnergyTerm {
   void linearise(const Model& model, const Points& u, TangentMode mode) override;
   void add_tangent_product(const Points& dx, Points& out) const override;
   void add_diagonal_blocks(Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks) const override;
+  /// Each pressing pair's k (c c^T) (x) n n^T over its points, for the Cholesky preconditioner: the two bodies'
+  /// points are not neighbours, so the coupling across them is lumped on the diagonal (add_coupling()), a bound.
+  bool add_to_matrix(TangentMatrix& K) const override;
   bool update_multipliers(const Model& model, const Points& u) override;
 
  private:
