@@ -53,56 +53,93 @@ Points pressed(const Model& model) {
   return u;
 }
 
-TEST(BodyContact, ForcesAreTheEnergysGradientAndTheTangentTheirs) {
-  const TwoBodies t = two_bodies();
-  BodyContact contact(t.model, t.surface.mesh, t.surface.map, t.surface.body_vertex_start, t.surface.body_face_start,
-                      BodyContactParams{.penalty = 1e9});
-  const Points u = pressed(t.model);
-  contact.refresh(t.model, Points::Zero(3, t.model.n_points));  // paired at rest, evaluated pressed in
-  ASSERT_GT(contact.pairs(), 0);
-  Points f = Points::Zero(3, t.model.n_points);
-  contact.add_forces(t.model, u, f);
+// the checks at u: forces against central differences of the energy, the tangent against those of the forces,
+// the diagonal blocks against the tangent's
+void check_derivatives(BodyContact& contact, const Model& model, const Points& u) {
+  Points f = Points::Zero(3, model.n_points);
+  contact.add_forces(model, u, f);
   ASSERT_GT(f.norm(), 0) << "they press";
   EXPECT_LT(f.rowwise().sum().norm(), 1e-10 * f.norm()) << "equal and opposite";
-  const BodyLoads loads = contact.loads(t.model, u);
-  EXPECT_LT((loads.force[0] + loads.force[1]).norm(), 1e-12);
-  EXPECT_GT(loads.force[1].y(), 0) << "the lower body pushes the upper up";
-  EXPECT_NEAR(loads.penetration, 2e-4, 1e-4);
-
-  // central differences of the energy along a few points' coordinates, and of the forces along a direction
   const double eps = 1e-8;
   int checked = 0;
-  for (index_t i = 0; i < t.model.n_points && checked < 40; i += 7)
+  for (index_t i = 0; i < model.n_points && checked < 40; i += 3)
     for (int a = 0; a < 3; ++a) {
       if (std::abs(f(a, i)) < 1e-6 * f.cwiseAbs().maxCoeff()) continue;
       Points up = u, down = u;
       up(a, i) += eps;
       down(a, i) -= eps;
-      const double gradient = (contact.energy(t.model, up) - contact.energy(t.model, down)) / (2 * eps);
-      EXPECT_NEAR(-gradient, f(a, i), 1e-5 * std::abs(f(a, i)) + 1e-9) << i << " " << a;
+      const double gradient = (contact.energy(model, up) - contact.energy(model, down)) / (2 * eps);
+      EXPECT_NEAR(-gradient, f(a, i), 1e-5 * std::abs(f(a, i)) + 1e-8 * f.cwiseAbs().maxCoeff()) << i << " " << a;
       ++checked;
     }
   EXPECT_GT(checked, 10);
-  Points direction(3, t.model.n_points);
-  for (index_t i = 0; i < t.model.n_points; ++i) direction.col(i) = Vec3(std::cos(i), std::sin(2.0 * i), 0.3);
-  contact.linearise(t.model, u, TangentMode::EXACT);
-  Points product = Points::Zero(3, t.model.n_points);
+  Points direction(3, model.n_points);
+  for (index_t i = 0; i < model.n_points; ++i) direction.col(i) = Vec3(std::cos(i), std::sin(2.0 * i), 0.3);
+  contact.linearise(model, u, TangentMode::EXACT);
+  Points product = Points::Zero(3, model.n_points);
   contact.add_tangent_product(direction, product);
   const double h = 1e-9;
-  Points f_up = Points::Zero(3, t.model.n_points), f_down = Points::Zero(3, t.model.n_points);
-  contact.add_forces(t.model, u + h * direction, f_up);
-  contact.add_forces(t.model, u - h * direction, f_down);
+  Points f_up = Points::Zero(3, model.n_points), f_down = Points::Zero(3, model.n_points);
+  contact.add_forces(model, u + h * direction, f_up);
+  contact.add_forces(model, u - h * direction, f_down);
   const Points difference = -(f_up - f_down) / (2 * h);
   EXPECT_LT((difference - product).norm(), 1e-4 * product.norm());
-  // the diagonal blocks are the tangent's
-  Eigen::Matrix<double, 9, Eigen::Dynamic> blocks = Eigen::Matrix<double, 9, Eigen::Dynamic>::Zero(9, t.model.n_points);
+  Eigen::Matrix<double, 9, Eigen::Dynamic> blocks = Eigen::Matrix<double, 9, Eigen::Dynamic>::Zero(9, model.n_points);
   contact.add_diagonal_blocks(blocks);
-  const index_t i = t.model.body_start[1];  // a point of the upper body's base corner
-  Points unit = Points::Zero(3, t.model.n_points);
-  unit(1, i) = 1;
-  Points column = Points::Zero(3, t.model.n_points);
-  contact.add_tangent_product(unit, column);
-  EXPECT_NEAR(Eigen::Map<const Mat3>(blocks.col(i).data())(1, 1), column(1, i), 1e-9 * (1 + std::abs(column(1, i))));
+  for (index_t i : {model.body_start[1], index_t{0}, model.n_points - 1})
+    for (int a = 0; a < 3; ++a) {
+      Points unit = Points::Zero(3, model.n_points);
+      unit(a, i) = 1;
+      Points column = Points::Zero(3, model.n_points);
+      contact.add_tangent_product(unit, column);
+      EXPECT_NEAR(Eigen::Map<const Mat3>(blocks.col(i).data())(a, a), column(a, i),
+                  1e-9 * (1 + std::abs(column(a, i))));
+    }
+}
+
+TEST(BodyContact, ForcesAreTheEnergysGradientAndTheTangentTheirs) {
+  const TwoBodies t = two_bodies();
+  BodyContactParams params;
+  params.penalty = 1e9;
+  BodyContact contact(t.model, t.surface.mesh, t.surface.map, t.surface.body_vertex_start, t.surface.body_face_start,
+                      params);
+  const Points u = pressed(t.model);
+  contact.refresh(t.model, Points::Zero(3, t.model.n_points));  // paired at rest, evaluated pressed in
+  ASSERT_GT(contact.pairs(), 0);
+  const BodyLoads loads = contact.loads(t.model, u);
+  EXPECT_LT((loads.force[0] + loads.force[1]).norm(), 1e-12);
+  EXPECT_GT(loads.force[1].y(), 0) << "the lower body pushes the upper up";
+  EXPECT_NEAR(loads.penetration, 2e-4, 1e-4);
+  check_derivatives(contact, t.model, u);
+}
+
+// with friction in force (after a multiplier update), on both sides of the cone: a slight shear sticks, a larger
+// one slides
+TEST(BodyContact, WithFrictionTooStickingAndSliding) {
+  const TwoBodies t = two_bodies();
+  BodyContactParams params;
+  params.penalty = 1e9;
+  params.friction = 0.5;
+  params.tangential_share = 0.1;
+  BodyContact contact(t.model, t.surface.mesh, t.surface.map, t.surface.body_vertex_start, t.surface.body_face_start,
+                      params);
+  const Points u = pressed(t.model);
+  contact.refresh(t.model, Points::Zero(3, t.model.n_points));
+  EXPECT_FALSE(contact.update_multipliers(t.model, u));  // the multipliers take the pressure, friction anchors
+  std::vector<double> held_back;
+  for (const double shear : {1e-7, 5e-3, 1e-2}) {  // the cone is about mu lambda / k_t = 1.6 mm of slip away
+    SCOPED_TRACE(shear);
+    Points sheared = u;
+    for (index_t i = t.model.body_start[1]; i < t.model.n_points; ++i) sheared(0, i) += shear;
+    const BodyLoads loads = contact.loads(t.model, sheared);
+    ASSERT_LT(loads.friction[1].x(), 0) << "friction holds the upper body back";
+    EXPECT_LT((loads.friction[0] + loads.friction[1]).norm(), 1e-12);
+    EXPECT_LT(-loads.friction[1].x(), 0.5 * loads.force[1].y()) << "within mu times the pressure";
+    held_back.push_back(-loads.friction[1].x());
+    check_derivatives(contact, t.model, sheared);
+  }
+  EXPECT_NEAR(held_back[0] / held_back[1], 0, 1e-3) << "a slight shear sticks: its force is its slip's";
+  EXPECT_NEAR(held_back[2], held_back[1], 1e-5 * held_back[1]) << "sliding: on the cone, whatever the slip";
 }
 
 TEST(BodyContact, TheMultipliersMeetTheConstraintAndKeepTheirForceAcrossARefresh) {

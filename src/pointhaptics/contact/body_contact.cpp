@@ -1,7 +1,6 @@
 #include <pointhaptics/contact/body_contact.hpp>
 
 #include <pointhaptics/core/error.hpp>
-#include <pointhaptics/geometry/mesh_distance.hpp>
 #include <pointhaptics/mechanics/tangent_matrix.hpp>
 
 #include <fmt/format.h>
@@ -40,6 +39,14 @@ BodyContact::BodyContact(const Model& model, TriangleMesh mesh, SurfaceMap map, 
   tolerance_ = params.tolerance > 0 ? params.tolerance : 1e-3 * spacing;
   reach_ = params.reach > 0 ? params.reach : spacing;
   rate_ = params.multiplier_rate;
+  const std::size_t bodies = vertex_start_.size() - 1;
+  if (!(params.friction >= 0) || !(params.tangential_share > 0 && params.tangential_share <= 1) ||
+      (!params.pair_friction.empty() && params.pair_friction.size() != bodies * bodies))
+    throw Error("body contact: friction must be >= 0, one per pair of bodies, and the tangential share in (0, 1]");
+  tangential_share_ = params.tangential_share;
+  pair_friction_ =
+      params.pair_friction.empty() ? std::vector<double>(bodies * bodies, params.friction) : params.pair_friction;
+  anchors_.assign(static_cast<std::size_t>(nv), Anchor{});
 
   // each vertex's share of its triangles' area, and its body's Young's modulus (its first point's)
   std::vector<double> area(static_cast<std::size_t>(nv), 0.0);
@@ -108,7 +115,8 @@ void BodyContact::refresh(const Model& model, const Points& u) {
     const Vec3 y = y_.col(v), vertex_normal = vertex_normal_.col(v);
     double best = std::numeric_limits<double>::infinity();
     index_t nearest = -1;
-    Vec3 nearest_point = Vec3::Zero(), nearest_normal = Vec3::Zero();
+    Vec3 nearest_normal = Vec3::Zero();
+    std::array<double, 3> beta{0, 0, 0};
     grid_.for_each_within(centroid_, y, reach_ + max_circumradius_, [&](index_t t) {
       if (body_of_face(t) == body) return;
       const auto& f = mesh_.F[static_cast<std::size_t>(t)];
@@ -116,55 +124,108 @@ void BodyContact::refresh(const Model& model, const Points& u) {
       const Vec3 normal = (b - a).cross(c - a).normalized();
       // surfaces that face each other only (not the far side of a thin body, nor a side face met edge on)
       if (!(normal.dot(vertex_normal) < 0)) return;
-      const Vec3 point = closest_on_triangle(y, a, b, c).first;
-      const double d = (y - point).norm();
-      if (d <= reach_ && d < best) {
-        best = d;
+      // the face covers the vertex: its projection on the face's plane lies in the triangle (a hundredth of it
+      // beyond, where two triangles meet). Not the face's plane beyond the body's edge: a vertex beside a body's
+      // base is below that plane but outside the body
+      const double distance = normal.dot(y - a);
+      const std::array<double, 3> coordinates = barycentric(y - distance * normal, a, b, c);
+      if (std::min({coordinates[0], coordinates[1], coordinates[2]}) < -0.01) return;
+      if (std::abs(distance) <= reach_ && std::abs(distance) < best) {
+        best = std::abs(distance);
         nearest = t;
-        nearest_point = point;
         nearest_normal = normal;
+        beta = coordinates;
       }
     });
-    if (nearest < 0) continue;
-    const auto& f = mesh_.F[static_cast<std::size_t>(nearest)];
-    const std::array<double, 3> beta = barycentric(nearest_point, y_.col(f[0]), y_.col(f[1]), y_.col(f[2]));
+    Anchor& anchor = anchors_[static_cast<std::size_t>(v)];
+    if (nearest < 0) {
+      anchor = Anchor{};
+      continue;
+    }
     Pair p;
     p.vertex = v;
     p.triangle = nearest;
     p.normal = nearest_normal;
     p.stiffness = vertex_stiffness_[static_cast<std::size_t>(v)];
     p.multiplier = previous_multiplier_[static_cast<std::size_t>(v)];
+    p.friction = pair_friction_[static_cast<std::size_t>(body) * (vertex_start_.size() - 1) +
+                                static_cast<std::size_t>(body_of_face(nearest))];
     p.first = static_cast<index_t>(coefficient_.size());
-    Vec3 reference = mesh_.V.col(v);
-    for (index_t e = map_.points.begin(v); e < map_.points.end(v); ++e)
-      coefficient_.emplace_back(map_.points.index[e], map_.weight[e]);
-    const auto own_end = coefficient_.size();
-    for (int b = 0; b < 3; ++b) {
-      reference -= beta[static_cast<std::size_t>(b)] * mesh_.V.col(f[static_cast<std::size_t>(b)]);
-      for (index_t e = map_.points.begin(f[static_cast<std::size_t>(b)]);
-           e < map_.points.end(f[static_cast<std::size_t>(b)]); ++e) {
-        const index_t j = map_.points.index[e];
-        const double c = -beta[static_cast<std::size_t>(b)] * map_.weight[e];
-        // the triangle's corners share points: one coefficient each
-        const auto same = std::find_if(coefficient_.begin() + static_cast<std::ptrdiff_t>(own_end), coefficient_.end(),
-                                       [&](const auto& jc) { return jc.first == j; });
-        if (same != coefficient_.end()) same->second += c;
-        else coefficient_.emplace_back(j, c);
-      }
-    }
+    p.gap0 = p.normal.dot(append_difference(v, nearest, beta));
     p.last = static_cast<index_t>(coefficient_.size());
-    p.gap0 = p.normal.dot(reference);
+    // friction holds a vertex where it was anchored while it is in force; else (and after a slide) it is
+    // anchored afresh where the vertex is now
+    if (!anchor.held || anchor.slid || anchor.triangle < 0 || p.multiplier <= 0) {
+      if (!anchor.slid || p.multiplier <= 0) anchor.tau.setZero();
+      anchor.triangle = nearest;
+      anchor.beta = beta;
+      anchor.held = p.multiplier > 0 && anchor.held;
+      anchor.slid = false;
+    }
+    anchor.tau -= anchor.tau.dot(p.normal) * p.normal;  // in the tangent plane of this pairing
+    p.slip_first = static_cast<index_t>(coefficient_.size());
+    p.slip0 = append_difference(v, anchor.triangle, anchor.beta);
+    p.slip_last = static_cast<index_t>(coefficient_.size());
     pairs_.push_back(p);
   }
-  pressing_.assign(pairs_.size(), 0);
   (void)model;
 }
 
+Vec3 BodyContact::append_difference(index_t v, index_t triangle, const std::array<double, 3>& beta) {
+  const auto own_end =
+      static_cast<std::ptrdiff_t>(coefficient_.size()) + static_cast<std::ptrdiff_t>(map_.points.row_size(v));
+  for (index_t e = map_.points.begin(v); e < map_.points.end(v); ++e)
+    coefficient_.emplace_back(map_.points.index[e], map_.weight[e]);
+  Vec3 reference = mesh_.V.col(v);
+  const auto& f = mesh_.F[static_cast<std::size_t>(triangle)];
+  for (std::size_t b = 0; b < 3; ++b) {
+    reference -= beta[b] * mesh_.V.col(f[b]);
+    for (index_t e = map_.points.begin(f[b]); e < map_.points.end(f[b]); ++e) {
+      const index_t j = map_.points.index[e];
+      const double c = -beta[b] * map_.weight[e];
+      // the triangle's corners share points: one coefficient each
+      const auto same = std::find_if(coefficient_.begin() + own_end, coefficient_.end(),
+                                     [&](const auto& jc) { return jc.first == j; });
+      if (same != coefficient_.end()) same->second += c;
+      else coefficient_.emplace_back(j, c);
+    }
+  }
+  return reference;
+}
+
+Vec3 BodyContact::gather(index_t first, index_t last, const Points& y) const {
+  Vec3 sum = Vec3::Zero();
+  for (index_t e = first; e < last; ++e) {
+    const auto& [j, c] = coefficient_[static_cast<std::size_t>(e)];
+    sum += c * y.col(j);
+  }
+  return sum;
+}
+
+void BodyContact::spread(index_t first, index_t last, const Vec3& along, Points& f) const {
+  for (index_t e = first; e < last; ++e) {
+    const auto& [j, c] = coefficient_[static_cast<std::size_t>(e)];
+    f.col(j) += c * along;
+  }
+}
+
 double BodyContact::gap(const Pair& p, const Points& u) const {
-  Vec3 moved = Vec3::Zero();
-  for (index_t e = p.first; e < p.last; ++e)
-    moved += coefficient_[static_cast<std::size_t>(e)].second * u.col(coefficient_[static_cast<std::size_t>(e)].first);
-  return p.gap0 + p.normal.dot(moved);
+  return p.gap0 + p.normal.dot(gather(p.first, p.last, u));
+}
+
+Vec3 BodyContact::slip(const Pair& p, const Points& u) const {
+  const Vec3 d = p.slip0 + gather(p.slip_first, p.slip_last, u);
+  return d - d.dot(p.normal) * p.normal;
+}
+
+Vec3 BodyContact::trial(const Pair& p, const Vec3& s) const {
+  return anchors_[static_cast<std::size_t>(p.vertex)].tau + tangential_stiffness(p) * s;
+}
+
+Vec3 BodyContact::friction_force(const Pair& p, const Vec3& s) const {
+  const Vec3 t = trial(p, s);
+  const double c = cone(p), norm = t.norm();
+  return norm > c ? Vec3(c / norm * t) : t;
 }
 
 double BodyContact::energy(const Model& model, const Points& u) {
@@ -173,6 +234,12 @@ double BodyContact::energy(const Model& model, const Points& u) {
   for (const Pair& p : pairs_) {
     const double f = pressing(p, gap(p, u));
     e += (f * f - p.multiplier * p.multiplier) / (2 * p.stiffness);
+    // friction: quadratic in the trial force inside the cone, linear beyond it
+    const double c = cone(p);
+    if (c <= 0) continue;
+    const double k = tangential_stiffness(p), t = trial(p, slip(p, u)).norm();
+    e += ((t <= c ? t * t : 2 * c * t - c * c) - anchors_[static_cast<std::size_t>(p.vertex)].tau.squaredNorm()) /
+         (2 * k);
   }
   return e;
 }
@@ -181,75 +248,116 @@ void BodyContact::add_forces(const Model& model, const Points& u, Points& f) {
   if (!refreshed_) refresh(model, u);
   for (const Pair& p : pairs_) {
     const double force = pressing(p, gap(p, u));
-    if (force <= 0) continue;
-    const Vec3 along = force * p.normal;
-    for (index_t e = p.first; e < p.last; ++e)
-      f.col(coefficient_[static_cast<std::size_t>(e)].first) +=
-          coefficient_[static_cast<std::size_t>(e)].second * along;
+    if (force > 0) spread(p.first, p.last, force * p.normal, f);
+    // the friction's force on the vertex is minus its trial force (clamped), against the slip
+    if (cone(p) > 0) spread(p.slip_first, p.slip_last, -friction_force(p, slip(p, u)), f);
   }
 }
 
 void BodyContact::linearise(const Model& model, const Points& u, TangentMode) {
   if (!refreshed_) refresh(model, u);
-  for (std::size_t k = 0; k < pairs_.size(); ++k)
-    pressing_[k] = pairs_[k].multiplier - pairs_[k].stiffness * gap(pairs_[k], u) > 0;
+  for (Pair& p : pairs_) {
+    p.pressing = p.multiplier - p.stiffness * gap(p, u) > 0;
+    p.friction_hessian.setZero();
+    const double c = cone(p);
+    if (c <= 0) continue;
+    const Mat3 tangent_plane = Mat3::Identity() - p.normal * p.normal.transpose();
+    const double k = tangential_stiffness(p);
+    const Vec3 t = trial(p, slip(p, u));
+    const double norm = t.norm();
+    // inside the cone k P; beyond it the clamped force's derivative, (c k / |t|) P (I - t^ t^T) P
+    p.friction_hessian = norm <= c ? Mat3(k * tangent_plane)
+                                   : Mat3(c * k / norm * tangent_plane *
+                                          (Mat3::Identity() - t * t.transpose() / (norm * norm)) * tangent_plane);
+  }
 }
 
 void BodyContact::add_tangent_product(const Points& dx, Points& out) const {
-  for (std::size_t k = 0; k < pairs_.size(); ++k) {
-    if (!pressing_[k]) continue;
-    const Pair& p = pairs_[k];
-    Vec3 moved = Vec3::Zero();
-    for (index_t e = p.first; e < p.last; ++e)
-      moved +=
-          coefficient_[static_cast<std::size_t>(e)].second * dx.col(coefficient_[static_cast<std::size_t>(e)].first);
-    const Vec3 h = p.stiffness * p.normal.dot(moved) * p.normal;
-    for (index_t e = p.first; e < p.last; ++e)
-      out.col(coefficient_[static_cast<std::size_t>(e)].first) += coefficient_[static_cast<std::size_t>(e)].second * h;
+  for (const Pair& p : pairs_) {
+    if (p.pressing) spread(p.first, p.last, p.stiffness * p.normal.dot(gather(p.first, p.last, dx)) * p.normal, out);
+    if (cone(p) > 0) spread(p.slip_first, p.slip_last, p.friction_hessian * gather(p.slip_first, p.slip_last, dx), out);
   }
 }
 
 void BodyContact::add_diagonal_blocks(Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks) const {
-  for (std::size_t k = 0; k < pairs_.size(); ++k) {
-    if (!pressing_[k]) continue;
-    const Pair& p = pairs_[k];
-    const Mat3 nn = p.stiffness * p.normal * p.normal.transpose();
-    for (index_t e = p.first; e < p.last; ++e) {
+  const auto add = [&](index_t first, index_t last, const Mat3& block) {
+    for (index_t e = first; e < last; ++e) {
       const auto& [j, c] = coefficient_[static_cast<std::size_t>(e)];
-      Eigen::Map<Mat3>(blocks.col(j).data()) += c * c * nn;
+      Eigen::Map<Mat3>(blocks.col(j).data()) += c * c * block;
     }
+  };
+  for (const Pair& p : pairs_) {
+    if (p.pressing) add(p.first, p.last, p.stiffness * p.normal * p.normal.transpose());
+    if (cone(p) > 0) add(p.slip_first, p.slip_last, p.friction_hessian);
   }
 }
 
 bool BodyContact::add_to_matrix(TangentMatrix& K) const {
-  for (std::size_t k = 0; k < pairs_.size(); ++k) {
-    if (!pressing_[k]) continue;
-    const Pair& p = pairs_[k];
-    const Mat3 nn = p.stiffness * p.normal * p.normal.transpose();
-    for (index_t e = p.first; e < p.last; ++e)
-      for (index_t f = e; f < p.last; ++f) {
+  const auto add = [&](index_t first, index_t last, const Mat3& block) {
+    for (index_t e = first; e < last; ++e)
+      for (index_t f = e; f < last; ++f) {
         const auto& [i, ci] = coefficient_[static_cast<std::size_t>(e)];
         const auto& [j, cj] = coefficient_[static_cast<std::size_t>(f)];
-        add_coupling(K, i, j, ci * cj, nn);
+        add_coupling(K, i, j, ci * cj, block);
       }
+  };
+  for (const Pair& p : pairs_) {
+    if (p.pressing) add(p.first, p.last, p.stiffness * p.normal * p.normal.transpose());
+    if (cone(p) > 0) add(p.slip_first, p.slip_last, p.friction_hessian);
   }
   return true;
 }
 
+bool BodyContact::update_friction(const Points& u) {
+  bool met = true;
+  for (const Pair& p : pairs_) {
+    Anchor& a = anchors_[static_cast<std::size_t>(p.vertex)];
+    const double c = cone(p);
+    if (c <= 0) {
+      a.held = false;
+      continue;
+    }
+    const Vec3 s = slip(p, u), t = trial(p, s);
+    if (t.norm() <= c) {
+      met = met && a.held && s.norm() <= tolerance_;  // sticking: done on its anchor
+      a.tau = t;
+    } else {
+      const Vec3 on_cone = c / t.norm() * t;  // sliding: done when its force stopped changing
+      met = met && a.held && (on_cone - a.tau).norm() <= tangential_stiffness(p) * tolerance_;
+      a.tau = on_cone;
+      a.slid = true;
+    }
+    a.held = true;
+  }
+  return met;
+}
+
 bool BodyContact::update_multipliers(const Model& model, const Points& u) {
-  // pair again where the bodies are now (keeping the multipliers), then check
-  refresh(model, u);
-  double deepest = 0;
-  for (const Pair& p : pairs_) deepest = std::max(deepest, -gap(p, u));
-  if (deepest <= tolerance_) return true;
+  // met when no vertex is deeper in another body than the tolerance and friction's stick and slide are met, with
+  // the pairs the solve had and with those at u (a vertex that came near another body during it is paired now);
+  // else the multipliers and anchors are updated at u and the vertices paired again where the bodies are now
+  if (!refreshed_) refresh(model, u);
+  const auto deepest = [&] {
+    double d = 0;
+    for (const Pair& p : pairs_) d = std::max(d, -gap(p, u));
+    return d;
+  };
+  const bool friction_met = update_friction(u);
+  if (deepest() <= tolerance_ && friction_met) {
+    refresh(model, u);
+    if (deepest() <= tolerance_) return true;
+  }
   for (Pair& p : pairs_) p.multiplier = pressing(p, gap(p, u));
+  refresh(model, u);
   return false;
 }
 
 void BodyContact::add(const Model& model, const State& state, Points& f) { add_forces(model, state.u, f); }
 
 void BodyContact::after_step(const Model& model, const State& state, Workspace&) {
-  // Uzawa's update spread over the steps: each multiplier moves by a share of the way to its pair's force
+  // Uzawa's update spread over the steps: each multiplier moves by a share of the way to its pair's force, and
+  // the friction takes its trial force (on the cone)
+  update_friction(state.u);
   for (Pair& p : pairs_) p.multiplier += rate_ * (pressing(p, gap(p, state.u)) - p.multiplier);
   refresh(model, state.u);
 }
@@ -257,13 +365,21 @@ void BodyContact::after_step(const Model& model, const State& state, Workspace&)
 BodyLoads BodyContact::loads(const Model&, const Points& u) const {
   BodyLoads out;
   out.force.assign(vertex_start_.size() - 1, Vec3::Zero());
+  out.friction = out.force;
   for (const Pair& p : pairs_) {
     const double g = gap(p, u), force = pressing(p, g);
     out.penetration = std::max(out.penetration, -g);
-    if (force <= 0) continue;
-    ++out.contacts;
-    out.force[static_cast<std::size_t>(body_of_vertex(p.vertex))] += force * p.normal;
+    out.contacts += force > 0;
+    const Vec3 friction = cone(p) > 0 ? Vec3(-friction_force(p, slip(p, u))) : Vec3::Zero();
+    const Anchor& a = anchors_[static_cast<std::size_t>(p.vertex)];
+    const auto vertex_body = static_cast<std::size_t>(body_of_vertex(p.vertex));
+    // the friction's reaction is on the anchor's body (the normal force's on the paired triangle's)
+    const auto anchor_body = static_cast<std::size_t>(body_of_face(a.triangle >= 0 ? a.triangle : p.triangle));
+    out.force[vertex_body] += force * p.normal + friction;
     out.force[static_cast<std::size_t>(body_of_face(p.triangle))] -= force * p.normal;
+    out.force[anchor_body] -= friction;
+    out.friction[vertex_body] += friction;
+    out.friction[anchor_body] -= friction;
   }
   return out;
 }

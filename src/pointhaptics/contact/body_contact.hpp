@@ -12,6 +12,15 @@
 /// on A's), so neither body's mesh decides alone. The force on v is F_v n and the triangle's vertices carry
 /// -F_v beta_b n: equal and opposite, so the bodies' momentum is conserved exactly, and both reach the points
 /// by W^T.
+///
+/// Coulomb friction (Simo and Laursen's augmented Lagrangian, as a tool's): a pressing vertex is anchored to a
+/// point of the other body's surface (a triangle and barycentric coordinates, so the anchor moves with that
+/// body), its slip s_v = P_v (y_v - anchor) with P_v = I - n n^T, and
+///   E_t = sum_v (|tau_v + k_t s_v|^2 - |tau_v|^2) / (2 k_t)
+/// while the trial force t = tau_v + k_t s_v lies in the cone |t| <= mu lambda_v (stick), linear in |t| beyond
+/// it (slip: the force stays on the cone). Between minimisations tau_v takes the trial force (put on the cone,
+/// and a sliding vertex's anchor moves to where it is); a static solve is done when no sticking vertex strays
+/// from its anchor by more than the tolerance, and no sliding one's force changes by more than its worth.
 #include <pointhaptics/core/model.hpp>
 #include <pointhaptics/geometry/spatial_grid.hpp>
 #include <pointhaptics/geometry/triangle_mesh.hpp>
@@ -25,7 +34,7 @@
 namespace pointhaptics {
 
 struct BodyContactParams {
-  /// Penalty per unit of a vertex's area, N/m^3 (0: 1000 E / spacing, E the softer body's; as a tool's contact).
+  /// Penalty per unit of a vertex's area, N/m^3 (0: 1000 E / spacing, E the vertex's body's; as a tool's contact).
   double penalty = 0;
   /// Largest penetration at which the constraint counts as met, m (0: a thousandth of the finest spacing).
   double tolerance = 0;
@@ -38,13 +47,21 @@ struct BodyContactParams {
   /// spread over time), so that a body at rest on another sinks into it by the tolerance, not by its weight
   /// over the penalty.
   double multiplier_rate = 0.2;
+  /// Coulomb's coefficient between any two bodies, and per pair of bodies (row-major, bodies x bodies,
+  /// symmetric; empty: `friction` for all).
+  double friction = 0;
+  std::vector<double> pair_friction;
+  /// The friction's penalty over the normal one (as a tool's contact: the multipliers meet the stick whatever it
+  /// is, and a small one keeps the stick-slip kink out of Newton's way).
+  double tangential_share = 0.01;
 };
 
 /// What the contact does to each body, N (scene axes): the sum of the forces the others exert on it.
 struct BodyLoads {
-  std::vector<Vec3> force;  ///< per body
-  int contacts = 0;         ///< pressing vertices
-  double penetration = 0;   ///< deepest vertex inside another body, m (0: none)
+  std::vector<Vec3> force;     ///< per body
+  std::vector<Vec3> friction;  ///< per body: the part of `force` friction makes
+  int contacts = 0;            ///< pressing vertices
+  double penetration = 0;      ///< deepest vertex inside another body, m (0: none)
 };
 
 class BodyContact final : public DynamicForces, public EnergyTerm {
@@ -54,8 +71,8 @@ class BodyContact final : public DynamicForces, public EnergyTerm {
   BodyContact(const Model& model, TriangleMesh mesh, SurfaceMap map, std::vector<index_t> vertex_start,
               std::vector<index_t> face_start, const BodyContactParams& params = {});
 
-  /// Pair the vertices with the other bodies' nearest triangles at u (and keep the multipliers of the vertices
-  /// that stay paired).
+  /// Pair the vertices with the other bodies' nearest triangles at u (keeping the multipliers, and the anchors
+  /// of the vertices whose friction is in force).
   void refresh(const Model& model, const Points& u);
   /// The loads on the bodies at u, with the pairs and multipliers as they are.
   BodyLoads loads(const Model& model, const Points& u) const;
@@ -74,42 +91,72 @@ class BodyContact final : public DynamicForces, public EnergyTerm {
   void linearise(const Model& model, const Points& u, TangentMode mode) override;
   void add_tangent_product(const Points& dx, Points& out) const override;
   void add_diagonal_blocks(Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks) const override;
-  /// Each pressing pair's k (c c^T) (x) n n^T over its points, for the Cholesky preconditioner: the two bodies'
-  /// points are not neighbours, so the coupling across them is lumped on the diagonal (add_coupling()), a bound.
+  /// Each pressing pair's blocks over its points, for the Cholesky preconditioner: the two bodies' points are
+  /// not neighbours, so the coupling across them is lumped on the diagonal (add_coupling()), a bound.
   bool add_to_matrix(TangentMatrix& K) const override;
   bool update_multipliers(const Model& model, const Points& u) override;
 
  private:
-  /// A vertex paired with another body's triangle: g = gap0 + n . sum_j c_j u_j over its points j.
+  /// A vertex paired with another body's triangle: its gap g = gap0 + n . sum_j c_j u_j over its points j, and
+  /// its slip from its anchor s = P (slip0 + sum_j d_j u_j).
   struct Pair {
     index_t vertex = 0, triangle = 0;
     Vec3 normal = Vec3::Zero();
-    double gap0 = 0;              ///< the gap at u = 0 with this pairing, m
-    double stiffness = 0;         ///< k_v, N/m
-    double multiplier = 0;        ///< lambda_v, N
-    index_t first = 0, last = 0;  ///< its coefficients: coefficient_[first, last)
+    double gap0 = 0;                        ///< the gap at u = 0 with this pairing, m
+    double stiffness = 0;                   ///< k_v, N/m
+    double multiplier = 0;                  ///< lambda_v, N
+    double friction = 0;                    ///< mu between its two bodies
+    index_t first = 0, last = 0;            ///< its gap's coefficients c: coefficient_[first, last)
+    Vec3 slip0 = Vec3::Zero();              ///< the vertex less its anchor at u = 0, m
+    index_t slip_first = 0, slip_last = 0;  ///< its slip's coefficients d: coefficient_[slip_first, slip_last)
+    bool pressing = false;                  ///< at the last linearise()
+    Mat3 friction_hessian = Mat3::Zero();   ///< at the last linearise(), in the slip's space (P H P)
+  };
+  /// Where a vertex's friction holds it: a point of another body's triangle, and the friction's multiplier.
+  struct Anchor {
+    index_t triangle = -1;  ///< -1: none
+    std::array<double, 3> beta{0, 0, 0};
+    Vec3 tau = Vec3::Zero();  ///< N, in the tangent plane
+    bool held = false;        ///< friction was in force at the last update (else anchored afresh at a refresh)
+    bool slid = false;        ///< its last update slid it: anchored afresh at the next refresh, tau kept
   };
   double gap(const Pair& p, const Points& u) const;
+  Vec3 slip(const Pair& p, const Points& u) const;
   /// The pair's pressing force F = <lambda - k g> at gap g, N.
   static double pressing(const Pair& p, double g) { return std::max(0.0, p.multiplier - p.stiffness * g); }
+  double tangential_stiffness(const Pair& p) const { return tangential_share_ * p.stiffness; }
+  double cone(const Pair& p) const { return p.friction * p.multiplier; }
+  /// The trial force tau + k_t s at slip s, N.
+  Vec3 trial(const Pair& p, const Vec3& s) const;
+  /// The friction's force at slip s: the trial force put on the cone, N (on the vertex, against the slip).
+  Vec3 friction_force(const Pair& p, const Vec3& s) const;
+  /// f_j += x_j along for the coefficients [first, last); and sum_j x_j y_j
+  void spread(index_t first, index_t last, const Vec3& along, Points& f) const;
+  Vec3 gather(index_t first, index_t last, const Points& y) const;
+  /// Coulomb's update at u (the multipliers and anchors): true when the stick and the slide are met.
+  bool update_friction(const Points& u);
   index_t body_of_vertex(index_t v) const;
   index_t body_of_face(index_t t) const;
+  /// the coefficients of y_v - sum_b beta_b y_{t_b} over the points (appended to coefficient_), and its value at u = 0
+  Vec3 append_difference(index_t v, index_t triangle, const std::array<double, 3>& beta);
 
   TriangleMesh mesh_;
   SurfaceMap map_;
   std::vector<index_t> vertex_start_, face_start_;
   std::vector<double> vertex_stiffness_;  ///< k_v, N/m
   double tolerance_ = 0, reach_ = 0, rate_ = 0.2, max_point_stiffness_ = 0, max_circumradius_ = 0;
+  double tangential_share_ = 0.01;
+  std::vector<double> pair_friction_;  ///< bodies x bodies
   bool refreshed_ = false;
 
   std::vector<Pair> pairs_;
   std::vector<std::pair<index_t, double>> coefficient_;  ///< (point j, c_j) of every pair
+  std::vector<Anchor> anchors_;                          ///< per vertex
   // refresh's scratch
   Points y_, centroid_;
   Points vertex_normal_;
   SpatialGrid grid_;
   std::vector<double> previous_multiplier_;  ///< per vertex, across a refresh
-  std::vector<char> pressing_;               ///< per pair, at the last linearise()
 };
 
 }  // namespace pointhaptics
