@@ -217,3 +217,70 @@ TEST(Bodies, TheShippedLayersSceneOpensWithTwoBodiesInContact) {
 }
 
 }  // namespace
+namespace {
+
+// a block resting on another whose base is held, under gravity tilted by atan(0.2): a static solve by contact
+// alone converges when the friction between them (0.5) can hold it, friction carrying the sideways weight, and
+// finds no equilibrium when it cannot (0.1: the block slides off)
+TEST(Bodies, FrictionHoldsABlockOnATiltedBlockInAStaticSolveOrLetsItSlide) {
+  const auto scene = [](double friction) {
+    return fmt::format(R"(
+[material]
+young = 1e5
+poisson = 0.3
+density = 1000.0
+[[object]]
+name = "lower"
+size = [0.04, 0.02, 0.04]
+spacing = 0.005
+[[object]]
+name = "upper"
+origin = [0.01, 0.02, 0.01]
+size = [0.02, 0.02, 0.02]
+spacing = 0.005
+[[fixed]]
+object = "lower"
+box = {{ min = [-1.0, -1.0, -1.0], max = [1.0, 0.0, 1.0] }}
+[contact]
+friction = 0.1
+pairs = [{{ bodies = ["lower", "upper"], friction = {} }}]
+[solver]
+kind = "static"
+[[load]]
+kind = "gravity"
+g = [1.962, -9.81, 0.0]
+)",
+                       friction);
+  };
+  const double mass = 0.02 * 0.02 * 0.02 * 1000.0;
+  SceneSession held = open_scene(parse_scene(scene(0.5), "scene.toml"), two_threads());
+  held.simulation->run(0);
+  const RunSummary summary = held.simulation->summary();
+  ASSERT_TRUE(summary.converged) << summary.failure;
+  const BodyLoads loads = held.simulation->body_contact()->loads(held.simulation->model(), held.simulation->state().u);
+  EXPECT_NEAR(loads.friction[1].x(), -mass * 1.962, 0.005 * mass * 1.962) << "friction carries the sideways weight";
+  EXPECT_NEAR(body(summary, "upper").contact_force.y(), mass * 9.81, 0.005 * mass * 9.81);
+  EXPECT_LT(body(summary, "upper").mean_displacement.x(), 0.02 * spacing) << "held where it rests (the bodies sheared)";
+  EXPECT_LT(summary.body_contact.penetration, 0.01 * spacing);
+
+  SceneSession slides = open_scene(parse_scene(scene(0.1), "scene.toml"), two_threads());
+  EXPECT_EQ(slides.simulation->step().status, StepStatus::FAILED);
+  EXPECT_FALSE(slides.simulation->summary().converged);
+}
+
+TEST(Bodies, ContactTablesAreReadAndTheirMistakesNamed) {
+  const auto fails = [](const std::string& text, const std::string& expected) {
+    const std::string message = error_of(text, false);
+    EXPECT_NE(message.find(expected), std::string::npos) << message;
+  };
+  fails(
+      two_blocks(0.0, "kind = \"static\"", "[contact]\npairs = [{ bodies = [\"lower\", \"middle\"], friction = 0.2 }]"),
+      "contact.pairs[0].bodies: no [[object]] is named \"middle\"");
+  fails(two_blocks(0.0, "kind = \"static\"", "[contact]\nfriction = -0.2"), "contact.friction: -0.2 is out of range");
+  fails(two_blocks(0.0, "kind = \"static\"", "[contact]\npairs = [{ bodies = [\"lower\"], friction = 0.2 }]"),
+        "contact.pairs[0].bodies: expected bodies = [\"NAME\", \"NAME\"]");
+  fails("[object]\nsize = [0.01, 0.01, 0.01]\n[contact]\nfriction = 0.3",
+        "contact: [contact] is between several [[object]] tables");
+}
+
+}  // namespace

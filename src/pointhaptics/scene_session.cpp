@@ -74,7 +74,21 @@ SceneSession open_scene(Scene scene, const SessionOptions& options) {
     return object_surface;
   };
   // several bodies touch on their surfaces (each carried by its own points)
-  if (s.simulation->model().n_bodies() > 1) s.simulation->add_body_contact(*surface_of_object());
+  if (s.simulation->model().n_bodies() > 1) {
+    BodyContactParams contact;
+    const std::size_t n = scene.bodies.size();
+    contact.pair_friction.assign(n * n, scene.contact.friction);
+    const auto index_of = [&](const std::string& name) {
+      std::size_t k = 0;
+      while (scene.bodies[k].name != name) ++k;  // the reader checked the names
+      return k;
+    };
+    for (const ContactSpec::Pair& p : scene.contact.pairs) {
+      const std::size_t a = index_of(p.bodies[0]), b = index_of(p.bodies[1]);
+      contact.pair_friction[a * n + b] = contact.pair_friction[b * n + a] = p.friction;
+    }
+    s.simulation->add_body_contact(*surface_of_object(), contact);
+  }
   for (std::size_t k = 0; k < scene.obstacles.size(); ++k) {
     const ObstacleSpec& o = scene.obstacles[k];
     // static rigid bodies the object's surface presses on

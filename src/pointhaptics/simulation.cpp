@@ -223,6 +223,7 @@ void Simulation::add_body_contact(const ObjectSurface& surface, const BodyContac
   BodyContactParams contact = params;
   if (sim.solver().kind == SolverKind::EXPLICIT && contact.max_point_stiffness <= 0)
     contact.max_point_stiffness = sim.model().material.young * sim.model().spacing;
+  contact.update_after_step = sim.solver().kind != SolverKind::STATIC;
   sim.body_contact() = std::make_unique<BodyContact>(sim.model(), surface.mesh, surface.map, surface.body_vertex_start,
                                                      surface.body_face_start, contact);
 }

@@ -124,7 +124,7 @@ TEST(BodyContact, WithFrictionTooStickingAndSliding) {
   BodyContact contact(t.model, t.surface.mesh, t.surface.map, t.surface.body_vertex_start, t.surface.body_face_start,
                       params);
   const Points u = pressed(t.model);
-  contact.refresh(t.model, Points::Zero(3, t.model.n_points));
+  contact.refresh(t.model, u);
   EXPECT_FALSE(contact.update_multipliers(t.model, u));  // the multipliers take the pressure, friction anchors
   std::vector<double> held_back;
   for (const double shear : {1e-7, 5e-3, 1e-2}) {  // the cone is about mu lambda / k_t = 1.6 mm of slip away

@@ -44,6 +44,7 @@ BodyContact::BodyContact(const Model& model, TriangleMesh mesh, SurfaceMap map, 
       (!params.pair_friction.empty() && params.pair_friction.size() != bodies * bodies))
     throw Error("body contact: friction must be >= 0, one per pair of bodies, and the tangential share in (0, 1]");
   tangential_share_ = params.tangential_share;
+  update_after_step_ = params.update_after_step;
   pair_friction_ =
       params.pair_friction.empty() ? std::vector<double>(bodies * bodies, params.friction) : params.pair_friction;
   anchors_.assign(static_cast<std::size_t>(nv), Anchor{});
@@ -116,14 +117,17 @@ void BodyContact::refresh(const Model& model, const Points& u) {
     double best = std::numeric_limits<double>::infinity();
     index_t nearest = -1;
     Vec3 nearest_normal = Vec3::Zero();
+    double nearest_distance = 0;
     std::array<double, 3> beta{0, 0, 0};
     grid_.for_each_within(centroid_, y, reach_ + max_circumradius_, [&](index_t t) {
       if (body_of_face(t) == body) return;
       const auto& f = mesh_.F[static_cast<std::size_t>(t)];
       const Vec3 a = y_.col(f[0]), b = y_.col(f[1]), c = y_.col(f[2]);
       const Vec3 normal = (b - a).cross(c - a).normalized();
-      // surfaces that face each other only (not the far side of a thin body, nor a side face met edge on)
-      if (!(normal.dot(vertex_normal) < 0)) return;
+      // surfaces that face each other only, within 60 degrees: not the far side of a thin body, nor a side face
+      // met edge on (a base's vertex beside a block standing on it, paired with the block's side, held the block
+      // from sliding as the side's plane came to it)
+      if (!(normal.dot(vertex_normal) < -0.5 * vertex_normal.norm())) return;
       // the face covers the vertex: its projection on the face's plane lies in the triangle (a hundredth of it
       // beyond, where two triangles meet). Not the face's plane beyond the body's edge: a vertex beside a body's
       // base is below that plane but outside the body
@@ -134,6 +138,7 @@ void BodyContact::refresh(const Model& model, const Points& u) {
         best = std::abs(distance);
         nearest = t;
         nearest_normal = normal;
+        nearest_distance = distance;
         beta = coordinates;
       }
     });
@@ -153,14 +158,17 @@ void BodyContact::refresh(const Model& model, const Points& u) {
     p.first = static_cast<index_t>(coefficient_.size());
     p.gap0 = p.normal.dot(append_difference(v, nearest, beta));
     p.last = static_cast<index_t>(coefficient_.size());
-    // friction holds a vertex where it was anchored while it is in force; else (and after a slide) it is
-    // anchored afresh where the vertex is now
-    if (!anchor.held || anchor.slid || anchor.triangle < 0 || p.multiplier <= 0) {
-      if (!anchor.slid || p.multiplier <= 0) anchor.tau.setZero();
+    // friction holds a vertex where it was anchored while it is in force; a vertex paired afresh sticks where it
+    // touches, and one that slid or began to press is anchored where it is now (a slide keeps its force)
+    const bool new_pair = anchor.triangle < 0;
+    if (new_pair || anchor.afresh) {
+      if (new_pair) {
+        anchor.state = nearest_distance <= tolerance_ ? Friction::FRESH : Friction::FREE;
+        anchor.tau.setZero();
+      }
       anchor.triangle = nearest;
       anchor.beta = beta;
-      anchor.held = p.multiplier > 0 && anchor.held;
-      anchor.slid = false;
+      anchor.afresh = false;
     }
     anchor.tau -= anchor.tau.dot(p.normal) * p.normal;  // in the tangent plane of this pairing
     p.slip_first = static_cast<index_t>(coefficient_.size());
@@ -308,28 +316,49 @@ bool BodyContact::add_to_matrix(TangentMatrix& K) const {
   return true;
 }
 
-bool BodyContact::update_friction(const Points& u) {
-  bool met = true;
+bool BodyContact::friction_met(const Points& u) const {
   for (const Pair& p : pairs_) {
-    Anchor& a = anchors_[static_cast<std::size_t>(p.vertex)];
-    const double c = cone(p);
-    if (c <= 0) {
-      a.held = false;
+    if (p.friction <= 0) continue;
+    const Anchor& a = anchors_[static_cast<std::size_t>(p.vertex)];
+    const bool presses = pressing(p, gap(p, u)) > 0;
+    if (a.state != Friction::HELD) {
+      if (presses) return false;  // its friction is to be put in force
       continue;
     }
+    const double c = cone(p);
     const Vec3 s = slip(p, u), t = trial(p, s);
+    // a sticking vertex is done on its anchor, a sliding one when its force stopped changing
+    if (t.norm() <= c ? s.norm() > tolerance_
+                      : (c / t.norm() * t - a.tau).norm() > tangential_stiffness(p) * tolerance_)
+      return false;
+  }
+  return true;
+}
+
+void BodyContact::update_friction(const Points& u) {
+  for (const Pair& p : pairs_) {
+    if (p.friction <= 0) continue;
+    Anchor& a = anchors_[static_cast<std::size_t>(p.vertex)];
+    if (!(pressing(p, gap(p, u)) > 0)) {  // no friction without pressure
+      a.state = Friction::FREE;
+      a.tau.setZero();
+      continue;
+    }
+    if (a.state == Friction::FREE) {  // pressing now: anchored where it is at the next refresh
+      a.state = Friction::HELD;
+      a.afresh = true;
+      continue;
+    }
+    const double c = cone(p);
+    const Vec3 t = trial(p, slip(p, u));
     if (t.norm() <= c) {
-      met = met && a.held && s.norm() <= tolerance_;  // sticking: done on its anchor
       a.tau = t;
     } else {
-      const Vec3 on_cone = c / t.norm() * t;  // sliding: done when its force stopped changing
-      met = met && a.held && (on_cone - a.tau).norm() <= tangential_stiffness(p) * tolerance_;
-      a.tau = on_cone;
-      a.slid = true;
+      a.tau = c / t.norm() * t;  // on the cone; the anchor moves to where the vertex is at the next refresh
+      a.afresh = true;
     }
-    a.held = true;
+    a.state = Friction::HELD;
   }
-  return met;
 }
 
 bool BodyContact::update_multipliers(const Model& model, const Points& u) {
@@ -342,11 +371,20 @@ bool BodyContact::update_multipliers(const Model& model, const Points& u) {
     for (const Pair& p : pairs_) d = std::max(d, -gap(p, u));
     return d;
   };
-  const bool friction_met = update_friction(u);
-  if (deepest() <= tolerance_ && friction_met) {
+  if (deepest() <= tolerance_ && friction_met(u)) {
+    // met with the pairs the solve had; also with those at u, or minimised again with them (a pairing made far
+    // from the minimiser is a linearisation of another geometry)
+    const BodyLoads before = loads(model, u);
     refresh(model, u);
-    if (deepest() <= tolerance_) return true;
+    const BodyLoads after = loads(model, u);
+    double change = 0, scale = 0;
+    for (std::size_t k = 0; k < before.force.size(); ++k) {
+      change = std::max(change, (after.force[k] - before.force[k]).norm());
+      scale = std::max(scale, before.force[k].norm());
+    }
+    return deepest() <= tolerance_ && change <= 1e-3 * scale;
   }
+  update_friction(u);
   for (Pair& p : pairs_) p.multiplier = pressing(p, gap(p, u));
   refresh(model, u);
   return false;
@@ -355,6 +393,7 @@ bool BodyContact::update_multipliers(const Model& model, const Points& u) {
 void BodyContact::add(const Model& model, const State& state, Points& f) { add_forces(model, state.u, f); }
 
 void BodyContact::after_step(const Model& model, const State& state, Workspace&) {
+  if (!update_after_step_) return;
   // Uzawa's update spread over the steps: each multiplier moves by a share of the way to its pair's force, and
   // the friction takes its trial force (on the cone)
   update_friction(state.u);

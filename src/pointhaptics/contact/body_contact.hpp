@@ -29,6 +29,8 @@
 #include <pointhaptics/solvers/solver.hpp>
 
 #include <array>
+#include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace pointhaptics {
@@ -47,6 +49,9 @@ struct BodyContactParams {
   /// spread over time), so that a body at rest on another sinks into it by the tolerance, not by its weight
   /// over the penalty.
   double multiplier_rate = 0.2;
+  /// Dynamics: the multipliers and the pairs are updated after each step. A static solve's equilibrium is met
+  /// by its own updates (update_multipliers()), and one after it would move what it converged to.
+  bool update_after_step = true;
   /// Coulomb's coefficient between any two bodies, and per pair of bodies (row-major, bodies x bodies,
   /// symmetric; empty: `friction` for all).
   double friction = 0;
@@ -112,20 +117,32 @@ class BodyContact final : public DynamicForces, public EnergyTerm {
     bool pressing = false;                  ///< at the last linearise()
     Mat3 friction_hessian = Mat3::Zero();   ///< at the last linearise(), in the slip's space (P H P)
   };
+  /// A vertex's friction: FRESH just paired while touching (it sticks until the first update: a static solve's
+  /// first minimisation holds a body resting on another by these springs, where without them it could slide off
+  /// under any sideways load), HELD in force (the cone mu lambda), FREE not pressing (none).
+  enum class Friction : std::uint8_t { FREE, FRESH, HELD };
   /// Where a vertex's friction holds it: a point of another body's triangle, and the friction's multiplier.
   struct Anchor {
     index_t triangle = -1;  ///< -1: none
     std::array<double, 3> beta{0, 0, 0};
     Vec3 tau = Vec3::Zero();  ///< N, in the tangent plane
-    bool held = false;        ///< friction was in force at the last update (else anchored afresh at a refresh)
-    bool slid = false;        ///< its last update slid it: anchored afresh at the next refresh, tau kept
+    Friction state = Friction::FREE;
+    bool afresh = false;  ///< anchored afresh where the vertex is at the next refresh (a slide, a new pressure)
   };
   double gap(const Pair& p, const Points& u) const;
   Vec3 slip(const Pair& p, const Points& u) const;
   /// The pair's pressing force F = <lambda - k g> at gap g, N.
   static double pressing(const Pair& p, double g) { return std::max(0.0, p.multiplier - p.stiffness * g); }
   double tangential_stiffness(const Pair& p) const { return tangential_share_ * p.stiffness; }
-  double cone(const Pair& p) const { return p.friction * p.multiplier; }
+  /// The friction cone's radius, N: mu lambda in force, unbounded while FRESH (a stick), 0 when FREE.
+  double cone(const Pair& p) const {
+    if (p.friction <= 0) return 0;
+    switch (anchors_[static_cast<std::size_t>(p.vertex)].state) {
+      case Friction::HELD: return p.friction * p.multiplier;
+      case Friction::FRESH: return std::numeric_limits<double>::infinity();
+      default: return 0;
+    }
+  }
   /// The trial force tau + k_t s at slip s, N.
   Vec3 trial(const Pair& p, const Vec3& s) const;
   /// The friction's force at slip s: the trial force put on the cone, N (on the vertex, against the slip).
@@ -133,8 +150,9 @@ class BodyContact final : public DynamicForces, public EnergyTerm {
   /// f_j += x_j along for the coefficients [first, last); and sum_j x_j y_j
   void spread(index_t first, index_t last, const Vec3& along, Points& f) const;
   Vec3 gather(index_t first, index_t last, const Points& y) const;
-  /// Coulomb's update at u (the multipliers and anchors): true when the stick and the slide are met.
-  bool update_friction(const Points& u);
+  /// Whether the stick and the slide are met at u; Coulomb's update at u (the multipliers and anchors).
+  bool friction_met(const Points& u) const;
+  void update_friction(const Points& u);
   index_t body_of_vertex(index_t v) const;
   index_t body_of_face(index_t t) const;
   /// the coefficients of y_v - sum_b beta_b y_{t_b} over the points (appended to coefficient_), and its value at u = 0
@@ -146,6 +164,7 @@ class BodyContact final : public DynamicForces, public EnergyTerm {
   std::vector<double> vertex_stiffness_;  ///< k_v, N/m
   double tolerance_ = 0, reach_ = 0, rate_ = 0.2, max_point_stiffness_ = 0, max_circumradius_ = 0;
   double tangential_share_ = 0.01;
+  bool update_after_step_ = true;
   std::vector<double> pair_friction_;  ///< bodies x bodies
   bool refreshed_ = false;
 

@@ -211,6 +211,17 @@ struct BodySpec {
   MaterialParams material;
 };
 
+/// [contact]: the contact between the bodies of several [[object]] tables (issue 47).
+struct ContactSpec {
+  double friction = 0;  ///< Coulomb's coefficient between any two bodies
+  struct Pair {
+    std::array<std::string, 2> bodies;
+    double friction = 0;
+  };
+  std::vector<Pair> pairs;  ///< per pair of bodies, over `friction`
+  int line = 0;
+};
+
 struct Scene {
   std::string path;  ///< the scene file ("<string>" when parsed from text), for messages
   /// With [[object]] tables, every body (`object` and `material` are then the first's); empty with one [object].
@@ -224,6 +235,7 @@ struct Scene {
   std::vector<LoadSpec> loads;
   std::vector<CutSpec> cuts;
   std::vector<ObstacleSpec> obstacles;
+  ContactSpec contact;
   SolverSpec solver;
   ProbeSpec probe;
   DeviceSpec device;

@@ -508,6 +508,32 @@ BodySpec read_body(TableReader& r, const MaterialParams& scene_material, const C
   return b;
 }
 
+// [contact]: friction = mu between any two bodies, and pairs = [{ bodies = ["a", "b"], friction = mu }, ...]
+void read_contact(TableReader& r, ContactSpec& c) {
+  c.line = r.line();
+  c.friction = r.number("friction", c.friction, non_negative_up_to(10), "must lie in [0, 10]");
+  const toml::node* node = r.find("pairs");
+  if (!node) return;
+  const toml::array* pairs = node->as_array();
+  const char* form = "expected [{ bodies = [\"NAME\", \"NAME\"], friction = mu }, ...]";
+  if (!pairs) r.fail_at(*node, "pairs", form);
+  for (std::size_t k = 0; k < pairs->size(); ++k) {
+    const toml::table* t = pairs->get(k)->as_table();
+    if (!t) r.fail_at(*pairs->get(k), "pairs", form);
+    TableReader p(r.context(), *t, fmt::format("{}[{}]", r.name("pairs"), k));
+    ContactSpec::Pair pair;
+    const toml::node* names = p.find("bodies");
+    const toml::array* two = names ? names->as_array() : nullptr;
+    if (!two || two->size() != 2 || !two->get(0)->as_string() || !two->get(1)->as_string())
+      p.fail_table("bodies", "expected bodies = [\"NAME\", \"NAME\"] (two [[object]] names)");
+    pair.bodies = {two->get(0)->as_string()->get(), two->get(1)->as_string()->get()};
+    if (!t->get("friction")) p.fail_table("friction", "missing (Coulomb's coefficient between the two bodies)");
+    pair.friction = p.number("friction", 0.0, non_negative_up_to(10), "must lie in [0, 10]");
+    p.finish();
+    c.pairs.push_back(pair);
+  }
+}
+
 FixedSpec read_fixed(TableReader& r) {
   FixedSpec f;
   f.line = r.line();
@@ -835,7 +861,19 @@ void check_body_names(const Scene& scene) {
     check(scene.fixed[k].object, "fixed", k, scene.fixed[k].line, false);
   for (std::size_t k = 0; k < scene.loads.size(); ++k)
     check(scene.loads[k].object, "load", k, scene.loads[k].line, scene.loads[k].kind == LoadKind::GRAVITY);
-  if (scene.bodies.size() < 2) return;
+  for (std::size_t k = 0; k < scene.contact.pairs.size(); ++k)
+    for (const std::string& name : scene.contact.pairs[k].bodies)
+      if (!known(name))
+        throw Error(fmt::format("{}:{}: contact.pairs[{}].bodies: no [[object]] is named \"{}\"", scene.path,
+                                scene.contact.line, k, name));
+  if (scene.bodies.size() < 2) {
+    if (scene.contact.line > 0)
+      throw Error(
+          fmt::format("{}:{}: contact: [contact] is between several [[object]] tables (this scene has one "
+                      "object; a tool's friction is [probe] friction, an obstacle's its own)",
+                      scene.path, scene.contact.line));
+    return;
+  }
   // not yet: each carries one object's points (a level of detail's active set, a refinement's sampling, a cut's
   // surface, a region's material)
   const auto refuse = [&](bool present, int line, std::string_view key, std::string_view why) {
@@ -919,6 +957,7 @@ Scene parse_scene(std::string_view text, const std::string& name, const std::str
   section("probe", [&](TableReader& r) { read_probe(r, scene.probe, ctx); });
   section("device", [&](TableReader& r) { read_device(r, scene.device, ctx); });
   section("lod", [&](TableReader& r) { read_lod(r, scene.lod); });
+  section("contact", [&](TableReader& r) { read_contact(r, scene.contact); });
   if (scene.probe.present && !scene.probe.held() && scene.device.kind == "virtual" && scene.probe.trajectory.empty() &&
       scene.probe.keyframes.empty())
     throw Error(fmt::format(
