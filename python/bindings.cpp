@@ -33,9 +33,9 @@ namespace {
 using RowPoints = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
 // A read-only (n, 3) view of a 3 x n column-major Points buffer owned by `owner`.
-py::array view(const ph::Points& P, py::handle owner) {
-  py::array a(py::dtype::of<double>(), {P.cols(), Eigen::Index{3}},
-              {Eigen::Index{3 * sizeof(double)}, Eigen::Index{sizeof(double)}}, P.data(), owner);
+py::array view(const ph::Points& P, py::handle owner, Eigen::Index first = 0, Eigen::Index count = -1) {
+  py::array a(py::dtype::of<double>(), {count < 0 ? P.cols() - first : count, Eigen::Index{3}},
+              {Eigen::Index{3 * sizeof(double)}, Eigen::Index{sizeof(double)}}, P.col(first).data(), owner);
   py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
   return a;
 }
@@ -624,6 +624,36 @@ names the problem.)doc")
           },
           "The scene's [[obstacle]] bodies by name, each a dict as the result JSON's obstacles block: kind, force (what "
           "the object exerts on it now, N), contacts, penetration (m), friction (N)")
+      .def_property_readonly(
+          "bodies",
+          [](py::object self) {
+            PySimulation& p = self.cast<PySimulation&>();
+            const auto lock = locked(p);
+            const ph::Model& m = p.sim->model();
+            const ph::RunSummary summary = p.sim->summary();
+            const auto vec = [](const ph::Vec3& v) { return std::array<double, 3>{v.x(), v.y(), v.z()}; };
+            py::dict d;
+            for (std::size_t k = 0; k < summary.bodies.size(); ++k) {
+              const ph::BodySummary& b = summary.bodies[k];
+              const Eigen::Index first = m.body_start[k];
+              py::dict block;
+              block["first_point"] = first;
+              block["points"] = b.points;
+              block["mass"] = b.mass;
+              block["contact_force"] = vec(b.contact_force);
+              block["mean_displacement"] = vec(b.mean_displacement);
+              block["max_displacement"] = b.max_displacement;
+              block["reference"] = view(m.X, self, first, b.points);
+              block["displacement"] = view(p.sim->state().u, self, first, b.points);
+              block["velocity"] = view(p.sim->state().velocity, self, first, b.points);
+              d[py::str(b.name)] = block;
+            }
+            return d;
+          },
+          "With several [[object]] tables, each body by name, a dict: first_point and points (its rows in the "
+          "object's arrays), mass (kg), contact_force (what the other bodies exert on it now, N), mean_displacement "
+          "(its centre of mass's, m), max_displacement (m), and its rows of reference, displacement and velocity as "
+          "read-only (points, 3) views. Empty with one object.")
       .def(
           "summary",
           [](PySimulation& p) {
