@@ -265,7 +265,10 @@ void BodyContact::add_forces(const Model& model, const Points& u, Points& f) {
 void BodyContact::linearise(const Model& model, const Points& u, TangentMode) {
   if (!refreshed_) refresh(model, u);
   for (Pair& p : pairs_) {
-    p.pressing = p.multiplier - p.stiffness * gap(p, u) > 0;
+    // at the kink too (a vertex touching with no multiplier yet): the tangent's pressing side there, so that a
+    // body resting exactly on another has its weight's stiffness from the first iteration (with only the side
+    // that has none, its fall is singular and conjugate gradients ran out in the ASan build)
+    p.pressing = p.multiplier - p.stiffness * gap(p, u) >= 0;
     p.friction_hessian.setZero();
     const double c = cone(p);
     if (c <= 0) continue;
