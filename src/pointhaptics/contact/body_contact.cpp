@@ -3,8 +3,6 @@
 #include <pointhaptics/core/error.hpp>
 #include <pointhaptics/mechanics/tangent_matrix.hpp>
 
-#include <fmt/format.h>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -78,13 +76,17 @@ BodyContact::BodyContact(const Model& model, TriangleMesh mesh, SurfaceMap map, 
   grid_ = SpatialGrid(2 * reach_);
 }
 
-index_t BodyContact::body_of_vertex(index_t v) const {
-  return static_cast<index_t>(std::upper_bound(vertex_start_.begin(), vertex_start_.end(), v) - vertex_start_.begin()) -
-         1;
+namespace {
+
+// the range k with starts[k] <= i < starts[k + 1]
+index_t range_of(const std::vector<index_t>& starts, index_t i) {
+  return static_cast<index_t>(std::upper_bound(starts.begin(), starts.end(), i) - starts.begin()) - 1;
 }
-index_t BodyContact::body_of_face(index_t t) const {
-  return static_cast<index_t>(std::upper_bound(face_start_.begin(), face_start_.end(), t) - face_start_.begin()) - 1;
-}
+
+}  // namespace
+
+index_t BodyContact::body_of_vertex(index_t v) const { return range_of(vertex_start_, v); }
+index_t BodyContact::body_of_face(index_t t) const { return range_of(face_start_, t); }
 
 void BodyContact::refresh(const Model& model, const Points& u) {
   refreshed_ = true;
@@ -283,39 +285,38 @@ void BodyContact::linearise(const Model& model, const Points& u, TangentMode) {
   }
 }
 
-void BodyContact::add_tangent_product(const Points& dx, Points& out) const {
+template <class Visit>
+void BodyContact::for_each_block(const Visit& visit) const {
   for (const Pair& p : pairs_) {
-    if (p.pressing) spread(p.first, p.last, p.stiffness * p.normal.dot(gather(p.first, p.last, dx)) * p.normal, out);
-    if (cone(p) > 0) spread(p.slip_first, p.slip_last, p.friction_hessian * gather(p.slip_first, p.slip_last, dx), out);
+    if (p.pressing) visit(p.first, p.last, Mat3(p.stiffness * p.normal * p.normal.transpose()));
+    if (cone(p) > 0) visit(p.slip_first, p.slip_last, p.friction_hessian);
   }
 }
 
+void BodyContact::add_tangent_product(const Points& dx, Points& out) const {
+  for_each_block([&](index_t first, index_t last, const Mat3& block) {
+    spread(first, last, block * gather(first, last, dx), out);
+  });
+}
+
 void BodyContact::add_diagonal_blocks(Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks) const {
-  const auto add = [&](index_t first, index_t last, const Mat3& block) {
+  for_each_block([&](index_t first, index_t last, const Mat3& block) {
     for (index_t e = first; e < last; ++e) {
       const auto& [j, c] = coefficient_[static_cast<std::size_t>(e)];
       Eigen::Map<Mat3>(blocks.col(j).data()) += c * c * block;
     }
-  };
-  for (const Pair& p : pairs_) {
-    if (p.pressing) add(p.first, p.last, p.stiffness * p.normal * p.normal.transpose());
-    if (cone(p) > 0) add(p.slip_first, p.slip_last, p.friction_hessian);
-  }
+  });
 }
 
 bool BodyContact::add_to_matrix(TangentMatrix& K) const {
-  const auto add = [&](index_t first, index_t last, const Mat3& block) {
+  for_each_block([&](index_t first, index_t last, const Mat3& block) {
     for (index_t e = first; e < last; ++e)
       for (index_t f = e; f < last; ++f) {
         const auto& [i, ci] = coefficient_[static_cast<std::size_t>(e)];
         const auto& [j, cj] = coefficient_[static_cast<std::size_t>(f)];
         add_coupling(K, i, j, ci * cj, block);
       }
-  };
-  for (const Pair& p : pairs_) {
-    if (p.pressing) add(p.first, p.last, p.stiffness * p.normal * p.normal.transpose());
-    if (cone(p) > 0) add(p.slip_first, p.slip_last, p.friction_hessian);
-  }
+  });
   return true;
 }
 

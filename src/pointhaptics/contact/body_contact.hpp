@@ -147,6 +147,10 @@ class BodyContact final : public DynamicForces, public EnergyTerm {
   Vec3 trial(const Pair& p, const Vec3& s) const;
   /// The friction's force at slip s: the trial force put on the cone, N (on the vertex, against the slip).
   Vec3 friction_force(const Pair& p, const Vec3& s) const;
+  /// visit(first, last, H) for each block of the tangent fixed by the last linearise(): a pressing pair's k n n^T
+  /// over its gap's coefficients, a pair in friction's P H P over its slip's; the tangent is sum c c^T (x) H
+  template <class Visit>
+  void for_each_block(const Visit& visit) const;
   /// f_j += x_j along for the coefficients [first, last); and sum_j x_j y_j
   void spread(index_t first, index_t last, const Vec3& along, Points& f) const;
   Vec3 gather(index_t first, index_t last, const Points& y) const;
