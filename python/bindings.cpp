@@ -30,6 +30,24 @@ namespace ph = pointhaptics;
 
 namespace {
 
+// tools or obstacles by name, as the result JSON writes them
+py::dict named_loads(const std::vector<std::pair<std::string, ph::ToolSummary>>& loads) {
+  const auto vec = [](const ph::Vec3& v) { return std::array<double, 3>{v.x(), v.y(), v.z()}; };
+  py::dict d;
+  for (const auto& [name, o] : loads) {
+    py::dict block;
+    block["kind"] = o.kind;
+    block["position"] = vec(o.position);
+    block["force"] = vec(o.force);
+    block["torque"] = vec(o.torque);
+    block["contacts"] = o.contacts;
+    block["penetration"] = o.penetration;
+    block["friction"] = vec(o.friction);
+    d[py::str(name)] = block;
+  }
+  return d;
+}
+
 using RowPoints = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
 // A read-only (n, 3) view of a 3 x n column-major Points buffer owned by `owner`.
@@ -609,21 +627,21 @@ names the problem.)doc")
           "obstacles",
           [](PySimulation& p) {
             const auto lock = locked(p);
-            const ph::RunSummary summary = p.sim->summary();
-            py::dict d;
-            for (const auto& [name, o] : summary.obstacles) {
-              py::dict block;
-              block["kind"] = o.kind;
-              block["force"] = std::array<double, 3>{o.force.x(), o.force.y(), o.force.z()};
-              block["contacts"] = o.contacts;
-              block["penetration"] = o.penetration;
-              block["friction"] = std::array<double, 3>{o.friction.x(), o.friction.y(), o.friction.z()};
-              d[py::str(name)] = block;
-            }
-            return d;
+            return named_loads(p.sim->summary().obstacles);
           },
-          "The scene's [[obstacle]] bodies by name, each a dict as the result JSON's obstacles block: kind, force (what "
-          "the object exerts on it now, N), contacts, penetration (m), friction (N)")
+          "The scene's [[obstacle]] bodies by name, each a dict as the result JSON's obstacles block: kind, position, "
+          "force (what the object exerts on it now, N), torque, contacts, penetration (m), friction (N)")
+      .def_property_readonly(
+          "tools",
+          [](PySimulation& p) {
+            const auto lock = locked(p);
+            ph::RunSummary summary = p.sim->summary();
+            if (summary.tool.present) summary.tools.insert(summary.tools.begin(), {summary.tool_name, summary.tool});
+            return named_loads(summary.tools);
+          },
+          "The scene's tools by name ([[tool]] tables; a [probe] as \"probe\"), each a dict as the result JSON's tools "
+          "block: kind, position (m), force (what the object exerts on it now, N), torque (N m), contacts, "
+          "penetration (m), friction (N)")
       .def_property_readonly(
           "bodies",
           [](py::object self) {

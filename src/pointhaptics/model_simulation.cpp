@@ -217,21 +217,27 @@ const StepReport& ModelSimulation::step() {
 
 DynamicForces* ModelSimulation::forces_this_step() {
   DynamicForces* tool = probe_ ? static_cast<DynamicForces*>(&probe_->tool) : held_tool_.get();
-  if (obstacles_.empty() && !body_contact_) return tool;
+  if (posed_bodies_.empty() && !body_contact_) return tool;
   forces_.clear();
   if (tool) forces_.add_member(tool);
-  for (Obstacle& o : obstacles_) forces_.add_member(&o.contact);
+  for (PosedBody& o : posed_bodies_) forces_.add_member(&o.contact);
   if (body_contact_) forces_.add_member(body_contact_.get());
   return &forces_;
 }
 
 void ModelSimulation::place_tools() {
-  // keyframed obstacles where they are at the step's end (the time the implicit and static solves are at)
-  for (Obstacle& o : obstacles_) {
+  // keyframed obstacles and tools where they are at the step's end (the time the implicit and static solves are at)
+  for (PosedBody& o : posed_bodies_) {
     if (o.path.keyframes().empty()) continue;
     ToolPose pose = o.start;
     pose.position += o.path.position(state_.time + (solver_.kind == SolverKind::STATIC ? 0.0 : solver_.dt));
     o.contact.set_pose(pose);
+  }
+  // a static solve starts with what presses already stuck (SurfaceContact::anchor_pressing): a body held by
+  // tools' friction alone has no equilibrium in a first minimisation without it
+  if (solver_.kind == SolverKind::STATIC) {
+    for (PosedBody& o : posed_bodies_) o.contact.contact().anchor_pressing(state_.u);
+    if (held_tool_) held_tool_->contact().anchor_pressing(state_.u);
   }
   if (!probe_) return;
   ProbeTool& tool = probe_->tool;

@@ -90,10 +90,13 @@ SurfaceContact probe_surface_contact(const ObjectSurface& surface, const Surface
 SurfaceContact probe_surface_contact(ActiveSurface part, const SurfaceContactParams& params, const ToolShape& shape,
                                      const Model& model, const ActiveSet& active);
 
-/// A static rigid body the object rests on or is pressed against (a table, a bone): a held tool that never
-/// moves, named for its reported force.
-struct Obstacle {
+/// A rigid body the scene poses: an obstacle the bodies rest on or are pressed against (a table, a bone, a
+/// keyframed plate), or a tool held at a position or moved along keyframes ([[tool]]). Either is a held tool
+/// that no device moves, named for its reported force.
+struct PosedBody {
+  enum class Role { OBSTACLE, TOOL };
   std::string name;
+  Role role = Role::OBSTACLE;
   HeldTool contact;
   /// Keyframed: its translation over time from `start` (empty keyframes: static)
   Trajectory path;
@@ -149,9 +152,9 @@ class ModelSimulation {
   /// A tool held at a pose the program sets (a static indentation); at most one of it and the probe.
   std::unique_ptr<HeldTool>& held_tool() { return held_tool_; }
   const HeldTool* held_tool() const { return held_tool_.get(); }
-  /// The obstacles, pressed on by the object beside its tool.
-  std::vector<Obstacle>& obstacles() { return obstacles_; }
-  const std::vector<Obstacle>& obstacles() const { return obstacles_; }
+  /// The obstacles and posed tools, pressed on by the bodies beside the probe or held tool.
+  std::vector<PosedBody>& posed_bodies() { return posed_bodies_; }
+  const std::vector<PosedBody>& posed_bodies() const { return posed_bodies_; }
   /// Contact between the model's bodies (several [[object]] tables); nullptr with one body.
   std::unique_ptr<BodyContact>& body_contact() { return body_contact_; }
 
@@ -164,12 +167,12 @@ class ModelSimulation {
   void count_inverted_neighbourhoods();
   void record(const StepReport& report, double seconds);
 
-  /// what acts on the model beside its material this step: the probe or held tool, the obstacles and the
+  /// what acts on the model beside its material this step: the probe or held tool, the posed bodies and the
   /// contact between the bodies
   /// (rebuilt each step from them; no allocation once it has held them all)
   DynamicForces* forces_this_step();
   ForceSet forces_;
-  std::vector<Obstacle> obstacles_;
+  std::vector<PosedBody> posed_bodies_;
   std::unique_ptr<BodyContact> body_contact_;
   Model model_;
   SolverSpec solver_;

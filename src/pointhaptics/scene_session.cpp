@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <chrono>
 #include <memory>
+#include <tuple>
 #include <utility>
 
 namespace pointhaptics {
@@ -55,6 +56,21 @@ std::pair<ToolShape, ToolPose> obstacle_shape(const ObstacleSpec& o, double spac
     }
   }
   return {shape, pose};
+}
+
+// a held or posed tool's shape, pose (at its position; NaN without one) and contact, from its [probe] or [[tool]]
+// keys
+std::tuple<ToolShape, ToolPose, SurfaceContactParams> held_tool_shape(const ProbeSpec& p) {
+  ToolShape shape;
+  shape.kind = p.capsule ? ToolKind::CAPSULE : ToolKind::SPHERE;
+  shape.radius = p.radius;
+  shape.length = p.length;
+  const auto& q = p.orientation;
+  SurfaceContactParams contact;
+  contact.friction = p.friction;
+  contact.non_negative_weights = p.non_negative_surface_map;
+  contact.sample_spacing = p.sample_spacing;
+  return {shape, ToolPose{p.position, Eigen::Quaterniond(q[0], q[1], q[2], q[3])}, contact};
 }
 
 }  // namespace
@@ -110,20 +126,30 @@ SceneSession open_scene(Scene scene, const SessionOptions& options) {
       throw Error(fmt::format("{}:{}: obstacle[{}]: {}", scene.path, o.line, k, e.what()));
     }
   }
+  for (std::size_t k = 0; k < scene.tools.size(); ++k) {
+    // tools the scene poses: held at a position, or moved along keyframes (where they are, scene axes)
+    const ToolSpec& t = scene.tools[k];
+    const ObjectSurface& surface = *surface_of_object();
+    const auto [shape, pose, contact] = held_tool_shape(t.probe);
+    std::vector<Keyframe> frames;
+    for (const auto& f : t.path) frames.push_back({f[0], Vec3(f[1], f[2], f[3]), false});
+    ToolPose start = pose;
+    if (!frames.empty()) start.position.setZero();
+    try {
+      s.simulation->add_posed_tool(t.name, shape, start, surface.mesh, surface.map, contact,
+                                   frames.empty() ? Trajectory() : Trajectory(std::move(frames)));
+    } catch (const Interrupted&) {
+      throw;
+    } catch (const Error& e) {
+      throw Error(fmt::format("{}:{}: tool[{}]: {}", scene.path, t.line, k, e.what()));
+    }
+  }
+  if (!scene.probe_name.empty()) s.simulation->set_tool_name(scene.probe_name);
   if (scene.probe.held()) {
     // a tool held at a position, touching the object's surface
     const ObjectSurface& surface = *surface_of_object();
-    ToolShape shape;
-    shape.kind = scene.probe.capsule ? ToolKind::CAPSULE : ToolKind::SPHERE;
-    shape.radius = scene.probe.radius;
-    shape.length = scene.probe.length;
-    const auto& q = scene.probe.orientation;
-    SurfaceContactParams contact;
-    contact.friction = scene.probe.friction;
-    contact.non_negative_weights = scene.probe.non_negative_surface_map;
-    contact.sample_spacing = scene.probe.sample_spacing;
-    s.simulation->hold_tool(shape, ToolPose{scene.probe.position, Eigen::Quaterniond(q[0], q[1], q[2], q[3])},
-                            surface.mesh, surface.map, contact);
+    const auto [shape, pose, contact] = held_tool_shape(scene.probe);
+    s.simulation->hold_tool(shape, pose, surface.mesh, surface.map, contact);
   } else if (scene.probe.present) {
     s.interactive = scene_interactive_options(scene, s.simulation->model());
     // the probe pushes on the object's surface (with levels of detail, on the part the active set carries)

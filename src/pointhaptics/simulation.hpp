@@ -86,6 +86,13 @@ class Simulation {
   /// over time, applied at each step's end (empty: static).
   void add_obstacle(std::string name, const ToolShape& shape, const ToolPose& pose, const TriangleMesh& mesh,
                     SurfaceMap map, const SurfaceContactParams& params = {}, const Trajectory& path = {});
+  /// A tool the scene poses ([[tool]] with a position or keyframes), by name: as an obstacle, except that it may
+  /// start pressed into the object (an indentation) and its force is in summary().tools. `path`: where it is
+  /// over time, added to `pose` (empty: held at `pose`). Any number of them, beside a probe or held tool.
+  void add_posed_tool(std::string name, const ToolShape& shape, const ToolPose& pose, const TriangleMesh& mesh,
+                      SurfaceMap map, const SurfaceContactParams& params = {}, const Trajectory& path = {});
+  /// The name the probe or held tool is reported under (summary().tool_name): its [[tool]]'s; "probe" by default.
+  void set_tool_name(std::string name) { tool_name_ = std::move(name); }
   /// Contact between the model's bodies (Model::body_start) on their surfaces (`surface`, with its bodies'
   /// vertices and triangles): contact/body_contact.hpp. Explicit steps lower its penalty to E x spacing per point,
   /// as a held tool's. Throws Error with one body, with levels of detail, or when it is already on.
@@ -136,11 +143,15 @@ class Simulation {
   RunSummary summary();
 
  private:
+  void add_posed_body(PosedBody::Role role, std::string name, const ToolShape& shape, const ToolPose& pose,
+                      const TriangleMesh& mesh, SurfaceMap map, const SurfaceContactParams& params,
+                      const Trajectory& path);
   ModelSimulation& core() { return lod_ ? lod_->active() : *object_; }
   const ModelSimulation& core() const { return lod_ ? lod_->active() : *object_; }
 
   std::unique_ptr<ModelSimulation> object_;  ///< without levels of detail
   std::unique_ptr<LevelsOfDetail> lod_;      ///< with them (then object_ is empty)
+  std::string tool_name_ = "probe";
   struct ScriptedCut {
     CutSpec spec;
     double done = 0;  ///< the share of its sweep already cut

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <unordered_map>
 
 namespace pointhaptics {
@@ -177,7 +178,25 @@ double SurfaceContact::tangential_penalty(index_t v) const {
   return tangential_share_ * penalty_[static_cast<std::size_t>(v)];
 }
 
-double SurfaceContact::friction_cone(index_t v) const { return friction_ * lambda_[static_cast<std::size_t>(v)]; }
+double SurfaceContact::friction_cone(index_t v) const {
+  if (anchors_[static_cast<std::size_t>(v)].fresh) return std::numeric_limits<double>::infinity();
+  return friction_ * lambda_[static_cast<std::size_t>(v)];
+}
+
+void SurfaceContact::anchor_pressing(const Points& u) {
+  if (anchors_.empty()) return;
+  evaluate(u);
+  for (index_t v = 0; v < y_.cols(); ++v) {
+    Anchor& a = anchors_[static_cast<std::size_t>(v)];
+    if (a.held) continue;
+    const ToolDistance d = tool_distance(shape_, pose_, y_.col(v));
+    if (!(d.penetration > 0)) continue;
+    a.local = pose_.orientation.conjugate() * (y_.col(v) - pose_.position);
+    a.tangent = Mat3::Identity() - d.normal * d.normal.transpose();
+    a.tau.setZero();
+    a.held = a.fresh = true;
+  }
+}
 
 Mat3 SurfaceContact::friction_hessian(index_t v) const {
   const Anchor& a = anchors_[static_cast<std::size_t>(v)];
@@ -316,6 +335,7 @@ bool SurfaceContact::update_multipliers(const Model& model, const Points& u) {
             !(tool_distance(shape_, pose_, y_.col(v)).penetration > 0);
       continue;
     }
+    met = met && !a.fresh;  // a fresh anchor's force is not yet on its cone
     const double k = tangential_penalty(v);
     const Vec3 t = friction_trial(v), clamped = friction_force(v);
     // a sticking vertex is done on its anchor, a sliding one when its force stopped changing; and the cones,
@@ -359,6 +379,7 @@ void SurfaceContact::advance_anchor(index_t v, const ToolDistance& d) {
     a.held = true;
   }
   // the trial force on the new tangent plane, put on the new cone if beyond it (the anchor then follows)
+  a.fresh = false;
   const Vec3 t = tangent * friction_trial(v);
   const double cone = friction_ * lambda;
   a.tau = t.norm() > cone ? Vec3(cone / t.norm() * t) : t;

@@ -130,6 +130,11 @@ class SurfaceContact final : public EnergyTerm {
   Vec3 tool_response(const Points& x) const;
   /// Uzawa's update at u: true (multipliers kept) when no vertex is deeper in the tool than the tolerance.
   bool update_multipliers(const Model& model, const Points& u) override;
+  /// With friction: anchor every vertex pressing into the tool at u that has no anchor yet, sticking without a
+  /// bound until the next update_multipliers() (which puts it on its cone). A static solve's first minimisation,
+  /// before any multiplier, then holds a body that only this tool's friction holds (two tools pinching it under
+  /// gravity), where a cone of friction x 0 would let it fall without end (the body contact's fresh pairs alike).
+  void anchor_pressing(const Points& u);
 
   /// The load on the tool at u (its multipliers and penalty as they are); same_u: u is the last evaluation's,
   /// whose carried surface is reused (the probe's placement tries several positions on one state).
@@ -198,6 +203,7 @@ class SurfaceContact final : public EnergyTerm {
     Mat3 tangent = Mat3::Zero();
     Vec3 tau = Vec3::Zero();
     bool held = false;
+    bool fresh = false;  ///< anchor_pressing()'s, before its first update: its cone has no bound
   };
   /// The friction's trial force on the tool from an anchored vertex v at y_: tau + k s.
   Vec3 friction_trial(index_t v) const;

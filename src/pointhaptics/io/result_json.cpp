@@ -83,18 +83,23 @@ std::string result_json(const Model& model, const State& state, const RunSummary
                      {"hold_stray_max_n", m.hold_max_n},
                      {"held_object_stray_mean_n", m.held_object_mean_n},
                      {"held_object_stray_max_n", m.held_object_max_n}}}};
-  if (s.tool.present) {
-    const ToolSummary& t = s.tool;
-    doc["tool"] = {{"kind", t.kind},
-                   {"position", vec(t.position)},
-                   {"force", vec(t.force)},
-                   {"torque", vec(t.torque)},
-                   {"contacts", t.contacts},
-                   {"penetration", t.penetration},
-                   {"friction", vec(t.friction)}};
+  const auto tool_block = [&](const ToolSummary& t) {
+    return json{{"kind", t.kind},
+                {"position", vec(t.position)},
+                {"force", vec(t.force)},
+                {"torque", vec(t.torque)},
+                {"contacts", t.contacts},
+                {"penetration", t.penetration},
+                {"friction", vec(t.friction)}};
+  };
+  if (s.tool.present) doc["tool"] = tool_block(s.tool);
+  if (s.tool.present || !s.tools.empty()) {
+    json& tools = doc["tools"] = json::object();
+    if (s.tool.present) tools[s.tool_name] = tool_block(s.tool);
+    for (const auto& [name, t] : s.tools) tools[name] = tool_block(t);
   }
   if (!s.obstacles.empty()) {
-    nlohmann::json& obstacles = doc["obstacles"] = nlohmann::json::object();
+    json& obstacles = doc["obstacles"] = json::object();
     for (const auto& [name, o] : s.obstacles)
       obstacles[name] = {{"kind", o.kind},
                          {"force", vec(o.force)},

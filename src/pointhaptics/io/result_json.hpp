@@ -118,6 +118,10 @@ struct RunSummary {
   ToolSummary tool;
   /// The obstacles by name: what the object does to each (`kind` its shape, `position` its pose's origin).
   std::vector<std::pair<std::string, ToolSummary>> obstacles;
+  /// The posed tools ([[tool]] with a position or keyframes) by name, as `tool`. The JSON's `tools` has them and
+  /// the probe or held tool (`tool`) under tool_name.
+  std::vector<std::pair<std::string, ToolSummary>> tools;
+  std::string tool_name = "probe";
   /// With several bodies, each one's block, in the model's order (empty with one body).
   std::vector<BodySummary> bodies;
   BodyContactSummary body_contact;

@@ -165,6 +165,26 @@ struct DeviceSpec {
   bool passivity_control = true;     ///< ForceRules::passivity_control
 };
 
+/// [[tool]] (issue 47): a named tool. Held at a `position`, or moved along `keyframes` by the scene (both in scene
+/// axes: a posed tool), or driven by the [[device]] it names (then it takes every [probe] key, its keyframes being
+/// the virtual device's script as [probe]'s are).
+struct ToolSpec {
+  std::string name;
+  ProbeSpec probe;  ///< its shape and contact's settings, and a held tool's position, as [probe]'s
+  /// A posed tool moved by the scene: keyframes (t, x, y, z), where it is (scene axes, m), linear in between and
+  /// held after the last (empty: held at probe.position, or driven by a device)
+  std::vector<std::array<double, 4>> path;
+  std::string device;  ///< the [[device]] that drives it (empty: posed by the scene)
+  int line = 0;
+};
+
+/// [[device]] (issue 47): a named device, with [device]'s keys, that a [[tool]] names.
+struct DeviceTable {
+  std::string name;
+  DeviceSpec spec;
+  int line = 0;
+};
+
 /// [lod]: levels of detail around the contact point (design.md, "Levels of detail").
 struct LodSpec {
   bool present = false;
@@ -235,9 +255,13 @@ struct Scene {
   std::vector<LoadSpec> loads;
   std::vector<CutSpec> cuts;
   std::vector<ObstacleSpec> obstacles;
+  /// [[tool]] tables: the posed ones (position or keyframes); one driven by a device is `probe` and `device`
+  std::vector<ToolSpec> tools;
+  std::vector<DeviceTable> devices;  ///< [[device]] tables
   ContactSpec contact;
   SolverSpec solver;
   ProbeSpec probe;
+  std::string probe_name;  ///< the [[tool]] the probe was given as (empty: [probe])
   DeviceSpec device;
   LodSpec lod;
 };

@@ -688,10 +688,34 @@ std::string resolve(const Context& ctx, const std::string& file) {
   return p.lexically_normal().string();
 }
 
+// a tool's shape and its contact's settings: [probe]'s and a [[tool]]'s keys radius, shape, length, orientation,
+// friction, surface_map and sample_spacing
+void read_tool_shape(TableReader& r, ProbeSpec& p) {
+  p.radius = r.number("radius", p.radius, positive_up_to(10), "must lie in (0, 10] (m)");
+  p.capsule = r.choice("shape", "sphere", {"sphere", "capsule"}) == "capsule";
+  p.length = r.number("length", p.length, non_negative_up_to(10), "must lie in [0, 10] (m)");
+  if (p.capsule && !(p.length > 0)) r.fail_table("length", "a capsule needs length > 0 (m): its axis segment");
+  if (!p.capsule && r.find("length"))
+    r.fail_at(*r.find("length"), "length", "only a capsule has a length (shape = \"capsule\")");
+  if (const toml::node* node = r.find("orientation")) {
+    const toml::array* a = node->as_array();
+    if (!a || a->size() != 4) r.fail_at(*node, "orientation", "expected a unit quaternion [w, x, y, z]");
+    double norm = 0;
+    for (std::size_t c = 0; c < 4; ++c) norm += std::pow(p.orientation[c] = r.as_number(*a->get(c), "orientation"), 2);
+    if (!(std::abs(std::sqrt(norm) - 1) < 1e-6))
+      r.fail_at(*node, "orientation", fmt::format("the quaternion's norm is {:.6g}, not 1", std::sqrt(norm)));
+  }
+  p.friction = r.number(
+      "friction", p.friction, [](double m) { return m >= 0 && m <= 10; }, "must be in [0, 10]");
+  p.non_negative_surface_map = r.choice("surface_map", "exact", {"exact", "non_negative"}) == "non_negative";
+  p.sample_spacing = r.number("sample_spacing", p.sample_spacing, positive_up_to(1),
+                              "must lie in (0, 1] (m: the contact's samples along the surface's edges)");
+}
+
 void read_probe(TableReader& r, ProbeSpec& p, const Context& ctx) {
   p.present = true;
   p.line = r.line();
-  p.radius = r.number("radius", p.radius, positive_up_to(10), "must lie in (0, 10] (m)");
+  read_tool_shape(r, p);
   const std::string mode = r.choice("mode", "push", {"push", "grab", "cut"});
   p.grab = mode == "grab";
   p.cut = mode == "cut";
@@ -719,20 +743,10 @@ void read_probe(TableReader& r, ProbeSpec& p, const Context& ctx) {
   if (r.find("origin")) p.origin = r.vec3("origin", p.origin);
   p.scale = r.number("scale", p.scale, positive_up_to(1e6), "must lie in (0, 1e6] (scene metres per device metre)");
   p.stiffness = r.number("stiffness", p.stiffness, non_negative_up_to(1e9), "must lie in [0, 1e9] (N/m)");
-  p.capsule = r.choice("shape", "sphere", {"sphere", "capsule"}) == "capsule";
-  p.length = r.number("length", p.length, non_negative_up_to(10), "must lie in [0, 10] (m)");
-  if (p.capsule && !(p.length > 0)) r.fail_table("length", "a capsule needs length > 0 (m): its axis segment");
-  if (!p.capsule && r.find("length"))
-    r.fail_at(*r.find("length"), "length", "only a capsule has a length (shape = \"capsule\")");
   if (p.cut && !p.capsule)
     r.fail_table("shape",
                  "a blade (mode = \"cut\") is a capsule whose axis is its edge: give shape = \"capsule\" and length");
-  p.friction = r.number(
-      "friction", p.friction, [](double m) { return m >= 0 && m <= 10; }, "must be in [0, 10]");
   p.object_stiffness = r.choice("local_stiffness", "contact", {"contact", "object"}) == "object";
-  p.non_negative_surface_map = r.choice("surface_map", "exact", {"exact", "non_negative"}) == "non_negative";
-  p.sample_spacing = r.number("sample_spacing", p.sample_spacing, positive_up_to(1),
-                              "must lie in (0, 1] (m: the contact's samples along the surface's edges)");
   if (r.find("position")) {
     p.position = r.vec3("position", p.position);
     if (r.find("trajectory") || r.find("keyframes"))
@@ -745,14 +759,6 @@ void read_probe(TableReader& r, ProbeSpec& p, const Context& ctx) {
     const Vec3 d = r.as_vec3(*node, "direction");
     if (!(d.norm() > 1e-12)) r.fail_at(*node, "direction", "must not be zero (the direction the tool presses in)");
     p.direction = d.normalized();
-  }
-  if (const toml::node* node = r.find("orientation")) {
-    const toml::array* a = node->as_array();
-    if (!a || a->size() != 4) r.fail_at(*node, "orientation", "expected a unit quaternion [w, x, y, z]");
-    double norm = 0;
-    for (std::size_t c = 0; c < 4; ++c) norm += std::pow(p.orientation[c] = r.as_number(*a->get(c), "orientation"), 2);
-    if (!(std::abs(std::sqrt(norm) - 1) < 1e-6))
-      r.fail_at(*node, "orientation", fmt::format("the quaternion's norm is {:.6g}, not 1", std::sqrt(norm)));
   }
 }
 
@@ -780,6 +786,66 @@ void read_device(TableReader& r, DeviceSpec& d, const Context& ctx) {
     if (!r.find("log")) r.fail_table("log", "a replay device needs log = \"session.csv\" (a recorded force log)");
     d.log = resolve(ctx, r.string("log", ""));
   }
+}
+
+// [[tool]]: name; driven by device = "NAME" (then every [probe] key), or posed: the shape's keys and position =
+// [x, y, z] or keyframes = [[t, x, y, z], ...] (scene axes)
+ToolSpec read_tool(TableReader& r, const Context& ctx) {
+  ToolSpec t;
+  t.line = r.line();
+  t.name = r.string("name", "");
+  if (t.name.empty()) r.fail_table("name", "a [[tool]] needs a name = \"...\" (its forces are reported by it)");
+  t.device = r.string("device", "");
+  if (!t.device.empty()) {
+    read_probe(r, t.probe, ctx);
+    return t;
+  }
+  t.probe.present = true;
+  t.probe.line = t.line;
+  read_tool_shape(r, t.probe);
+  for (const char* key : {"mode", "trajectory", "origin", "scale", "stiffness", "local_stiffness", "cut_resistance"})
+    if (const toml::node* node = r.find(key))
+      r.fail_at(*node, key,
+                "only a tool driven by a device has it (give device = \"NAME\" naming a [[device]]); a posed tool "
+                "pushes, held at position = [x, y, z] or moved along keyframes = [[t, x, y, z], ...]");
+  if ((r.find("position") != nullptr) == (r.find("keyframes") != nullptr))
+    r.fail_table("position",
+                 "a tool not driven by a device is held at position = [x, y, z] or moved along keyframes = [[t, x, "
+                 "y, z], ...] (scene axes, m): give one of them, or device = \"NAME\"");
+  if (r.find("position")) t.probe.position = r.vec3("position", t.probe.position);
+  if (const toml::node* node = r.find("direction")) {
+    if (!r.find("position"))
+      r.fail_at(*node, "direction", "only a tool held at a position (position = [x, y, z]) presses along a direction");
+    const Vec3 d = r.as_vec3(*node, "direction");
+    if (!(d.norm() > 1e-12)) r.fail_at(*node, "direction", "must not be zero (the direction the tool presses in)");
+    t.probe.direction = d.normalized();
+  }
+  if (const toml::node* node = r.find("keyframes")) {
+    const toml::array* rows = node->as_array();
+    if (!rows || rows->empty()) r.fail_at(*node, "keyframes", "expected keyframes = [[t, x, y, z], ...] (s, m)");
+    for (const toml::node& row : *rows) {
+      const toml::array* k = row.as_array();
+      if (!k || k->size() != 4) r.fail_at(row, "keyframes", "each keyframe is [t, x, y, z] (s; m, scene axes)");
+      std::array<double, 4> frame{};
+      for (std::size_t a = 0; a < 4; ++a) frame[a] = r.as_number(*k->get(a), "keyframes");
+      const double last_t = t.path.empty() ? -1.0 : t.path.back()[0];
+      if (!(frame[0] > last_t) || frame[0] < 0 || frame[0] > 1e6)
+        r.fail_at(row, "keyframes", "times must increase, from 0 s, and stay within 1e6 s");
+      if (!(std::max({std::abs(frame[1]), std::abs(frame[2]), std::abs(frame[3])}) <= 1e6))
+        r.fail_at(row, "keyframes", "a position must lie within 1e6 m");
+      t.path.push_back(frame);
+    }
+  }
+  return t;
+}
+
+DeviceTable read_device_table(TableReader& r, const Context& ctx) {
+  DeviceTable d;
+  d.line = r.line();
+  d.name = r.string("name", "");
+  if (d.name.empty()) r.fail_table("name", "a [[device]] needs a name = \"...\" (a [[tool]] names it)");
+  read_device(r, d.spec, ctx);
+  return d;
 }
 
 void read_lod(TableReader& r, LodSpec& l) {
@@ -834,6 +900,76 @@ void read_lod(TableReader& r, LodSpec& l) {
 
 // Each [[fixed]] and [[load]] names an [[object]] (optional with one, and for gravity, which loads every one), and
 // what does not yet work with several objects is refused by name
+// [[tool]] and [[device]] tables: unique names; each device drives one tool and each tool's device exists. A tool
+// driven by a device becomes the scene's probe and its device (one hand: a second is refused by name); the posed
+// ones stay in scene.tools.
+void bind_tools(Scene& scene, bool device_section) {
+  const auto fail = [&](int line, const std::string& what) {
+    throw Error(fmt::format("{}:{}: {}", scene.path, line, what));
+  };
+  for (std::size_t a = 0; a < scene.tools.size(); ++a)
+    for (std::size_t b = 0; b < a; ++b)
+      if (scene.tools[a].name == scene.tools[b].name)
+        fail(scene.tools[a].line,
+             fmt::format("tool[{}].name: \"{}\" is already the name of tool[{}] (names are unique)", a,
+                         scene.tools[a].name, b));
+  for (std::size_t a = 0; a < scene.devices.size(); ++a)
+    for (std::size_t b = 0; b < a; ++b)
+      if (scene.devices[a].name == scene.devices[b].name)
+        fail(scene.devices[a].line,
+             fmt::format("device[{}].name: \"{}\" is already the name of device[{}] (names are unique)", a,
+                         scene.devices[a].name, b));
+  std::vector<int> driven(scene.devices.size(), -1);  // the tool each device drives
+  int hands = 0;
+  for (std::size_t k = 0; k < scene.tools.size(); ++k) {
+    const ToolSpec& t = scene.tools[k];
+    if (t.device.empty()) continue;
+    const auto d = std::find_if(scene.devices.begin(), scene.devices.end(),
+                                [&](const DeviceTable& d) { return d.name == t.device; });
+    if (d == scene.devices.end()) {
+      std::string names;
+      for (const DeviceTable& e : scene.devices) names += (names.empty() ? "\"" : ", \"") + e.name + "\"";
+      fail(t.line, fmt::format("tool[{}].device: no [[device]] is named \"{}\"{}", k, t.device,
+                               names.empty() ? std::string(" (the scene has no [[device]] table)")
+                                             : fmt::format(" (the devices: {})", names)));
+    }
+    const auto slot = static_cast<std::size_t>(d - scene.devices.begin());
+    if (driven[slot] >= 0)
+      fail(t.line, fmt::format("tool[{}].device: \"{}\" already drives tool[{}] \"{}\" (one tool per device)", k,
+                               t.device, driven[slot], scene.tools[static_cast<std::size_t>(driven[slot])].name));
+    driven[slot] = static_cast<int>(k);
+    if (t.probe.held())
+      fail(t.line, fmt::format("tool[{}].position: a tool driven by a device is not held at a position (leave out "
+                               "position, or device)",
+                               k));
+    if (++hands > 1)
+      fail(t.line, fmt::format("tool[{}].device: a second tool driven by a device (two hands) is not supported yet: "
+                               "one tool follows a device, the others are posed (position or keyframes)",
+                               k));
+    if (scene.probe.present || device_section)
+      fail(t.line, fmt::format("tool[{}].device: the scene's [probe] / [device] already make its device-driven tool "
+                               "(give it either as [probe] and [device] or as [[tool]] and [[device]])",
+                               k));
+  }
+  for (std::size_t k = 0; k < scene.devices.size(); ++k)
+    if (driven[k] < 0)
+      fail(scene.devices[k].line,
+           fmt::format("device[{}]: \"{}\" drives no tool (a [[tool]] names it: device = \"{}\")", k,
+                       scene.devices[k].name, scene.devices[k].name));
+  // the device-driven tool is the scene's probe, its device the scene's device
+  for (std::size_t k = 0; k < scene.tools.size(); ++k) {
+    if (scene.tools[k].device.empty()) continue;
+    scene.probe = scene.tools[k].probe;
+    scene.device = scene
+                       .devices[static_cast<std::size_t>(std::find(driven.begin(), driven.end(), static_cast<int>(k)) -
+                                                         driven.begin())]
+                       .spec;
+    scene.probe_name = scene.tools[k].name;
+    scene.tools.erase(scene.tools.begin() + static_cast<std::ptrdiff_t>(k));
+    break;
+  }
+}
+
 void check_body_names(const Scene& scene) {
   const auto known = [&](const std::string& object) {
     return std::any_of(scene.bodies.begin(), scene.bodies.end(), [&](const BodySpec& b) { return b.name == object; });
@@ -955,7 +1091,13 @@ Scene parse_scene(std::string_view text, const std::string& name, const std::str
   section("kernel", [&](TableReader& r) { read_kernel(r, scene.kernel); });
   section("solver", [&](TableReader& r) { read_solver(r, scene.solver); });
   section("probe", [&](TableReader& r) { read_probe(r, scene.probe, ctx); });
-  section("device", [&](TableReader& r) { read_device(r, scene.device, ctx); });
+  const toml::node* device_node = root.get("device");
+  if (device_node && device_node->is_array_of_tables())
+    read_array_of_tables(top, "device", [&](TableReader& r) { scene.devices.push_back(read_device_table(r, ctx)); });
+  else section("device", [&](TableReader& r) { read_device(r, scene.device, ctx); });
+  read_array_of_tables(top, "tool", [&](TableReader& r) { scene.tools.push_back(read_tool(r, ctx)); });
+  const bool device_section = device_node && !device_node->is_array_of_tables();
+  bind_tools(scene, device_section);
   section("lod", [&](TableReader& r) { read_lod(r, scene.lod); });
   section("contact", [&](TableReader& r) { read_contact(r, scene.contact); });
   if (scene.probe.present && !scene.probe.held() && scene.device.kind == "virtual" && scene.probe.trajectory.empty() &&
@@ -969,10 +1111,10 @@ Scene parse_scene(std::string_view text, const std::string& name, const std::str
         fmt::format("{}:{}: probe.friction: a device's probe with levels of detail touches the point spheres, which "
                     "are frictionless",
                     name, scene.probe.line));
-  if (scene.probe.held() && root.get("device"))
+  if (scene.probe.held() && device_section)
     throw Error(
         fmt::format("{}:{}: probe: a tool held at a position is not driven by a [device]", name, scene.probe.line));
-  if (root.get("device") && !scene.probe.present)
+  if (device_section && !scene.probe.present)
     throw Error(fmt::format("{}: device: a [device] needs a [probe] to drive", name));
   if (scene.probe.present && !scene.probe.held() && scene.solver.kind == SolverKind::STATIC)
     throw Error(
@@ -991,6 +1133,9 @@ Scene parse_scene(std::string_view text, const std::string& name, const std::str
             fmt::format("{}:{}: obstacle[{}].name: \"{}\" is already the name of obstacle[{}] (names are "
                         "unique)",
                         name, scene.obstacles[a].line, a, scene.obstacles[a].name, b));
+  if (!scene.tools.empty() && scene.lod.present)
+    throw Error(fmt::format("{}:{}: tool: a [[tool]] not yet with levels of detail (use [probe])", name,
+                            scene.tools.front().line));
   if (!scene.obstacles.empty() && scene.lod.present)
     throw Error(
         fmt::format("{}:{}: obstacle: not yet with levels of detail (an active set carries only part of the "
