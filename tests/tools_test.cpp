@@ -1,0 +1,251 @@
+// Named tools (issue 47): [[tool]] tables held at a position or moved along keyframes (any number of them), one
+// driven by a named [[device]]; read with named errors. A posed tool indents as a held [probe] does; two tools
+// pinching a free block under gravity carry its weight by friction in a static solve, or let it slip when the
+// pinch is below the weight over 2 mu; two keyframed tools lift a block off a table in implicit dynamics.
+#include <pointhaptics/io/result_json.hpp>
+#include <pointhaptics/io/scene_toml.hpp>
+#include <pointhaptics/scene_session.hpp>
+#include <pointhaptics/simulation.hpp>
+
+#include <gtest/gtest.h>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <string>
+
+using namespace pointhaptics;
+
+namespace {
+
+constexpr double weight = 0.02 * 0.02 * 0.02 * 1000.0 * 9.81;  // the 2 cm sample's, N
+
+SessionOptions two_threads() {
+  SessionOptions options;
+  options.threads = 2;
+  return options;
+}
+
+const ToolSummary& tool(const RunSummary& s, const std::string& name) {
+  for (const auto& [n, t] : s.tools)
+    if (n == name) return t;
+  throw Error("no tool " + name);
+}
+
+std::string error_of(const std::string& text) {
+  try {
+    SceneSession s = open_scene(parse_scene(text, "scene.toml"), two_threads());
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+// a 2 x 2 x 2 cm sample from the origin (E = 50 kPa, 8 g) under gravity, and `more`
+std::string sample(const std::string& solver, const std::string& more) {
+  return fmt::format(R"(
+[object]
+shape = "box"
+size = [0.02, 0.02, 0.02]
+spacing = 0.0025
+[material]
+young = 5e4
+poisson = 0.3
+density = 1000.0
+damping = 0.05
+[solver]
+{}
+[[load]]
+kind = "gravity"
+{}
+)",
+                     solver, more);
+}
+
+// a jaw: a vertical capsule (axis along y) of 5 mm radius, its straight part longer than the sample is high,
+// pressing on the face x = 0 (side -1) or x = 0.02 (side +1) `depth` deep, or moved along `keyframes`
+std::string jaw(const std::string& name, double mu, const std::string& where, double length = 0.04) {
+  return fmt::format(R"(
+[[tool]]
+name = "{}"
+shape = "capsule"
+radius = 0.005
+length = {}
+orientation = [0.7071067811865476, -0.7071067811865476, 0.0, 0.0]
+friction = {}
+{}
+)",
+                     name, length, mu, where);
+}
+std::string pinch(double mu, double depth = 0.001) {
+  return jaw("left", mu, fmt::format("position = [{}, 0.01, 0.01]", -0.005 + depth)) +
+         jaw("right", mu, fmt::format("position = [{}, 0.01, 0.01]", 0.025 - depth));
+}
+
+TEST(Tools, TablesAreReadAndTheirMistakesNamed) {
+  const Scene scene = parse_scene(sample("kind = \"static\"", pinch(0.5) + R"(
+[[tool]]
+name = "finger"
+radius = 0.003
+keyframes = [[0.0, 0.01, 0.03, 0.01], [0.5, 0.01, 0.021, 0.01]])"));
+  ASSERT_EQ(scene.tools.size(), 3u);
+  EXPECT_EQ(scene.tools[0].name, "left");
+  EXPECT_TRUE(scene.tools[0].probe.capsule);
+  EXPECT_DOUBLE_EQ(scene.tools[0].probe.length, 0.04);
+  EXPECT_DOUBLE_EQ(scene.tools[1].probe.friction, 0.5);
+  EXPECT_DOUBLE_EQ(scene.tools[1].probe.position.x(), 0.024);
+  ASSERT_EQ(scene.tools[2].path.size(), 2u);
+  EXPECT_DOUBLE_EQ(scene.tools[2].path[1][2], 0.021);
+  EXPECT_FALSE(scene.probe.present);
+
+  const std::string device = "\n[[device]]\nname = \"hand\"\n";
+  struct Case {
+    std::string text, message;
+  };
+  const std::vector<Case> cases = {
+      {"[[tool]]\nradius = 0.003\nposition = [0.0, 0.03, 0.0]", "tool[0].name"},
+      {jaw("left", 0, "position = [0.0, 0.03, 0.0]") + jaw("left", 0, "position = [0.0, 0.04, 0.0]"),
+       "tool[1].name: \"left\" is already the name of tool[0]"},
+      {"[[tool]]\nname = \"a\"\nradius = 0.003", "give one of them, or device"},
+      {"[[tool]]\nname = \"a\"\nposition = [0.0, 0.03, 0.0]\nkeyframes = [[0.0, 0.0, 0.03, 0.0]]",
+       "give one of them, or device"},
+      {"[[tool]]\nname = \"a\"\nmode = \"grab\"\nposition = [0.0, 0.03, 0.0]", "tool[0].mode: only a tool driven"},
+      {"[[tool]]\nname = \"a\"\nkeyframes = [[0.5, 0.0, 0.03, 0.0], [0.2, 0.0, 0.03, 0.0]]", "times must increase"},
+      {"[[tool]]\nname = \"a\"\ndevice = \"foot\"\nkeyframes = [[0.0, 0.0, 0.03, 0.0]]" + device,
+       "tool[0].device: no [[device]] is named \"foot\" (the devices: \"hand\")"},
+      {"[[tool]]\nname = \"a\"\ndevice = \"hand\"\nkeyframes = [[0.0, 0.0, 0.03, 0.0]]\n"
+       "[[tool]]\nname = \"b\"\ndevice = \"hand\"\nkeyframes = [[0.0, 0.0, 0.03, 0.0]]" +
+           device,
+       "tool[1].device: \"hand\" already drives tool[0] \"a\" (one tool per device)"},
+      {"[[tool]]\nname = \"a\"\nposition = [0.0, 0.03, 0.0]" + device + "[[device]]\nname = \"hand\"\n",
+       "device[1].name: \"hand\" is already the name of device[0]"},
+      {"[[tool]]\nname = \"a\"\nposition = [0.0, 0.03, 0.0]" + device, "device[0]: \"hand\" drives no tool"},
+      {"[[tool]]\nname = \"a\"\ndevice = \"hand\"\nkeyframes = [[0.0, 0.0, 0.03, 0.0]]\n"
+       "[[tool]]\nname = \"b\"\ndevice = \"foot\"\nkeyframes = [[0.0, 0.0, 0.03, 0.0]]" +
+           device + "[[device]]\nname = \"foot\"\n",
+       "tool[1].device: a second tool driven by a device (two hands) is not supported yet"},
+      {"[[tool]]\nname = \"a\"\ndevice = \"hand\"\nkeyframes = [[0.0, 0.0, 0.03, 0.0]]" + device +
+           "[probe]\nkeyframes = [[0.0, 0.0, 0.03, 0.0]]",
+       "tool[0].device: the scene's [probe] / [device] already make its device-driven tool"},
+      {"[[tool]]\nname = \"a\"\nposition = [0.0, 0.03, 0.0]\n[lod]\ncontact = [0.01, 0.02, 0.01]",
+       "not yet with levels of detail"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.text);
+    const std::string message = error_of(sample("kind = \"implicit\"", c.text));
+    EXPECT_NE(message.find(c.message), std::string::npos) << message;
+    EXPECT_NE(message.find("scene.toml:"), std::string::npos) << message;
+  }
+}
+
+// a [[tool]] driven by a [[device]] is the scene's probe and device, as [probe] and [device] give them
+TEST(Tools, OneDrivenByADeviceIsTheProbeItsTableDescribes) {
+  const std::string keys =
+      "radius = 0.004\nfriction = 0.3\nkeyframes = [[0.0, 0.01, 0.03, 0.01], [0.5, 0.01, 0.019, 0.01, 1]]\n"
+      "origin = [0.0, 0.0, 0.0]\n";
+  const Scene named =
+      parse_scene(sample("kind = \"implicit\"", "[[tool]]\nname = \"finger\"\ndevice = \"hand\"\n" + keys +
+                                                    "[[device]]\nname = \"hand\"\nspecs = \"falcon\"\n"));
+  const Scene single =
+      parse_scene(sample("kind = \"implicit\"", "[probe]\n" + keys + "[device]\nspecs = \"falcon\"\n"));
+  EXPECT_TRUE(named.tools.empty());
+  EXPECT_EQ(named.probe_name, "finger");
+  ASSERT_TRUE(named.probe.present);
+  EXPECT_DOUBLE_EQ(named.probe.radius, single.probe.radius);
+  EXPECT_DOUBLE_EQ(named.probe.friction, single.probe.friction);
+  EXPECT_EQ(named.probe.keyframes, single.probe.keyframes);
+  EXPECT_EQ(named.device.specs, "falcon");
+  EXPECT_EQ(named.device.kind, single.device.kind);
+}
+
+// a posed tool held 1 mm into a block fixed at its base presses as a [probe] held there does, reported by name in
+// the summary and the result JSON's `tools` (beside a [probe]'s, under "probe")
+TEST(Tools, APosedToolIndentsAsAHeldProbeAndIsReportedByName) {
+  const std::string base = "[[fixed]]\nbox = { min = [-1.0, -1.0, -1.0], max = [1.0, 0.0, 1.0] }\n";
+  SceneSession probe = open_scene(
+      parse_scene(sample("kind = \"static\"", base + "[probe]\nradius = 0.005\nposition = [0.01, 0.024, 0.01]")),
+      two_threads());
+  SceneSession named = open_scene(
+      parse_scene(sample("kind = \"static\"", base + "[[tool]]\nname = \"finger\"\nradius = 0.005\nposition = [0.01, "
+                                                     "0.024, 0.01]\n[[tool]]\nname = \"away\"\nradius = "
+                                                     "0.005\nposition = [0.1, 0.1, 0.1]")),
+      two_threads());
+  probe.simulation->step();
+  named.simulation->step();
+  const RunSummary a = probe.simulation->summary(), b = named.simulation->summary();
+  ASSERT_TRUE(a.converged && b.converged) << a.failure << b.failure;
+  ASSERT_TRUE(a.tool.present);
+  ASSERT_EQ(b.tools.size(), 2u);
+  EXPECT_GT(a.tool.force.y(), 0.01);  // pressing down on the block: the block pushes it up
+  EXPECT_LT((tool(b, "finger").force - a.tool.force).norm(), 1e-6 * a.tool.force.norm());
+  EXPECT_EQ(tool(b, "away").contacts, 0);
+  const nlohmann::json doc =
+      nlohmann::json::parse(result_json(named.simulation->model(), named.simulation->state(), b));
+  EXPECT_NEAR(doc["tools"]["finger"]["force"][1].get<double>(), tool(b, "finger").force.y(), 1e-12);
+  EXPECT_EQ(doc["tools"].size(), 2u);
+  const nlohmann::json single =
+      nlohmann::json::parse(result_json(probe.simulation->model(), probe.simulation->state(), a));
+  EXPECT_NEAR(single["tools"]["probe"]["force"][1].get<double>(), a.tool.force.y(), 1e-12);
+  EXPECT_TRUE(single.contains("tool"));
+}
+
+// two vertical jaws pinch a free sample 1 mm deep from both sides under gravity (nothing else holds it): in a
+// static solve friction carries the weight, half on each jaw, their normal forces equal and opposite; below the
+// weight over 2 x the normal force the sample slips and the solve has no equilibrium, above it holds
+TEST(Tools, TwoToolsPinchingASampleCarryItsWeightByFrictionOrLetItSlip) {
+  const auto solve = [](double mu) {
+    SceneSession s =
+        open_scene(parse_scene(sample("kind = \"static\"\nmax_iterations = 15", pinch(mu))), two_threads());
+    s.simulation->step();
+    return s.simulation->summary();
+  };
+  const RunSummary held = solve(0.5);
+  ASSERT_TRUE(held.converged) << held.failure;
+  const ToolSummary &left = tool(held, "left"), &right = tool(held, "right");
+  EXPECT_NEAR(left.force.y() + right.force.y(), -weight, 0.005 * weight);  // the sample hangs on them
+  EXPECT_NEAR(left.force.y(), right.force.y(), 0.005 * weight);
+  EXPECT_GT(right.force.x(), 5 * weight);  // pressed apart
+  EXPECT_LT((left.force + right.force).cwiseAbs().maxCoeff() - std::abs(left.force.y() + right.force.y()),
+            1e-6 * right.force.x());                              // normal forces equal and opposite
+  EXPECT_NEAR(left.friction.y(), left.force.y(), 0.01 * weight);  // carried by friction, not by the pressure
+  // the threshold: the pinch's normal force N against the weight, mu* = W / (2 N)
+  const double threshold = weight / (2 * right.force.x());
+  const RunSummary slips = solve(0.95 * threshold);
+  EXPECT_FALSE(slips.converged);
+  EXPECT_NE(slips.failure.find("no equilibrium"), std::string::npos) << slips.failure;
+  const RunSummary holds = solve(1.05 * threshold);
+  EXPECT_TRUE(holds.converged) << holds.failure;
+  EXPECT_NEAR(tool(holds, "left").force.y() + tool(holds, "right").force.y(), -weight, 0.005 * weight);
+}
+
+// two jaws close 1 mm into a sample resting on a table over 0.1 s, lift it 1 cm over 0.2 s and hold it: in
+// implicit dynamics friction lifts it off the table (mu = 0.5), or it slips and stays (mu = 0.02)
+TEST(Tools, TwoKeyframedToolsLiftASampleOffTheTable) {
+  const auto lift = [](double mu) {
+    const std::string table =
+        "[[obstacle]]\nname = \"table\"\nplane = { point = [0.0, 0.0, 0.0], normal = [0.0, 1.0, 0.0] }\nfriction = "
+        "0.5\n";
+    const auto path = [](double x0, double x1) {
+      return fmt::format("keyframes = [[0.0, {0}, 0.0125, 0.01], [0.1, {1}, 0.0125, 0.01], [0.3, {1}, 0.0225, 0.01]]",
+                         x0, x1);
+    };
+    SceneSession s = open_scene(
+        parse_scene(sample("kind = \"implicit\"\ndt = 0.002", table + jaw("left", mu, path(-0.0055, -0.004), 0.016) +
+                                                                  jaw("right", mu, path(0.0255, 0.024), 0.016))),
+        two_threads());
+    s.simulation->run(0.4);
+    return std::pair(s.simulation->summary(), Points(s.simulation->state().u));
+  };
+  const auto [lifted, u] = lift(0.5);
+  ASSERT_TRUE(lifted.converged) << lifted.failure;
+  EXPECT_NEAR(u.row(1).mean(), 0.01, 0.001);  // carried up with the jaws, less their grip's give
+  ASSERT_EQ(lifted.obstacles.size(), 1u);
+  EXPECT_EQ(lifted.obstacles[0].second.contacts, 0);  // off the table
+  EXPECT_NEAR(tool(lifted, "left").force.y() + tool(lifted, "right").force.y(), -weight, 0.01 * weight);
+  const auto [slipped, v] = lift(0.02);
+  ASSERT_TRUE(slipped.converged) << slipped.failure;
+  EXPECT_LT(v.row(1).mean(), 0.002);  // left on the table
+  EXPECT_GT(slipped.obstacles[0].second.contacts, 0);
+}
+
+}  // namespace
