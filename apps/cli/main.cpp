@@ -2,6 +2,7 @@
 #include "experiment_beam.hpp"
 #include "experiment_cantilever.hpp"
 #include "experiment_contact.hpp"
+#include "experiment_contact_pairs.hpp"
 #include "experiment_cut.hpp"
 #include "experiment_force_profile.hpp"
 #include "experiment_lod.hpp"
@@ -544,6 +545,15 @@ int cli_main(int argc, char** argv) {
   cut_cmd->add_option("--out", cut_experiment.out, "Output folder")->required();
   cut_cmd->add_option("--threads", cut_experiment.threads, "Threads (0: all)")->check(thread_count);
 
+  ph::experiments::ContactPairsOptions pairs;
+  CLI::App* pairs_cmd = experiment_cmd->add_subcommand(
+      "contact-pairs",
+      "Contact pairs against statics: a block on a table, a block on a block, two tools pinching a sample (slipping "
+      "below W / 2N), two jaws lifting it, a cut piece falling onto a table");
+  pairs_cmd->add_option("--out", pairs.out, "Output folder")->required();
+  pairs_cmd->add_option("--threads", pairs.threads, "Threads (0: all)")->check(thread_count);
+  pairs_cmd->add_option("--plot-script", pairs.plot_script, "plot_contact_pairs.py to use");
+
   ph::experiments::ForceProfileOptions profile;
   CLI::App* profile_cmd = experiment_cmd->add_subcommand(
       "force-profile", "Seed Fig. 2c: the force felt while dragging a point of the beam and letting it go");
@@ -607,6 +617,7 @@ int cli_main(int argc, char** argv) {
     if (*contact_cmd) return ph::experiments::run_contact_experiment(contact);
     if (*profile_cmd) return ph::experiments::run_force_profile_experiment(profile);
     if (*cut_cmd) return ph::experiments::run_cut_experiment(cut_experiment);
+    if (*pairs_cmd) return ph::experiments::run_contact_pairs_experiment(pairs);
     if (*lod_table_cmd) return ph::experiments::run_lod_table_experiment(lod_table);
     if (*propagation_cmd) return ph::experiments::run_propagation_experiment(propagation);
     if (*lod_error_cmd) return ph::experiments::run_lod_error_experiment(lod_error);

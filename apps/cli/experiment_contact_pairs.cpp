@@ -1,0 +1,238 @@
+#include "experiment_contact_pairs.hpp"
+
+#include "plots.hpp"
+
+#include <pointhaptics/mechanics/cut.hpp>
+#include <pointhaptics/pointhaptics.hpp>
+
+#include <fmt/format.h>
+#include <fmt/os.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace pointhaptics::experiments {
+
+namespace {
+
+constexpr double g = 9.81;
+
+/// One quantity a contact pair must give, against what statics says it is.
+struct Check {
+  std::string pair, quantity;
+  double measured = 0, expected = 0;
+  double tolerance = 0;  ///< on the relative error (|measured - expected| / |expected|); 0: a yes-or-no check
+  bool holds = false;
+  double relative_error() const { return expected != 0 ? std::abs(measured - expected) / std::abs(expected) : 0.0; }
+};
+
+Check within(std::string pair, std::string quantity, double measured, double expected, double tolerance) {
+  Check c{std::move(pair), std::move(quantity), measured, expected, tolerance, false};
+  c.holds = std::isfinite(measured) && c.relative_error() <= tolerance;
+  return c;
+}
+Check yes(std::string pair, std::string quantity, bool holds) {
+  return Check{std::move(pair), std::move(quantity), holds ? 1.0 : 0.0, 1.0, 0.0, holds};
+}
+
+SceneSession open(const std::string& text, const std::string& name, int threads) {
+  SessionOptions options;
+  options.threads = threads;
+  return open_scene(parse_scene(text, name), options);
+}
+
+const ToolSummary& named(const std::vector<std::pair<std::string, ToolSummary>>& loads, const std::string& name) {
+  for (const auto& [n, t] : loads)
+    if (n == name) return t;
+  throw Error(fmt::format("experiment contact-pairs: nothing named \"{}\" in the summary", name));
+}
+
+const std::string table =
+    "[[obstacle]]\nname = \"table\"\nplane = { point = [0.0, 0.0, 0.0], normal = [0.0, 1.0, 0.0] }\nfriction = 0.5\n";
+
+// a soft block (4 x 2 x 4 cm, E = 100 kPa) resting on a table, static: the table carries its weight
+void block_on_table(std::vector<Check>& checks, int threads) {
+  SceneSession s = open(
+      "[object]\nshape = \"box\"\nsize = [0.04, 0.02, 0.04]\nspacing = 0.005\n[material]\nyoung = 1e5\npoisson = "
+      "0.3\ndensity = 1000.0\n[solver]\nkind = \"static\"\n[[load]]\nkind = \"gravity\"\n" +
+          table,
+      "block-on-table", threads);
+  s.simulation->step();
+  const RunSummary r = s.simulation->summary();
+  const double weight = 0.04 * 0.02 * 0.04 * 1000.0 * g;
+  checks.push_back(yes("body-table", "static solve converged", r.converged));
+  checks.push_back(
+      within("body-table", "table's support / weight", -named(r.obstacles, "table").force.y(), weight, 0.005));
+}
+
+// a block (2 x 2 x 2 cm, E = 200 kPa, 16 g) on a block (4 x 2 x 4 cm, E = 100 kPa, 32 g) on a table, both free,
+// run to rest in implicit dynamics (0.5 s; a static solve of two free bodies stacked does not yet converge: the
+// closing note of issue 47 says so): the lower one carries the upper's weight, the table both
+void block_on_block(std::vector<Check>& checks, int threads) {
+  SceneSession s = open(
+      "[material]\nyoung = 1e5\npoisson = 0.3\ndensity = 1000.0\ndamping = 20.0\n"
+      "[[object]]\nname = \"lower\"\nshape = \"box\"\nsize = [0.04, 0.02, 0.04]\nspacing = 0.005\n"
+      "[[object]]\nname = \"upper\"\nshape = \"box\"\nsize = [0.02, 0.02, 0.02]\norigin = [0.01, 0.02, "
+      "0.01]\nspacing = 0.005\nmaterial = { young = 2e5, density = 2000.0 }\n"
+      "[contact]\nfriction = 0.5\n[solver]\nkind = \"implicit\"\ndt = 2e-3\n[[load]]\nkind = \"gravity\"\n" +
+          table,
+      "block-on-block", threads);
+  s.simulation->run(0.5);
+  const RunSummary r = s.simulation->summary();
+  checks.push_back(yes("body-body", "stacked blocks: every implicit step converged", r.converged));
+  double upper = 0, total = 0;
+  Vec3 on_upper = Vec3::Zero();
+  for (const BodySummary& b : r.bodies) {
+    total += b.mass * g;
+    if (b.name == "upper") upper = b.mass * g, on_upper = b.contact_force;
+  }
+  checks.push_back(within("body-body", "lower block's support of the upper / its weight", on_upper.y(), upper, 0.005));
+  checks.push_back(within("body-table", "table's support of both / their weight",
+                          -named(r.obstacles, "table").force.y(), total, 0.005));
+}
+
+// a vertical jaw (a capsule of 5 mm radius, axis along y) pressing 1 mm into the face x = 0 or x = 0.02 of a 2 cm
+// sample
+std::string jaw(const std::string& name, double mu, const std::string& where, double length) {
+  return fmt::format(
+      "[[tool]]\nname = \"{}\"\nshape = \"capsule\"\nradius = 0.005\nlength = {}\norientation = "
+      "[0.7071067811865476, -0.7071067811865476, 0.0, 0.0]\nfriction = {}\n{}\n",
+      name, length, mu, where);
+}
+std::string sample(const std::string& solver, const std::string& more) {
+  return "[object]\nshape = \"box\"\nsize = [0.02, 0.02, 0.02]\nspacing = 0.0025\n[material]\nyoung = "
+         "5e4\npoisson = 0.3\ndensity = 1000.0\ndamping = 0.05\n[solver]\n" +
+         solver + "\n[[load]]\nkind = \"gravity\"\n" + more;
+}
+
+// two jaws pinch a free 2 cm sample (8 g) 1 mm deep, static: friction carries its weight, half on each, their
+// pressures equal and opposite; below W / (2 N) it slips (no equilibrium), above it holds
+void pinch(std::vector<Check>& checks, int threads) {
+  const double weight = 0.02 * 0.02 * 0.02 * 1000.0 * g;
+  const auto solve = [&](double mu) {
+    SceneSession s = open(
+        sample("kind = \"static\"\nmax_iterations = 15", jaw("left", mu, "position = [-0.004, 0.01, 0.01]", 0.04) +
+                                                             jaw("right", mu, "position = [0.024, 0.01, 0.01]", 0.04)),
+        "pinch", threads);
+    s.simulation->step();
+    return s.simulation->summary();
+  };
+  const RunSummary held = solve(0.5);
+  const ToolSummary &left = named(held.tools, "left"), &right = named(held.tools, "right");
+  checks.push_back(yes("tool-body", "pinched sample: static solve converged", held.converged));
+  checks.push_back(
+      within("tool-body", "the jaws' lift / the sample's weight", -(left.force.y() + right.force.y()), weight, 0.005));
+  checks.push_back(within("tool-body", "left jaw's lift / half the weight", -left.force.y(), 0.5 * weight, 0.005));
+  checks.push_back(within("tool-body", "left jaw's pressure / the right's", -left.force.x(), right.force.x(), 1e-6));
+  const double threshold = weight / (2 * right.force.x());
+  const RunSummary below = solve(0.95 * threshold), above = solve(1.05 * threshold);
+  checks.push_back(yes("tool-body",
+                       fmt::format("slips at mu = 0.95 W / 2N = {:.4f} (no equilibrium)", 0.95 * threshold),
+                       !below.converged && below.failure.find("no equilibrium") != std::string::npos));
+  checks.push_back(
+      yes("tool-body", fmt::format("holds at mu = 1.05 W / 2N = {:.4f}", 1.05 * threshold), above.converged));
+}
+
+// two jaws close 1 mm into a sample on a table over 0.1 s, lift it 1 cm over 0.2 s and hold it (implicit, 0.4 s)
+void lift(std::vector<Check>& checks, int threads) {
+  const double weight = 0.02 * 0.02 * 0.02 * 1000.0 * g;
+  const auto path = [](double x0, double x1) {
+    return fmt::format("keyframes = [[0.0, {0}, 0.0125, 0.01], [0.1, {1}, 0.0125, 0.01], [0.3, {1}, 0.0225, 0.01]]", x0,
+                       x1);
+  };
+  SceneSession s =
+      open(sample("kind = \"implicit\"\ndt = 0.002", table + jaw("left", 0.5, path(-0.0055, -0.004), 0.016) +
+                                                         jaw("right", 0.5, path(0.0255, 0.024), 0.016)),
+           "lift", threads);
+  s.simulation->run(0.4);
+  const RunSummary r = s.simulation->summary();
+  checks.push_back(yes("tool-body", "lifted: every implicit step converged", r.converged));
+  checks.push_back(within("tool-body", "lifted sample's mean rise / the jaws' 1 cm",
+                          s.simulation->state().u.row(1).mean(), 0.01, 0.1));
+  checks.push_back(
+      yes("body-table", "lifted sample off the table (no contact)", named(r.obstacles, "table").contacts == 0));
+  checks.push_back(within("tool-body", "lifting jaws' lift / the weight",
+                          -(named(r.tools, "left").force.y() + named(r.tools, "right").force.y()), weight, 0.01));
+}
+
+// the seed's cantilever under its weight, cut through near its root at 0.2 s: the free piece falls 2 cm onto a
+// table and comes to rest (implicit, 1.5 s); the table carries the piece, the root the stump
+void cut_piece_falls(std::vector<Check>& checks, int threads) {
+  SceneSession s = open(
+      "[object]\nshape = \"box\"\nsize = [0.15, 0.03, 0.03]\nspacing = 0.0075\n[material]\nyoung = 1e6\npoisson = "
+      "0.4\ndensity = 1000.0\ndamping = 20.0\n[[fixed]]\nbox = { min = [-1.0, -1.0, -1.0], max = [0.0, 1.0, 1.0] "
+      "}\n[[load]]\nkind = \"gravity\"\n[[cut]]\nedge = [[0.03375, 0.04, -0.01], [0.03375, 0.04, 0.04]]\nto = "
+      "[[0.03375, -0.01, -0.01], [0.03375, -0.01, 0.04]]\nstart = 0.2\nduration = 0.05\n[solver]\nkind = "
+      "\"implicit\"\ndt = 2e-3\n[[obstacle]]\nname = \"table\"\nplane = { point = [0.0, -0.02, 0.0], normal = [0.0, "
+      "1.0, 0.0] }\nfriction = 0.5\n",
+      "cut-piece", threads);
+  s.simulation->run(1.5);
+  const RunSummary r = s.simulation->summary();
+  const Model& model = s.simulation->model();
+  std::vector<index_t> piece_of;
+  const std::vector<index_t> pieces = piece_sizes(model, piece_of);
+  checks.push_back(yes("body-table", "cut piece: two pieces, every step converged", r.converged && pieces.size() == 2));
+  // the piece that holds no fixed point falls: its weight is what the table must carry
+  std::vector<bool> held_piece(pieces.size(), false);
+  for (index_t i = 0; i < model.n_points; ++i)
+    if (model.fixed[static_cast<std::size_t>(i)])
+      held_piece[static_cast<std::size_t>(piece_of[static_cast<std::size_t>(i)])] = true;
+  double falling = 0;
+  for (index_t i = 0; i < model.n_points; ++i)
+    if (!held_piece[static_cast<std::size_t>(piece_of[static_cast<std::size_t>(i)])]) falling += model.mass[i] * g;
+  checks.push_back(within("body-table", "table's support of the cut piece / its weight",
+                          -named(r.obstacles, "table").force.y(), falling, 0.005));
+  checks.push_back(yes("body-table",
+                       fmt::format("cut piece at rest on the table (kinetic energy {:.2g} J)", r.kinetic_energy),
+                       r.kinetic_energy < 1e-9 && named(r.obstacles, "table").contacts > 0));
+}
+
+}  // namespace
+
+int run_contact_pairs_experiment(const ContactPairsOptions& options) {
+  namespace fs = std::filesystem;
+  fs::create_directories(options.out);
+  const fs::path out = options.out;
+  std::vector<Check> checks;
+  block_on_table(checks, options.threads);
+  block_on_block(checks, options.threads);
+  pinch(checks, options.threads);
+  lift(checks, options.threads);
+  cut_piece_falls(checks, options.threads);
+  auto csv = fmt::output_file((out / "contact-pairs.csv").string());
+  csv.print("pair,quantity,measured,expected,relative_error,tolerance,holds\n");
+  for (const Check& c : checks)
+    csv.print("{},\"{}\",{:.9g},{:.9g},{:.3g},{:.3g},{}\n", c.pair, c.quantity, c.measured, c.expected,
+              c.relative_error(), c.tolerance, c.holds ? 1 : 0);
+  csv.close();
+  const int plots = run_plot_script("plot_contact_pairs.py", out.string(), options.plot_script);
+  auto md = fmt::output_file((out / "summary.md").string());
+  md.print(
+      "# Contact pairs (issue 47)\n\n"
+      "Each kind of contact pair against what statics says it must carry (`contact-pairs.csv`; the relative errors "
+      "against their tolerances in `contact-pairs.png`).\n\n"
+      "| pair | quantity | measured | expected | relative error | tolerance | holds |\n|---|---|---|---|---|---|---|\n");
+  for (const Check& c : checks)
+    md.print("| {} | {} | {:.6g} | {:.6g} | {} | {} | {} |\n", c.pair, c.quantity, c.measured, c.expected,
+             c.tolerance > 0 ? fmt::format("{:.2e}", c.relative_error()) : "-",
+             c.tolerance > 0 ? fmt::format("{:.1e}", c.tolerance) : "-", c.holds ? "yes" : "**no**");
+  md.print(
+      "\nNot yet here: two elastic spheres pressed together against Hertz's two-body law (the body contact's "
+      "pairs are vertex to triangle on each body's own surface, and at the spacings a test affords, 1 mm on a 1 cm "
+      "sphere, the contact patch at small approach spans one or two spacings; refinement, which resolves it for a "
+      "tool, is not yet available with several bodies).\n");
+  md.close();
+  bool all = plots == 0;
+  for (const Check& c : checks) {
+    fmt::print("{:<10} {:<60} {:>12.6g} {:>12.6g} {}\n", c.pair, c.quantity, c.measured, c.expected,
+               c.holds ? "holds" : "FAILS");
+    all = all && c.holds;
+  }
+  fmt::print("wrote {}\n", out.string());
+  if (!all) fmt::print(stderr, "experiment contact-pairs: a check failed (see {})\n", (out / "summary.md").string());
+  return all ? 0 : 1;
+}
+
+}  // namespace pointhaptics::experiments
