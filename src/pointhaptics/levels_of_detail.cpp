@@ -48,19 +48,19 @@ void remove_added_energy(const Model& model, double energy_before, State& state)
 }  // namespace
 
 LevelsOfDetail::LevelsOfDetail(ModelSimulation&& object, const LodParams& params, const Vec3& contact)
-    : solver_(object.solver_), n_threads_(object.n_threads_), params_(params), contact_(contact) {
+    : solver_(object.solver()), n_threads_(object.n_threads()), params_(params), contact_(contact) {
   validate(params);
   if (!contact.allFinite()) throw Error("lod: the contact point is not finite");
-  full_ = std::move(object.model_);
-  full_state_ = object.state_;
+  full_state_ = object.state();
+  full_ = object.take_model();
   tree_ = std::make_unique<KdTree>(full_.X);
   // the object's simulation, its model taken, hands its diagnostics, inputs and probe to the first active
   // set like any re-selection; built here, before any step (set-up, not a stall)
   active_ = std::make_unique<ModelSimulation>(std::move(object));
   // the object's own cuts so far are in its model (and its sheets): the active sets are built with them
-  sheets_carried_ = active_->cut_sheets_.triangles.size();
-  sheet_revision_carried_ = active_->cut_sheets_.revision;
-  take_over(build_lod(full_, params_, snap(contact), solver_.kind, active_->cut_sheets_.triangles, object_cuts_made_),
+  sheets_carried_ = active_->cut_sheets().triangles.size();
+  sheet_revision_carried_ = active_->cut_sheets().revision;
+  take_over(build_lod(full_, params_, snap(contact), solver_.kind, active_->cut_sheets().triangles, object_cuts_made_),
             true);
 }
 
@@ -68,7 +68,7 @@ void LevelsOfDetail::carry_cuts() {
   ModelSimulation& sim = *active_;
   // the pairs the active model lost, where the object has them
   const Csr& object = full_.neighbours;
-  for (const auto& [k, l] : sim.severed_log_) {
+  for (const auto& [k, l] : sim.severed()) {
     const index_t i = active_set_.full_of[k], j = active_set_.full_of[l];
     for (index_t e = object.begin(i); e < object.end(i); ++e)
       if (object.index[e] == j) {
@@ -76,10 +76,10 @@ void LevelsOfDetail::carry_cuts() {
         break;
       }
   }
-  sim.severed_log_.clear();
+  sim.clear_severed();
   // the object's pairs across the new sheets: those between points that are not both simulated too (the
   // last strip's two triangles again, as a straight cut extends them)
-  const CutSheets& sheets = sim.cut_sheets_;
+  const CutSheets& sheets = sim.cut_sheets();
   if (sheets.revision != sheet_revision_carried_) {
     const std::size_t from = std::min(sheets_carried_ >= 2 ? sheets_carried_ - 2 : 0, sheets.triangles.size());
     const std::vector<index_t> crossing =
@@ -181,7 +181,7 @@ std::vector<index_t> LevelsOfDetail::update(const Vec3& contact, bool onset, boo
   apply_object_cuts();
   if (!asynchronous)
     return take_over(
-        build_lod(full_, params_, snap(contact), solver_.kind, active_->cut_sheets_.triangles, object_cuts_made_),
+        build_lod(full_, params_, snap(contact), solver_.kind, active_->cut_sheets().triangles, object_cuts_made_),
         true);
   // the worker only reads the object's model: a cut meanwhile reaches it once the build is done (carry_cuts())
   // and, with a probe on the surface, the part of it the new active set carries
@@ -191,7 +191,7 @@ std::vector<index_t> LevelsOfDetail::update(const Vec3& contact, bool onset, boo
   const double reach = probe ? tool_reach(probe_shape(probe->tool.contact().params())) : 0.0;
   pending_ = std::async(std::launch::async,
                         [&full = full_, params = params_, at = snap(contact), kind = solver_.kind,
-                         sheets = active_->cut_sheets_.triangles, cuts = object_cuts_made_, surface, reach] {
+                         sheets = active_->cut_sheets().triangles, cuts = object_cuts_made_, surface, reach] {
                           LodBuild build = build_lod(full, params, at, kind, sheets, cuts);
                           if (surface) {
                             build.part = restrict_surface(surface->mesh, surface->map, build.active, reach);
@@ -210,7 +210,7 @@ std::vector<index_t> LevelsOfDetail::take_over(LodBuild build, bool built_here) 
   carry_cuts();
   if (build.object_cuts != object_cuts_made_) {
     const CutReport late =
-        cut_as_object(next, full_, active_->cut_sheets_.triangles, solver_.kind != SolverKind::EXPLICIT);
+        cut_as_object(next, full_, active_->cut_sheets().triangles, solver_.kind != SolverKind::EXPLICIT);
     if (late.severed_pairs > 0 && build.stable_dt > 0)
       build.stable_dt = std::min(
           build.stable_dt, local_stable_time_step(next.model, late.cut_points, ModelSimulation::cut_patch_rings, 0.8,
@@ -236,18 +236,10 @@ std::vector<index_t> LevelsOfDetail::take_over(LodBuild build, bool built_here) 
   // a new simulation of the new active model; what the pipeline carries (diagnostics, inputs, the probe,
   // renumbered: grabbed points follow their new numbers, none at the first selection) moves over
   auto sim = std::make_unique<ModelSimulation>(next.model, solver_, n_threads_, build.stable_dt);
-  sim->solver_impl_->continue_from(*active_->solver_impl_);
-  sim->diagnostics_ = std::move(active_->diagnostics_);
-  sim->inputs_ = active_->inputs_;
-  sim->probe_ = std::move(active_->probe_);
-  // the cuts' sheets, and a split of the surface along them in flight (it reads the object's model)
-  sim->cut_sheets_ = std::move(active_->cut_sheets_);
-  sim->sheet_edge_ = active_->sheet_edge_;
-  sim->split_ = std::move(active_->split_);
-  sim->log_severed_ = true;
+  sim->continue_from(std::move(*active_));
   active_ = std::move(sim);
-  if (active_->probe_) {
-    ProbeAttachment& probe = *active_->probe_;
+  if (active_->probe()) {
+    ProbeAttachment& probe = *active_->probe();
     probe.object_model = &full_;
     probe.active_set = &active_set_;  // (next, once moved there below)
     std::optional<SurfaceContact> surface;

@@ -3,6 +3,7 @@
 #include <pointhaptics/lod/active_surface.hpp>
 
 #include <pointhaptics/core/error.hpp>
+#include <pointhaptics/core/stage_timer.hpp>
 #include <pointhaptics/mechanics/inversion.hpp>
 #include <pointhaptics/solvers/explicit_solver.hpp>
 
@@ -61,6 +62,18 @@ ModelSimulation::ModelSimulation(Model model, const SolverSpec& solver, int n_th
   hold_points(model_, 0.0, state_.u);  // held points start at their prescribed displacement at t = 0
 }
 
+void ModelSimulation::continue_from(ModelSimulation&& previous) {
+  solver_impl_->continue_from(*previous.solver_impl_);
+  diagnostics_ = std::move(previous.diagnostics_);
+  inputs_ = previous.inputs_;
+  probe_ = std::move(previous.probe_);
+  // the cuts' sheets, and a split of the surface along them in flight (it reads the object's model)
+  cut_sheets_ = std::move(previous.cut_sheets_);
+  sheet_edge_ = previous.sheet_edge_;
+  split_ = std::move(previous.split_);
+  log_severed_ = true;
+}
+
 double ModelSimulation::stable_dt() const {
   if (!(stable_dt_ > 0)) stable_dt_ = stable_time_step(model_, 0.8, 40, n_threads_);
   return stable_dt_;
@@ -79,7 +92,7 @@ void ModelSimulation::set_state(const State& state) {
 }
 
 CutReport ModelSimulation::cut(std::span<const BladeSweep> sweeps) {
-  const auto start = std::chrono::steady_clock::now();
+  const StageClock clock;
   cut_positions_ = model_.X + state_.u;  // allocates only the first time
   // (explicit dynamics drops the hourglass diagonal: only Newton's preconditioner reads it)
   const CutReport report = pointhaptics::cut(model_, cut_positions_, sweeps, solver_.kind != SolverKind::EXPLICIT);
@@ -100,7 +113,7 @@ CutReport ModelSimulation::cut(std::span<const BladeSweep> sweeps) {
   // leave the surface whole across it)
   if (!sweeps.empty()) record_cut_sheet(sweeps.back());
   ++diagnostics_.cuts;
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds = clock.seconds();
   diagnostics_.max_cut_seconds = std::max(diagnostics_.max_cut_seconds, seconds);
   diagnostics_.cut_seconds += seconds;
   return report;
@@ -172,7 +185,7 @@ void ModelSimulation::refresh_probe_surface() {
                 shape = probe_shape(probe.tool.contact().params()),
                 &object = probe.object_model ? *probe.object_model : model_,
                 whole_model = probe.active_set == nullptr]() {
-    const auto start = std::chrono::steady_clock::now();
+    const StageClock clock;
     tbb::task_arena one_thread(1);
     SplitContact made = one_thread.execute([&] {
       SplitContact m{std::make_shared<const ObjectSurface>(split_surface(*surface, object, sheets.triangles)),
@@ -180,7 +193,7 @@ void ModelSimulation::refresh_probe_surface() {
       if (whole_model) m.contact.emplace(probe_surface_contact(*m.surface, params, shape, object, nullptr));
       return m;
     });
-    made.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    made.seconds = clock.seconds();
     return made;
   };
   // in real time on a worker, taken over at a later step; otherwise now (reproducible runs)
@@ -194,25 +207,24 @@ const StepReport& ModelSimulation::step() {
   if (diagnostics_.failed)
     throw Error(
         fmt::format("simulation: no step after a failed one (t = {:.6g} s: {})", state_.time, diagnostics_.failure));
-  using clock = std::chrono::steady_clock;
-  const auto start = clock::now();
-  // the tools take their place for this step, from the inputs
-  place_tools();
-  const auto placed = clock::now();
-  // the solver: internal, external and tool forces, time integration or equilibrium, held points
+  const StageClock clock;
+  // inputs: the tools take their place for this step
+  timed_stage(diagnostics_.tools_seconds, [&] { place_tools(); });
+  // the solver: internal, external, contact and tool forces, time integration or equilibrium, held points
+  timed_stage(diagnostics_.solve_seconds, [&] { solve(); });
+  // checks: a state that is not finite is not a result, whatever the solver said; nor is an inverted one (counted)
+  check_finite(report_);
+  count_inverted_neighbourhoods();
+  // diagnostics
+  record(report_, clock.seconds());
+  return report_;
+}
+
+void ModelSimulation::solve() {
   DynamicForces* tools = forces_this_step();
   solver_impl_->set_real_time(probe_ && probe_->asynchronous_lod);
   report_ = solver_impl_->step(model_, state_, ws_, tools);
   if (tools && report_.status != StepStatus::FAILED) tools->after_step(model_, state_, ws_);
-  const auto solved = clock::now();
-  // a state that is not finite is not a result, whatever the solver said; nor is an inverted one (counted)
-  check_finite(report_);
-  count_inverted_neighbourhoods();
-  const auto seconds = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
-  diagnostics_.tools_seconds += seconds(start, placed);
-  diagnostics_.solve_seconds += seconds(placed, solved);
-  record(report_, seconds(start, clock::now()));
-  return report_;
 }
 
 DynamicForces* ModelSimulation::forces_this_step() {

@@ -158,9 +158,21 @@ class ModelSimulation {
   /// Contact between the model's bodies (several [[object]] tables); nullptr with one body.
   std::unique_ptr<BodyContact>& body_contact() { return body_contact_; }
 
+  // ---- for the layer above that carries a simulation's pipeline from one model to the next (levels of
+  // detail: each active set is a new ModelSimulation)
+  /// Moves the model out: this simulation is then only the carrier of its pipeline's state for continue_from().
+  Model take_model() { return std::move(model_); }
+  /// Take over `previous`'s pipeline (a simulation of another model of the same object): its solver's warm
+  /// start and factors, diagnostics, inputs, probe, cuts' sheets and a surface split in flight; from then on
+  /// the pairs the cuts sever are logged (severed()) for the layer above.
+  void continue_from(ModelSimulation&& previous);
+  /// The neighbour pairs the cuts severed since clear_severed() (logged after continue_from()).
+  const std::vector<std::array<index_t, 2>>& severed() const { return severed_log_; }
+  void clear_severed() { severed_log_.clear(); }
+
  private:
-  friend class LevelsOfDetail;  // takes the object's model, state, diagnostics and probe over
   void place_tools();
+  void solve();
   void record_cut_sheet(const BladeSweep& sweep);
   void refresh_probe_surface();
   void check_finite(StepReport& report) const;

@@ -1,5 +1,7 @@
 #include <pointhaptics/simulation.hpp>
 
+#include <pointhaptics/core/stage_timer.hpp>
+
 #include <pointhaptics/core/error.hpp>
 #include <pointhaptics/core/run_control.hpp>
 #include <pointhaptics/mechanics/energy.hpp>
@@ -36,11 +38,13 @@ const StepReport& Simulation::step() {
 }
 
 const StepReport& Simulation::run_step_stages() {
-  const auto start = std::chrono::steady_clock::now();
+  const StageClock clock;
   // the inputs were filled by the caller (inputs()); the active set follows the last step's contact
-  if (lod_) lod_->follow_probe();
-  const double selecting = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  ModelSimulation& sim = core();
+  double selecting = 0;
+  timed_stage(selecting, [&] {
+    if (lod_) lod_->follow_probe();
+  });
+  ModelSimulation& sim = core();  // (the new active set's, when it changed)
   sim.diagnostics().active_set_seconds += selecting;
   sim.diagnostics().step_seconds += selecting;
   // the scripted blades cut what they sweep during this step
@@ -52,8 +56,7 @@ const StepReport& Simulation::run_step_stages() {
     lod_->mark_stale();
   }
   StepDiagnostics& d = core().diagnostics();  // (the active set's simulation: it may have changed above)
-  d.max_step_seconds =
-      std::max(d.max_step_seconds, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  d.max_step_seconds = std::max(d.max_step_seconds, clock.seconds());
   return report;
 }
 
