@@ -7,6 +7,8 @@
 #include <pointhaptics/scene_session.hpp>
 #include <pointhaptics/simulation.hpp>
 
+#include "support/scene_sessions.hpp"
+
 #include <gtest/gtest.h>
 
 #include <fmt/format.h>
@@ -50,21 +52,8 @@ material = {{ young = 2e5, density = 2000.0 }}
 constexpr double lower_weight = 0.04 * 0.02 * 0.04 * 1000.0 * 9.81;  // N
 constexpr double upper_weight = 0.02 * 0.02 * 0.02 * 2000.0 * 9.81;  // N
 
-SessionOptions two_threads() {
-  SessionOptions options;
-  options.threads = 2;
-  return options;
-}
-
-std::string error_of(const std::string& text, bool open = true) {
-  try {
-    Scene scene = parse_scene(text, "scene.toml");
-    if (open) SceneSession s = open_scene(std::move(scene), two_threads());
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "no error";
-}
+using test::error_of;
+using test::two_threads;
 
 const BodySummary& body(const RunSummary& s, const std::string& name) {
   for (const BodySummary& b : s.bodies)

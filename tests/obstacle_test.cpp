@@ -7,6 +7,8 @@
 #include <pointhaptics/scene_session.hpp>
 #include <pointhaptics/simulation.hpp>
 
+#include "support/scene_sessions.hpp"
+
 #include <gtest/gtest.h>
 
 #include <fmt/format.h>
@@ -44,25 +46,13 @@ kind = "gravity"
                      spacing, solver, obstacle, more);
 }
 
-SessionOptions two_threads() {
-  SessionOptions options;
-  options.threads = 2;
-  return options;
-}
+using test::error_of;
+using test::two_threads;
 
 const ToolSummary& obstacle(const RunSummary& s, const std::string& name) {
   for (const auto& [n, o] : s.obstacles)
     if (n == name) return o;
   throw Error("no obstacle " + name);
-}
-
-std::string error_of(const std::string& text) {
-  try {
-    SceneSession s = open_scene(parse_scene(text, "scene.toml"), two_threads());
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "no error";
 }
 
 TEST(Obstacle, TablesAreReadWithEveryShapeAndTheirMistakesNamed) {

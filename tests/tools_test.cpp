@@ -7,6 +7,8 @@
 #include <pointhaptics/scene_session.hpp>
 #include <pointhaptics/simulation.hpp>
 
+#include "support/scene_sessions.hpp"
+
 #include <gtest/gtest.h>
 
 #include <fmt/format.h>
@@ -20,25 +22,13 @@ namespace {
 
 constexpr double weight = 0.02 * 0.02 * 0.02 * 1000.0 * 9.81;  // the 2 cm sample's, N
 
-SessionOptions two_threads() {
-  SessionOptions options;
-  options.threads = 2;
-  return options;
-}
+using test::error_of;
+using test::two_threads;
 
 const ToolSummary& tool(const RunSummary& s, const std::string& name) {
   for (const auto& [n, t] : s.tools)
     if (n == name) return t;
   throw Error("no tool " + name);
-}
-
-std::string error_of(const std::string& text) {
-  try {
-    SceneSession s = open_scene(parse_scene(text, "scene.toml"), two_threads());
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "no error";
 }
 
 // a 2 x 2 x 2 cm sample from the origin (E = 50 kPa, 8 g) under gravity, and `more`
