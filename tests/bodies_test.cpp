@@ -6,6 +6,7 @@
 #include <pointhaptics/scene_builder.hpp>
 #include <pointhaptics/scene_session.hpp>
 #include <pointhaptics/simulation.hpp>
+#include <pointhaptics/vtk_output.hpp>
 
 #include "support/scene_sessions.hpp"
 
@@ -14,6 +15,9 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 
 using namespace pointhaptics;
@@ -192,6 +196,47 @@ TEST(Bodies, ABlockOnABlockOnATableEachCarriesWhatIsAboveIt) {
 }  // namespace
 
 namespace {
+
+// with several bodies a ParaView series per body beside the object's: body_<name>.pvd, each frame its own points
+// with their rows of the arrays, and its own part of the surface (its triangles renumbered from its first vertex)
+TEST(Bodies, EachBodyHasItsOwnParaViewSeries) {
+  Scene scene =
+      parse_scene(two_blocks(0.001, "kind = \"implicit\"\ndt = 2e-3", "[[load]]\nkind = \"gravity\""), "scene.toml");
+  SceneSession s = open_scene(scene, two_threads());
+  const ObjectSurface surface = build_object_surface(s.scene, s.simulation->model());
+  const std::string folder = (std::filesystem::temp_directory_path() / "ph_bodies_vtk").string();
+  std::filesystem::remove_all(folder);
+  VtkSeries object(folder);
+  std::vector<VtkSeries> bodies = body_vtk_series(folder, s.simulation->model());
+  ASSERT_EQ(bodies.size(), 2u);
+  add_vtk_frame(object, *s.simulation, &surface, &bodies);
+  s.simulation->step();
+  add_vtk_frame(object, *s.simulation, &surface, &bodies);
+  const auto text = [](const std::string& path) {
+    std::ifstream in(path);
+    std::stringstream all;
+    all << in.rdbuf();
+    return all.str();
+  };
+  const Model& m = s.simulation->model();
+  for (std::size_t k = 0; k < 2; ++k) {
+    const std::string name = k == 0 ? "lower" : "upper";
+    EXPECT_EQ(bodies[k].collection_path(), folder + "/body_" + name + ".pvd");
+    const std::string pvd = text(bodies[k].collection_path());
+    EXPECT_NE(pvd.find("body_" + name + "_000001.vtp"), std::string::npos) << pvd;
+    const std::string frame = text(folder + "/body_" + name + "_000001.vtp");
+    EXPECT_NE(frame.find(fmt::format("NumberOfPoints=\"{}\"", m.body_start[k + 1] - m.body_start[k])),
+              std::string::npos);
+    const std::string part = text(folder + "/body_" + name + "_surface_000001.vtp");
+    EXPECT_NE(part.find(fmt::format("NumberOfPoints=\"{}\"",
+                                    surface.body_vertex_start[k + 1] - surface.body_vertex_start[k])),
+              std::string::npos);
+    EXPECT_NE(
+        part.find(fmt::format("NumberOfPolys=\"{}\"", surface.body_face_start[k + 1] - surface.body_face_start[k])),
+        std::string::npos);
+  }
+  std::filesystem::remove_all(folder);
+}
 
 // the shipped scene opens with its two layers, apart, in contact with each other and the table at the start
 TEST(Bodies, TheShippedLayersSceneOpensWithTwoBodiesInContact) {

@@ -220,7 +220,9 @@ int run_command(const RunOptions& opt) {
   auto vtk_surface = [&]() -> const ph::ObjectSurface* {
     return surface ? &surface->at(sim.model(), sim.cut_sheets()) : nullptr;
   };
-  if (vtk) ph::add_vtk_frame(*vtk, sim, vtk_surface());  // the initial state
+  // with several bodies, a series per body beside the object's
+  std::vector<ph::VtkSeries> body_vtk = vtk ? ph::body_vtk_series(opt.vtk, sim.model()) : std::vector<ph::VtkSeries>{};
+  if (vtk) ph::add_vtk_frame(*vtk, sim, vtk_surface(), &body_vtk);  // the initial state
   const double start_time = sim.time();
   const bool options_real_time = !opt.deterministic;
   ph::InteractiveResult interactive;
@@ -244,7 +246,7 @@ int run_command(const RunOptions& opt) {
     // run's step count is not known in advance)
     if (vtk && opt.vtk_every > 0)
       options.after_step = [&](long long step) {
-        if (step % opt.vtk_every == 0) errors.attempt([&] { ph::add_vtk_frame(*vtk, sim, vtk_surface()); });
+        if (step % opt.vtk_every == 0) errors.attempt([&] { ph::add_vtk_frame(*vtk, sim, vtk_surface(), &body_vtk); });
       };
     interactive = ph::run_interactive(sim, *session.device, options);
     if (force_log) errors.attempt([&] { force_log->commit(); });
@@ -287,7 +289,7 @@ int run_command(const RunOptions& opt) {
         // frames: every vtk_every steps (default: about 50 over the run), and the last state below
         const long long every = opt.vtk_every > 0 ? opt.vtk_every : std::max<long long>(1, n_steps / 50);
         if (vtk && step % every == 0 && step < n_steps)
-          errors.attempt([&] { ph::add_vtk_frame(*vtk, sim, vtk_surface()); });
+          errors.attempt([&] { ph::add_vtk_frame(*vtk, sim, vtk_surface(), &body_vtk); });
         return !interrupted.load();
       });
     } catch (const ph::Interrupted&) {
@@ -297,7 +299,7 @@ int run_command(const RunOptions& opt) {
     progress.within_step = nullptr;
   }
   // the last state (an interactive run writes only the first and the last)
-  if (vtk) errors.attempt([&] { ph::add_vtk_frame(*vtk, sim, vtk_surface()); });
+  if (vtk) errors.attempt([&] { ph::add_vtk_frame(*vtk, sim, vtk_surface(), &body_vtk); });
   if (!opt.csv.empty()) errors.attempt([&] { ph::write_points_csv(opt.csv, sim); });
   if (!opt.surface.empty())
     errors.attempt([&] {

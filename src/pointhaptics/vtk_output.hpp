@@ -16,8 +16,15 @@ std::vector<VtkArray> vtk_arrays(Simulation& sim);
 /// its points' values).
 std::vector<VtkArray> surface_vtk_arrays(const ObjectSurface& surface, const std::vector<VtkArray>& point_arrays);
 
+/// With several bodies (Model::body_start), a series per body beside the object's, in the same folder and named
+/// for it (`<folder>/body_<name>.pvd`, its name kept to letters, digits, '-' and '_'; ParaView opens each as the
+/// body's animation); none with one body.
+std::vector<VtkSeries> body_vtk_series(const std::string& folder, const Model& model);
+
 /// Add the simulation's current state to the series at its time; with `surface`, its deformed surface too
-/// (part 1 of the time step).
-void add_vtk_frame(VtkSeries& series, Simulation& sim, const ObjectSurface* surface = nullptr);
+/// (part 1 of the time step). With `bodies` (body_vtk_series()), each body's rows of the same arrays and its
+/// part of the surface to its own series.
+void add_vtk_frame(VtkSeries& series, Simulation& sim, const ObjectSurface* surface = nullptr,
+                   std::vector<VtkSeries>* bodies = nullptr);
 
 }  // namespace pointhaptics
