@@ -40,6 +40,7 @@ struct RunOptions {
   std::string scene;
   std::string json;
   std::string force_log;
+  std::string tool_log;
   std::string vtk;
   std::string csv;
   std::string surface;
@@ -172,6 +173,7 @@ int run_command(const RunOptions& opt) {
   if (!opt.csv.empty()) ph::check_output_path(opt.csv, "--csv");
   if (!opt.surface.empty()) ph::check_output_path(opt.surface, "--surface");
   if (!opt.force_log.empty()) ph::check_output_path(opt.force_log, "--force-log");
+  if (!opt.tool_log.empty()) ph::check_output_path(opt.tool_log, "--tool-log");
   ph::SessionOptions session_options;
   session_options.threads = opt.threads;
   session_options.max_memory = static_cast<double>(opt.max_memory);
@@ -255,6 +257,19 @@ int run_command(const RunOptions& opt) {
           fmt::format("--force-log {}: {} haptic ticks were not logged (the simulation thread fell behind)",
                       opt.force_log, interactive.log_dropped));
   } else {
+    // the posed tools' forces at every step (and the start): t, tool, force, its friction part, contacts, depth
+    std::optional<ph::TextOutput> tool_log;
+    const auto log_tools = [&] {
+      for (const auto& [name, load] : sim.posed_tool_loads())
+        tool_log->print("{:.9g},{},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{},{:.9g}\n", sim.time(), name,
+                        load.force.x(), load.force.y(), load.force.z(), load.friction.x(), load.friction.y(),
+                        load.friction.z(), load.contacts, load.penetration);
+    };
+    if (!opt.tool_log.empty()) {
+      tool_log.emplace(opt.tool_log, "--tool-log");
+      tool_log->print("t,tool,fx,fy,fz,friction_x,friction_y,friction_z,contacts,penetration\n");
+      log_tools();
+    }
     ph::cli::ProgressBar bar(!opt.quiet);
     const auto stepping = std::chrono::steady_clock::now();
     const long long n_steps = sim.steps_in(scene.solver.duration);
@@ -290,6 +305,7 @@ int run_command(const RunOptions& opt) {
         const long long every = opt.vtk_every > 0 ? opt.vtk_every : std::max<long long>(1, n_steps / 50);
         if (vtk && step % every == 0 && step < n_steps)
           errors.attempt([&] { ph::add_vtk_frame(*vtk, sim, vtk_surface(), &body_vtk); });
+        if (tool_log) log_tools();
         return !interrupted.load();
       });
     } catch (const ph::Interrupted&) {
@@ -297,6 +313,7 @@ int run_command(const RunOptions& opt) {
       // converged load increment (static), not a completed step; the summary says so (Simulation::step)
     }
     progress.within_step = nullptr;
+    if (tool_log) errors.attempt([&] { tool_log->commit(); });
   }
   // the last state (an interactive run writes only the first and the last)
   if (vtk) errors.attempt([&] { ph::add_vtk_frame(*vtk, sim, vtk_surface(), &body_vtk); });
@@ -394,6 +411,9 @@ int cli_main(int argc, char** argv) {
   run_cmd->add_flag("--quiet,-q", run.quiet, "Print nothing but errors");
   run_cmd->add_option("--force-log", run.force_log,
                       "With a [probe]: write the haptic log (CSV, one row per tick) to FILE");
+  run_cmd->add_option("--tool-log", run.tool_log,
+                      "With [[tool]] tables held or moved by the scene: write each tool's force at every step (CSV: t, "
+                      "tool, fx, fy, fz, friction_x, friction_y, friction_z, contacts, penetration)");
   run_cmd->add_option("--vtk", run.vtk, "Write a ParaView time series (DIR/frame.pvd and DIR/frame_*.vtp)");
   run_cmd->add_option("--csv", run.csv,
                       "Write the final state as CSV, one row per point (x, y, z, u, stress, energy, flags)");

@@ -245,6 +245,14 @@ void Simulation::add_posed_body(PosedBody::Role role, std::string name, const To
   sim.posed_bodies().push_back(PosedBody{std::move(name), role, std::move(held), path, pose});
 }
 
+std::vector<std::pair<std::string, ToolLoad>> Simulation::posed_tool_loads() {
+  ModelSimulation& sim = core();
+  std::vector<std::pair<std::string, ToolLoad>> loads;
+  for (PosedBody& o : sim.posed_bodies())
+    if (o.role == PosedBody::Role::TOOL) loads.emplace_back(o.name, o.contact.load(sim.model(), sim.state().u));
+  return loads;
+}
+
 void Simulation::add_body_contact(const ObjectSurface& surface, const BodyContactParams& params) {
   ModelSimulation& sim = core();
   if (lod_) throw Error("body contact: not yet with levels of detail (an active set is one body's)");

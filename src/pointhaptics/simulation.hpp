@@ -91,6 +91,9 @@ class Simulation {
   /// over time, added to `pose` (empty: held at `pose`). Any number of them, beside a probe or held tool.
   void add_posed_tool(std::string name, const ToolShape& shape, const ToolPose& pose, const TriangleMesh& mesh,
                       SurfaceMap map, const SurfaceContactParams& params = {}, const Trajectory& path = {});
+  /// What the bodies exert on each posed tool ([[tool]] with a position or keyframes) now, by name, in the order
+  /// they were added: the rows of `run --tool-log`.
+  std::vector<std::pair<std::string, ToolLoad>> posed_tool_loads();
   /// The name the probe or held tool is reported under (summary().tool_name): its [[tool]]'s; "probe" by default.
   void set_tool_name(std::string name) { tool_name_ = std::move(name); }
   /// Contact between the model's bodies (Model::body_start) on their surfaces (`surface`, with its bodies'
