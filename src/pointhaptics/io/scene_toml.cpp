@@ -591,6 +591,41 @@ CutSpec read_cut(TableReader& r) {
   return c;
 }
 
+// keyframes = [[t, a, b, c], ...] of a body the scene poses (an obstacle's translation, a tool's position): times
+// increasing from 0 s within 1e6 s, values within 1e6 m; `form` and `what` name them in the errors. Empty without
+// the key.
+std::vector<std::array<double, 4>> read_posed_keyframes(TableReader& r, std::string_view form, std::string_view what) {
+  std::vector<std::array<double, 4>> frames;
+  const toml::node* node = r.find("keyframes");
+  if (!node) return frames;
+  const toml::array* rows = node->as_array();
+  if (!rows || rows->empty()) r.fail_at(*node, "keyframes", fmt::format("expected keyframes = [{}, ...]", form));
+  for (const toml::node& row : *rows) {
+    const toml::array* k = row.as_array();
+    if (!k || k->size() != 4) r.fail_at(row, "keyframes", fmt::format("each keyframe is {} (s, m)", form));
+    std::array<double, 4> frame{};
+    for (std::size_t a = 0; a < 4; ++a) frame[a] = r.as_number(*k->get(a), "keyframes");
+    const double last_t = frames.empty() ? -1.0 : frames.back()[0];
+    if (!(frame[0] > last_t) || frame[0] < 0 || frame[0] > 1e6)
+      r.fail_at(row, "keyframes", "times must increase, from 0 s, and stay within 1e6 s");
+    if (!(std::max({std::abs(frame[1]), std::abs(frame[2]), std::abs(frame[3])}) <= 1e6))
+      r.fail_at(row, "keyframes", fmt::format("{} must lie within 1e6 m", what));
+    frames.push_back(frame);
+  }
+  return frames;
+}
+
+// direction = [x, y, z]: the unit direction a tool held at a position presses in (only with position)
+void read_press_direction(TableReader& r, ProbeSpec& p) {
+  const toml::node* node = r.find("direction");
+  if (!node) return;
+  if (!r.find("position"))
+    r.fail_at(*node, "direction", "only a tool held at a position (position = [x, y, z]) presses along a direction");
+  const Vec3 d = r.as_vec3(*node, "direction");
+  if (!(d.norm() > 1e-12)) r.fail_at(*node, "direction", "must not be zero (the direction the tool presses in)");
+  p.direction = d.normalized();
+}
+
 // name = "...", exactly one of plane = { point, normal }, box = { min, max }, sphere = { centre, radius } or
 // capsule = { ends = [[x, y, z], [x, y, z]], radius }, and friction
 ObstacleSpec read_obstacle(TableReader& r) {
@@ -640,24 +675,7 @@ ObstacleSpec read_obstacle(TableReader& r) {
   }
   o.friction = r.number(
       "friction", o.friction, [](double mu) { return mu >= 0 && mu <= 10; }, "must lie in [0, 10]");
-  if (const toml::node* node = r.find("keyframes")) {
-    const toml::array* rows = node->as_array();
-    if (!rows || rows->empty()) r.fail_at(*node, "keyframes", "expected keyframes = [[t, dx, dy, dz], ...]");
-    double last_t = -1;
-    for (const toml::node& row : *rows) {
-      const toml::array* k = row.as_array();
-      if (!k || k->size() != 4) r.fail_at(row, "keyframes", "each keyframe is [t, dx, dy, dz] (s, m)");
-      std::array<double, 4> frame{};
-      for (std::size_t a = 0; a < 4; ++a) frame[a] = r.as_number(*k->get(a), "keyframes");
-      if (!(frame[0] > last_t) || frame[0] > 1e6)
-        r.fail_at(row, "keyframes", "times must increase, from 0 s, and stay within 1e6 s");
-      if (!(std::max({std::abs(frame[1]), std::abs(frame[2]), std::abs(frame[3])}) <= 1e6))
-        r.fail_at(row, "keyframes", "a translation must lie within 1e6 m");
-      last_t = frame[0];
-      o.keyframes.push_back(frame);
-    }
-    if (o.keyframes.front()[0] < 0) r.fail_at(*node, "keyframes", "times must start at 0 s or later");
-  }
+  o.keyframes = read_posed_keyframes(r, "[t, dx, dy, dz]", "a translation");
   return o;
 }
 
@@ -753,13 +771,7 @@ void read_probe(TableReader& r, ProbeSpec& p, const Context& ctx) {
       r.fail_at(*r.find("position"), "position",
                 "a tool held at a position has no trajectory or keyframes: give one or the other");
   }
-  if (const toml::node* node = r.find("direction")) {
-    if (!r.find("position"))
-      r.fail_at(*node, "direction", "only a tool held at a position (position = [x, y, z]) presses along a direction");
-    const Vec3 d = r.as_vec3(*node, "direction");
-    if (!(d.norm() > 1e-12)) r.fail_at(*node, "direction", "must not be zero (the direction the tool presses in)");
-    p.direction = d.normalized();
-  }
+  read_press_direction(r, p);
 }
 
 void read_device(TableReader& r, DeviceSpec& d, const Context& ctx) {
@@ -813,29 +825,8 @@ ToolSpec read_tool(TableReader& r, const Context& ctx) {
                  "a tool not driven by a device is held at position = [x, y, z] or moved along keyframes = [[t, x, "
                  "y, z], ...] (scene axes, m): give one of them, or device = \"NAME\"");
   if (r.find("position")) t.probe.position = r.vec3("position", t.probe.position);
-  if (const toml::node* node = r.find("direction")) {
-    if (!r.find("position"))
-      r.fail_at(*node, "direction", "only a tool held at a position (position = [x, y, z]) presses along a direction");
-    const Vec3 d = r.as_vec3(*node, "direction");
-    if (!(d.norm() > 1e-12)) r.fail_at(*node, "direction", "must not be zero (the direction the tool presses in)");
-    t.probe.direction = d.normalized();
-  }
-  if (const toml::node* node = r.find("keyframes")) {
-    const toml::array* rows = node->as_array();
-    if (!rows || rows->empty()) r.fail_at(*node, "keyframes", "expected keyframes = [[t, x, y, z], ...] (s, m)");
-    for (const toml::node& row : *rows) {
-      const toml::array* k = row.as_array();
-      if (!k || k->size() != 4) r.fail_at(row, "keyframes", "each keyframe is [t, x, y, z] (s; m, scene axes)");
-      std::array<double, 4> frame{};
-      for (std::size_t a = 0; a < 4; ++a) frame[a] = r.as_number(*k->get(a), "keyframes");
-      const double last_t = t.path.empty() ? -1.0 : t.path.back()[0];
-      if (!(frame[0] > last_t) || frame[0] < 0 || frame[0] > 1e6)
-        r.fail_at(row, "keyframes", "times must increase, from 0 s, and stay within 1e6 s");
-      if (!(std::max({std::abs(frame[1]), std::abs(frame[2]), std::abs(frame[3])}) <= 1e6))
-        r.fail_at(row, "keyframes", "a position must lie within 1e6 m");
-      t.path.push_back(frame);
-    }
-  }
+  read_press_direction(r, t.probe);
+  t.path = read_posed_keyframes(r, "[t, x, y, z]", "a position");
   return t;
 }
 
@@ -898,8 +889,6 @@ void read_lod(TableReader& r, LodSpec& l) {
   if (r.find("contact")) l.contact = r.vec3("contact", l.contact);
 }
 
-// Each [[fixed]] and [[load]] names an [[object]] (optional with one, and for gravity, which loads every one), and
-// what does not yet work with several objects is refused by name
 // [[tool]] and [[device]] tables: unique names; each device drives one tool and each tool's device exists. A tool
 // driven by a device becomes the scene's probe and its device (one hand: a second is refused by name); the posed
 // ones stay in scene.tools.
@@ -921,6 +910,7 @@ void bind_tools(Scene& scene, bool device_section) {
                          scene.devices[a].name, b));
   std::vector<int> driven(scene.devices.size(), -1);  // the tool each device drives
   int hands = 0;
+  std::size_t hand_tool = 0, hand_device = 0;  // the device-driven tool and its device
   for (std::size_t k = 0; k < scene.tools.size(); ++k) {
     const ToolSpec& t = scene.tools[k];
     if (t.device.empty()) continue;
@@ -938,6 +928,8 @@ void bind_tools(Scene& scene, bool device_section) {
       fail(t.line, fmt::format("tool[{}].device: \"{}\" already drives tool[{}] \"{}\" (one tool per device)", k,
                                t.device, driven[slot], scene.tools[static_cast<std::size_t>(driven[slot])].name));
     driven[slot] = static_cast<int>(k);
+    hand_tool = k;
+    hand_device = slot;
     if (t.probe.held())
       fail(t.line, fmt::format("tool[{}].position: a tool driven by a device is not held at a position (leave out "
                                "position, or device)",
@@ -957,19 +949,15 @@ void bind_tools(Scene& scene, bool device_section) {
            fmt::format("device[{}]: \"{}\" drives no tool (a [[tool]] names it: device = \"{}\")", k,
                        scene.devices[k].name, scene.devices[k].name));
   // the device-driven tool is the scene's probe, its device the scene's device
-  for (std::size_t k = 0; k < scene.tools.size(); ++k) {
-    if (scene.tools[k].device.empty()) continue;
-    scene.probe = scene.tools[k].probe;
-    scene.device = scene
-                       .devices[static_cast<std::size_t>(std::find(driven.begin(), driven.end(), static_cast<int>(k)) -
-                                                         driven.begin())]
-                       .spec;
-    scene.probe_name = scene.tools[k].name;
-    scene.tools.erase(scene.tools.begin() + static_cast<std::ptrdiff_t>(k));
-    break;
-  }
+  if (hands == 0) return;
+  scene.probe = scene.tools[hand_tool].probe;
+  scene.device = scene.devices[hand_device].spec;
+  scene.probe_name = scene.tools[hand_tool].name;
+  scene.tools.erase(scene.tools.begin() + static_cast<std::ptrdiff_t>(hand_tool));
 }
 
+// Each [[fixed]] and [[load]] names an [[object]] (optional with one, and for gravity, which loads every one), and
+// what does not yet work with several objects is refused by name
 void check_body_names(const Scene& scene) {
   const auto known = [&](const std::string& object) {
     return std::any_of(scene.bodies.begin(), scene.bodies.end(), [&](const BodySpec& b) { return b.name == object; });
