@@ -560,6 +560,7 @@ names the problem.)doc")
                 // a device's probe: its session in simulated time (`pointhaptics run --deterministic`)
                 const std::unique_ptr<ph::Device> device = ph::make_scene_device(p.scene);
                 ph::InteractiveOptions options = p.interactive;
+                const auto other_devices = ph::make_other_hand_devices(p.scene, options);
                 options.real_time = false;
                 options.log = false;
                 p.last_session = ph::run_interactive(*p.sim, *device, options);
@@ -706,6 +707,7 @@ names the problem.)doc")
             scene.probe.grab = mode == "grab";
             scene.solver.duration = duration;
             ph::InteractiveOptions o = ph::scene_interactive_options(scene, p.sim->model());
+            o.other_hands.clear();  // this probe alone
             o.real_time = real_time;
             ph::InteractiveResult r;
             long_call(p, [&] {

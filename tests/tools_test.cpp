@@ -112,8 +112,8 @@ keyframes = [[0.0, 0.01, 0.03, 0.01], [0.5, 0.01, 0.021, 0.01]])"));
       {"[[tool]]\nname = \"a\"\nposition = [0.0, 0.03, 0.0]" + device, "device[0]: \"hand\" drives no tool"},
       {"[[tool]]\nname = \"a\"\ndevice = \"hand\"\nkeyframes = [[0.0, 0.0, 0.03, 0.0]]\n"
        "[[tool]]\nname = \"b\"\ndevice = \"foot\"\nkeyframes = [[0.0, 0.0, 0.03, 0.0]]" +
-           device + "[[device]]\nname = \"foot\"\n",
-       "tool[1].device: a second tool driven by a device (two hands) is not supported yet"},
+           device + "[[device]]\nname = \"foot\"\n[lod]\ncontact = [0.01, 0.02, 0.01]",
+       "tool \"b\": a second device-driven tool (two hands) is not yet with levels of detail"},
       {"[[tool]]\nname = \"a\"\ndevice = \"hand\"\nkeyframes = [[0.0, 0.0, 0.03, 0.0]]" + device +
            "[probe]\nkeyframes = [[0.0, 0.0, 0.03, 0.0]]",
        "tool[0].device: the scene's [probe] / [device] already make its device-driven tool"},

@@ -117,6 +117,7 @@ std::unique_ptr<Prepared> prepare(const Scene& scene_in, ProbeSource source, int
   DeviceSpecs mouse_specs = known_device_specs(scene.device.specs == "custom" ? "touch" : scene.device.specs);
   mouse_specs.name = "mouse";
   p->device = make_device(scene, source, mouse_specs, p->mouse, p->device_name);
+  p->other_devices = make_other_hand_devices(scene, p->options);
   DisplayFrame initial;
   initial.u = Points::Zero(3, p->reference.cols());
   initial.probe = p->options.mapping.origin;

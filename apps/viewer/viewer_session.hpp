@@ -29,6 +29,8 @@ struct Prepared {
   std::unique_ptr<Device> device;
   MouseDevice* mouse = nullptr;  ///< the device, when the mouse drives it
   std::string device_name;       ///< what drives the probe, for the panel
+  /// The scene's other device-driven tools' devices (two hands): the mouse drives the first tool, these the others
+  std::vector<std::unique_ptr<Device>> other_devices;
   InteractiveOptions options;
   Points reference;  ///< the object's points, m
   std::vector<unsigned char> fixed;

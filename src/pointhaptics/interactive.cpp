@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -42,21 +43,35 @@ void publish_display(Simulation& sim, const HapticFrame& haptic, long long step,
   display.publish();
 }
 
-// One simulation step with the latest device point; then the local contact model is published for the
-// haptic loop (run_interactive publishes the display frames, at most one per display_period).
-// `stray` compares each model with the one before.
-int simulation_step(Simulation& sim, HapticLoop& loop, LocalModelStray& stray) {
-  loop.frames().update();
-  const HapticFrame& frame = loop.frames().front();
-  sim.inputs().device = frame.device;
-  sim.inputs().button = frame.button;
-  sim.inputs().orientation = frame.orientation;
+// A hand of the run: its device's haptic loop, and how far its local models strayed.
+struct RunningHand {
+  std::unique_ptr<HapticLoop> loop;
+  LocalModelStray stray;
+  int max_contacts = 0;
+};
+
+// One simulation step with each hand's latest device point; then each hand's local contact model is published for
+// its haptic loop (run_interactive publishes the display frames, at most one per display_period). `stray` compares
+// each model with the one before.
+void simulation_step(Simulation& sim, std::vector<RunningHand>& hands) {
+  for (std::size_t k = 0; k < hands.size(); ++k) {
+    TripleBuffer<HapticFrame>& frames = hands[k].loop->frames();
+    frames.update();
+    const HapticFrame& frame = frames.front();
+    StepInputs& inputs = sim.inputs(k);
+    inputs.device = frame.device;
+    inputs.button = frame.button;
+    inputs.orientation = frame.orientation;
+  }
   sim.step();
-  const ProbeTool& probe = *sim.probe();
-  loop.contact_models().back() = probe.contact_model();
-  loop.contact_models().publish();
-  stray.add(probe.contact_model(), probe.held_stiffness());
-  return probe.contact_model().contacts;
+  for (std::size_t k = 0; k < hands.size(); ++k) {
+    const ProbeTool& probe = *sim.probe(k);
+    RunningHand& hand = hands[k];
+    hand.loop->contact_models().back() = probe.contact_model();
+    hand.loop->contact_models().publish();
+    hand.stray.add(probe.contact_model(), probe.held_stiffness());
+    hand.max_contacts = std::max(hand.max_contacts, probe.contact_model().contacts);
+  }
 }
 
 }  // namespace
@@ -68,22 +83,37 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
     throw Error("interactive run: needs a dynamic solver (explicit or implicit)");
   if (options.display && options.display->back().u.cols() != sim.model().n_points)
     throw Error("interactive run: the display frames must be sized for the model's points (3 x n)");
-  const CouplingGains gains = coupling_budget(device.specs(), options.mapping.scale, options.coupling_safety);
-  // in real time levels of detail are built on a worker thread and taken over at the first step after they
-  // are ready; in deterministic runs in place, so that a run is reproducible
-  sim.attach_probe(options.probe, gains.stiffness, device.specs().max_force, options.real_time, options.surface);
-  struct Detach {  // the probe belongs to this run
-    Simulation& sim;
-    ~Detach() { sim.detach_probe(); }
-  } detach{sim};
+  if (!options.other_hands.empty() && sim.lod_enabled())
+    throw Error("interactive run: a second hand with levels of detail is not supported yet");
+  for (const HandOptions& h : options.other_hands)
+    if (!h.device) throw Error(fmt::format("interactive run: hand \"{}\" has no device", h.name));
   const bool streamed = static_cast<bool>(options.log_sink);
   if (options.log && !streamed && !std::isfinite(options.duration))
     throw Error("interactive run: a force log kept in memory needs a finite duration (stream it to a file)");
-  // the loop holds a few seconds of rows; this thread takes them after every step
-  HapticLoop loop(device, options.mapping, gains, options.rules, options.haptic_rate,
-                  options.log || streamed ? static_cast<std::size_t>(4 * options.haptic_rate) + 64 : 0);
+  // each hand's probe, and its haptic loop (the first keeps the force log: a few seconds of rows, which this
+  // thread takes after every step). In real time levels of detail are built on a worker thread and taken over at
+  // the first step after they are ready; in deterministic runs in place, so that a run is reproducible
+  struct Detach {  // the probes belong to this run
+    Simulation& sim;
+    ~Detach() { sim.detach_probe(); }
+  } detach{sim};
+  std::vector<RunningHand> hands(1 + options.other_hands.size());
+  const auto attach = [&](std::size_t k, Device& device, const ProbeParams& probe,
+                          std::shared_ptr<const ObjectSurface> surface, const WorkspaceMapping& mapping,
+                          const std::string& name) {
+    const CouplingGains gains = coupling_budget(device.specs(), mapping.scale, options.coupling_safety);
+    sim.attach_probe(probe, gains.stiffness, device.specs().max_force, options.real_time, std::move(surface), name);
+    const std::size_t log_rows =
+        k == 0 && (options.log || streamed) ? static_cast<std::size_t>(4 * options.haptic_rate) + 64 : 0;
+    hands[k].loop = std::make_unique<HapticLoop>(device, mapping, gains, options.rules, options.haptic_rate, log_rows);
+  };
+  attach(0, device, options.probe, options.surface, options.mapping, {});
+  for (std::size_t k = 0; k < options.other_hands.size(); ++k) {
+    const HandOptions& h = options.other_hands[k];
+    attach(k + 1, *h.device, h.probe, h.surface, h.mapping, h.name);
+  }
+  HapticLoop& loop = *hands.front().loop;
   InteractiveResult result;
-  LocalModelStray stray;
   const auto take_log = [&] {
     if (streamed) loop.take_log(options.log_sink);
     else if (options.log) loop.take_log([&](const HapticLogRow& row) { result.log.push_back(row); });
@@ -108,23 +138,29 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
   };
   // a stop requested inside a step ends the run there (the state is that of the step's start, or of its last
   // explicit sub-step); the haptic loop is stopped either way
+  const auto device_failed = [&hands] {
+    return std::any_of(hands.begin(), hands.end(), [](const RunningHand& h) { return h.loop->device_failed(); });
+  };
+  const auto stop_loops = [&hands] {
+    for (RunningHand& h : hands) h.loop->stop();
+  };
   try {
     if (options.real_time) {
-      loop.start();
+      for (RunningHand& h : hands) h.loop->start();
       for (;;) {
         const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        if (wall >= options.duration || loop.device_failed() || stopped() || sim.diagnostics().failed) break;
+        if (wall >= options.duration || device_failed() || stopped() || sim.diagnostics().failed) break;
         if (sim.time() - t0 > wall) {  // ahead of the wall clock: wait for it
           std::this_thread::sleep_for(std::chrono::duration<double>(sim.time() - t0 - wall));
           continue;
         }
-        result.max_contacts = std::max(result.max_contacts, simulation_step(sim, loop, stray));
+        simulation_step(sim, hands);
         ++result.simulation_steps;
         display(false);
         take_log();
         if (options.after_step) options.after_step(result.simulation_steps);
       }
-      loop.stop();
+      stop_loops();
     } else {
       const double h = 1.0 / options.haptic_rate;
       if (!(options.duration >= 0) || !(options.duration * options.haptic_rate <= Simulation::max_run_steps))
@@ -135,10 +171,11 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
       const auto n_ticks = static_cast<long long>(std::llround(options.duration * options.haptic_rate));
       for (long long k = 1; k <= n_ticks && !stopped() && !sim.diagnostics().failed; ++k) {
         const double t = k * h;
-        if (!loop.tick(t, h)) break;
+        // every hand's tick at t (a hand whose device failed ends the run)
+        if (!std::all_of(hands.begin(), hands.end(), [&](RunningHand& hand) { return hand.loop->tick(t, h); })) break;
         take_log();
         while (sim.time() - t0 < t - 1e-12 && !sim.diagnostics().failed) {
-          result.max_contacts = std::max(result.max_contacts, simulation_step(sim, loop, stray));
+          simulation_step(sim, hands);
           ++result.simulation_steps;
           display(false);
           if (options.after_step) options.after_step(result.simulation_steps);
@@ -146,7 +183,7 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
       }
     }
   } catch (const Interrupted&) {
-    loop.stop();
+    stop_loops();
   }
   result.interrupted = stopped();
   display(true);
@@ -154,8 +191,18 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
   result.haptic = loop.stats();
   take_log();
   result.log_dropped = loop.log_dropped();
-  result.tool = sim.tool_summary();  // before the probe is detached
-  result.local_model = stray.summary();
+  // before the probes are detached
+  result.max_contacts = hands.front().max_contacts;
+  result.tool = sim.tool_summary();
+  result.local_model = hands.front().stray.summary();
+  for (std::size_t k = 1; k < hands.size(); ++k) {
+    HandResult hand{sim.hand_name(k), hands[k].loop->stats(), sim.tool_summary(k), hands[k].max_contacts,
+                    hands[k].stray.summary()};
+    hand.tool.haptic_ticks = hand.haptic.ticks;
+    hand.tool.haptic_period_p99_us = hand.haptic.period_p99_us;
+    hand.tool.haptic_max_force_n = hand.haptic.max_force_n;
+    result.other_hands.push_back(std::move(hand));
+  }
   return result;
 }
 
@@ -169,6 +216,12 @@ void add_interactive_summary(RunSummary& summary, const InteractiveResult& inter
   summary.haptic_passivity_dissipated = interactive.haptic.passivity_dissipated;
   summary.haptic_passivity_ticks = interactive.haptic.passivity_ticks;
   summary.local_model = interactive.local_model;
+  for (const HandResult& hand : interactive.other_hands) {
+    const auto same = [&](const auto& named) { return named.first == hand.name; };
+    const auto it = std::find_if(summary.tools.begin(), summary.tools.end(), same);
+    if (it != summary.tools.end()) it->second = hand.tool;
+    else summary.tools.emplace_back(hand.name, hand.tool);
+  }
 }
 
 }  // namespace pointhaptics

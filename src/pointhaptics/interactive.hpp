@@ -32,6 +32,16 @@ struct DisplayFrame {
   long long cut_revision = 0;
 };
 
+/// A second (or later) hand of an interactive run (issue 47): its own device, probe and workspace, its own haptic
+/// loop and local contact model; it touches every body as the first does.
+struct HandOptions {
+  Device* device = nullptr;  ///< not owned; must outlive the run
+  std::string name;          ///< what the result reports it under (empty: "hand2", ...)
+  ProbeParams probe;
+  std::shared_ptr<const ObjectSurface> surface;  ///< as InteractiveOptions::surface
+  WorkspaceMapping mapping;
+};
+
 struct InteractiveOptions {
   ProbeParams probe;
   /// The object's surface: the probe pushes on it (issue 16) instead of on the point spheres (null: the
@@ -60,6 +70,19 @@ struct InteractiveOptions {
   std::function<void(long long)> after_step;
   /// If set, the run also ends (at the next step) once this becomes true: a viewer's window closed.
   const std::atomic<bool>* stop = nullptr;
+  /// More hands beside the first (whose device run_interactive() takes and whose probe, surface and mapping are
+  /// above): each ticks its own haptic loop at the haptic rate, none waits on another or on the simulation.
+  /// Without levels of detail.
+  std::vector<HandOptions> other_hands;
+};
+
+/// A second or later hand's figures at the end of a run.
+struct HandResult {
+  std::string name;
+  HapticStats haptic;
+  ToolSummary tool;  ///< its probe at the end, with its haptic figures
+  int max_contacts = 0;
+  LocalModelSummary local_model;
 };
 
 struct InteractiveResult {
@@ -69,12 +92,13 @@ struct InteractiveResult {
   long long simulation_steps = 0;
   double simulation_wall_s = 0;
   int max_contacts = 0;
-  ToolSummary tool;               ///< the probe at the end (the result JSON's tool block)
-  LocalModelSummary local_model;  ///< how far each local model strayed from the next update
-  bool interrupted = false;       ///< a stop was requested (run_control.hpp): the run ended at the state reached
+  ToolSummary tool;                     ///< the probe at the end (the result JSON's tool block)
+  LocalModelSummary local_model;        ///< how far each local model strayed from the next update
+  bool interrupted = false;             ///< a stop was requested (run_control.hpp): the run ended at the state reached
+  std::vector<HandResult> other_hands;  ///< InteractiveOptions::other_hands', in their order
 };
 
-/// Run the simulation with a probe driven by `device` for options.duration. Real time: the haptic loop
+/// Run the simulation with a probe driven by `device` (and one more per options.other_hands) for options.duration. Real time: the haptic loop
 /// ticks on its own thread at the haptic rate while this thread steps the simulation as fast as it can
 /// (but never ahead of the wall clock), exchanging the probe and the local contact model through
 /// lock-free buffers. Deterministic (real_time = false): the same exchange, interleaved on one thread in
@@ -84,7 +108,8 @@ struct InteractiveResult {
 /// a step too) ends the run at the state reached, with `interrupted` set. Throws Error on bad options.
 InteractiveResult run_interactive(Simulation& sim, Device& device, const InteractiveOptions& options);
 
-/// A run's summary with its interactive session's: the probe's tool block and the haptic loop's figures.
+/// A run's summary with its interactive session's: the probe's tool block and the haptic loop's figures, and
+/// every other hand's tool block (in `tools`) with its own haptic figures.
 void add_interactive_summary(RunSummary& summary, const InteractiveResult& interactive);
 
 }  // namespace pointhaptics

@@ -158,7 +158,7 @@ Vec3 LevelsOfDetail::contact_of_probe(const Vec3& probe, const std::vector<index
 }
 
 void LevelsOfDetail::follow_probe() {
-  const std::optional<ProbeAttachment>& attached = active_->probe();
+  const ProbeAttachment* attached = active_->probe();
   if (!attached || active_->diagnostics().steps == 0) return;
   const ProbeTool& p = attached->tool;
   const bool onset = p.contacts_before_step() == 0 && p.contact_model().contacts > 0;
@@ -185,7 +185,7 @@ std::vector<index_t> LevelsOfDetail::update(const Vec3& contact, bool onset, boo
         true);
   // the worker only reads the object's model: a cut meanwhile reaches it once the build is done (carry_cuts())
   // and, with a probe on the surface, the part of it the new active set carries
-  const std::optional<ProbeAttachment>& probe = active_->probe();
+  const ProbeAttachment* probe = active_->probe();
   std::shared_ptr<const ObjectSurface> surface =
       probe && probe->surface ? (probe->split ? probe->split : probe->surface) : nullptr;
   const double reach = probe ? tool_reach(probe_shape(probe->tool.contact().params())) : 0.0;

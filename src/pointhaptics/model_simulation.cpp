@@ -66,12 +66,28 @@ void ModelSimulation::continue_from(ModelSimulation&& previous) {
   solver_impl_->continue_from(*previous.solver_impl_);
   diagnostics_ = std::move(previous.diagnostics_);
   inputs_ = previous.inputs_;
-  probe_ = std::move(previous.probe_);
-  // the cuts' sheets, and a split of the surface along them in flight (it reads the object's model)
+  // the hands, with a split of the surface along the cuts' sheets in flight (it reads the object's model)
+  hands_ = std::move(previous.hands_);
   cut_sheets_ = std::move(previous.cut_sheets_);
   sheet_edge_ = previous.sheet_edge_;
-  split_ = std::move(previous.split_);
   log_severed_ = true;
+}
+
+StepInputs& ModelSimulation::inputs(std::size_t hand) {
+  if (hand >= inputs_.size())
+    throw Error(fmt::format("simulation: no hand {} (it has {})", hand, std::max<std::size_t>(hands_.size(), 1)));
+  return inputs_[hand];
+}
+
+void ModelSimulation::add_hand(ProbeAttachment hand) {
+  hands_.push_back(std::move(hand));
+  inputs_.resize(std::max<std::size_t>(hands_.size(), 1));
+  inputs_[hands_.size() - 1] = StepInputs{};
+}
+
+void ModelSimulation::remove_hands() {
+  hands_.clear();
+  inputs_.assign(1, StepInputs{});
 }
 
 double ModelSimulation::stable_dt() const {
@@ -157,11 +173,10 @@ void ModelSimulation::record_cut_sheet(const BladeSweep& sweep) {
   sheet_edge_ = {sweep.a1, sweep.b1, a1, b1};
 }
 
-void ModelSimulation::refresh_probe_surface() {
-  ProbeAttachment& probe = *probe_;
+void ModelSimulation::refresh_probe_surface(ProbeAttachment& probe) {
   // the probe's contact from now on: with the split surface (with levels of detail, its part the active set
   // carries, made here: the active set may have changed since the split began)
-  auto take = [&](SplitContact done) {
+  auto take = [&](SurfaceSplit done) {
     std::vector<index_t> same(static_cast<std::size_t>(model_.n_points));
     std::iota(same.begin(), same.end(), index_t{0});
     SurfaceContact contact =
@@ -174,9 +189,10 @@ void ModelSimulation::refresh_probe_surface() {
     ++diagnostics_.surface_splits;
     diagnostics_.max_split_seconds = std::max(diagnostics_.max_split_seconds, done.seconds);
   };
-  if (split_.valid()) {
-    if (split_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;  // the worker is at it
-    take(split_.get());
+  if (probe.split_in_flight.valid()) {
+    if (probe.split_in_flight.wait_for(std::chrono::seconds(0)) != std::future_status::ready)
+      return;  // the worker is at it
+    take(probe.split_in_flight.get());
   }
   if (probe.surface_revision == cut_sheets_.revision) return;
   // on one thread: in real time the other core runs the haptic loop. The surface is the object's, split along
@@ -187,8 +203,8 @@ void ModelSimulation::refresh_probe_surface() {
                 whole_model = probe.active_set == nullptr]() {
     const StageClock clock;
     tbb::task_arena one_thread(1);
-    SplitContact made = one_thread.execute([&] {
-      SplitContact m{std::make_shared<const ObjectSurface>(split_surface(*surface, object, sheets.triangles)),
+    SurfaceSplit made = one_thread.execute([&] {
+      SurfaceSplit m{std::make_shared<const ObjectSurface>(split_surface(*surface, object, sheets.triangles)),
                      std::nullopt, sheets.revision};
       if (whole_model) m.contact.emplace(probe_surface_contact(*m.surface, params, shape, object, nullptr));
       return m;
@@ -197,7 +213,7 @@ void ModelSimulation::refresh_probe_surface() {
     return made;
   };
   // in real time on a worker, taken over at a later step; otherwise now (reproducible runs)
-  if (probe.asynchronous_lod) split_ = std::async(std::launch::async, std::move(split));
+  if (probe.asynchronous_lod) probe.split_in_flight = std::async(std::launch::async, std::move(split));
   else take(split());
 }
 
@@ -222,16 +238,18 @@ const StepReport& ModelSimulation::step() {
 
 void ModelSimulation::solve() {
   DynamicForces* tools = forces_this_step();
-  solver_impl_->set_real_time(probe_ && probe_->asynchronous_lod);
+  solver_impl_->set_real_time(
+      std::any_of(hands_.begin(), hands_.end(), [](const ProbeAttachment& h) { return h.asynchronous_lod; }));
   report_ = solver_impl_->step(model_, state_, ws_, tools);
   if (tools && report_.status != StepStatus::FAILED) tools->after_step(model_, state_, ws_);
 }
 
 DynamicForces* ModelSimulation::forces_this_step() {
-  DynamicForces* tool = probe_ ? static_cast<DynamicForces*>(&probe_->tool) : held_tool_.get();
-  if (posed_bodies_.empty() && !body_contact_) return tool;
+  if (hands_.size() <= 1 && posed_bodies_.empty() && !body_contact_)
+    return hands_.empty() ? held_tool_.get() : static_cast<DynamicForces*>(&hands_.front().tool);
   forces_.clear();
-  if (tool) forces_.add_member(tool);
+  for (ProbeAttachment& hand : hands_) forces_.add_member(&hand.tool);
+  if (held_tool_) forces_.add_member(held_tool_.get());
   for (PosedBody& o : posed_bodies_) forces_.add_member(&o.contact);
   if (body_contact_) forces_.add_member(body_contact_.get());
   return &forces_;
@@ -251,9 +269,12 @@ void ModelSimulation::place_tools() {
     for (PosedBody& o : posed_bodies_) o.contact.contact().anchor_pressing(state_.u);
     if (held_tool_) held_tool_->contact().anchor_pressing(state_.u);
   }
-  if (!probe_) return;
-  ProbeTool& tool = probe_->tool;
-  tool.place(model_, state_, inputs_.device, inputs_.button, inputs_.orientation);
+  for (std::size_t k = 0; k < hands_.size(); ++k) place_hand(hands_[k], inputs_[k]);
+}
+
+void ModelSimulation::place_hand(ProbeAttachment& hand, const StepInputs& inputs) {
+  ProbeTool& tool = hand.tool;
+  tool.place(model_, state_, inputs.device, inputs.button, inputs.orientation);
   // a blade with its button held cuts the strips its edge swept over its last steps (ProbeTool::blade_trail;
   // nothing on the step a cut starts)
   if (tool.cutting()) {
@@ -265,9 +286,9 @@ void ModelSimulation::place_tools() {
       blade_strips_.push_back(BladeSweep{trail[k][0], trail[k][1], to[0], to[1]});
     }
     tool.resist_cut(model_, blade_strips_.empty() ? CutReport{} : cut(blade_strips_), solver_.dt);
-  } else if (probe_->surface && (split_.valid() || probe_->surface_revision != cut_sheets_.revision)) {
+  } else if (hand.surface && (hand.split_in_flight.valid() || hand.surface_revision != cut_sheets_.revision)) {
     // the blade lifted (or a scripted cut went on): the probe pushes on the split surface from now on
-    refresh_probe_surface();
+    refresh_probe_surface(hand);
   }
 }
 

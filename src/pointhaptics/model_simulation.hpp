@@ -63,7 +63,15 @@ struct StepDiagnostics {
   double max_split_seconds = 0;  ///< the longest split, s (off the simulation's thread in real time)
 };
 
-/// The probe's tool and its settings, as a simulation holds them (carried to the next active model).
+/// A probe's surface split along the cuts' sheets of a revision (made on a worker thread in real time).
+struct SurfaceSplit {
+  std::shared_ptr<const ObjectSurface> surface;  ///< over the object's points
+  std::optional<SurfaceContact> contact;         ///< over the model's, made with it without levels of detail
+  long long revision = 0;
+  double seconds = 0;
+};
+
+/// A device-driven tool (a hand) and its settings, as a simulation holds them (carried to the next active model).
 struct ProbeAttachment {
   ProbeTool tool;
   /// The probe runs in real time: levels of detail are re-selected on a worker thread, and a background
@@ -80,6 +88,9 @@ struct ProbeAttachment {
   /// whose points it is split, and the active set the simulation's model is; null without.
   const Model* object_model = nullptr;
   const ActiveSet* active_set = nullptr;
+  /// The contact with the surface split along the sheets of a revision, being made on a worker thread in real
+  /// time (it reads the model, or with levels of detail the object's model: a hand is dropped before either)
+  std::future<SurfaceSplit> split_in_flight;
 };
 
 /// The probe's contact with `surface` (of the object) over `model`'s points: the whole surface, or with
@@ -137,7 +148,9 @@ class ModelSimulation {
   const CutSheets& cut_sheets() const { return cut_sheets_; }
   /// Replace the state (same model). Throws Error for a state of another size.
   void set_state(const State& state);
-  StepInputs& inputs() { return inputs_; }
+  /// What the caller sets for a hand (0: the first, the only one without probes) before a step. Throws Error for
+  /// a hand the simulation does not have.
+  StepInputs& inputs(std::size_t hand = 0);
   const SolverSpec& solver() const { return solver_; }
   /// The explicit stable step (computed at construction for explicit steps, else when first asked; from the
   /// simulation's own thread).
@@ -147,9 +160,18 @@ class ModelSimulation {
 
   StepDiagnostics& diagnostics() { return diagnostics_; }
   const StepDiagnostics& diagnostics() const { return diagnostics_; }
-  std::optional<ProbeAttachment>& probe() { return probe_; }
-  const std::optional<ProbeAttachment>& probe() const { return probe_; }
-  /// A tool held at a pose the program sets (a static indentation); at most one of it and the probe.
+  /// The device-driven tools (hands), each placed at every step toward its device point (inputs(hand)); the
+  /// first is the probe. Add one with add_hand().
+  std::vector<ProbeAttachment>& hands() { return hands_; }
+  const std::vector<ProbeAttachment>& hands() const { return hands_; }
+  /// The first hand (nullptr without one).
+  ProbeAttachment* probe() { return hands_.empty() ? nullptr : &hands_.front(); }
+  const ProbeAttachment* probe() const { return hands_.empty() ? nullptr : &hands_.front(); }
+  /// A hand from now on, with inputs at rest (no device point: lifted off).
+  void add_hand(ProbeAttachment hand);
+  /// No hand from now on.
+  void remove_hands();
+  /// A tool held at a pose the program sets (a static indentation); at most one of it and the hands.
   std::unique_ptr<HeldTool>& held_tool() { return held_tool_; }
   const HeldTool* held_tool() const { return held_tool_.get(); }
   /// The obstacles and posed tools, pressed on by the bodies beside the probe or held tool.
@@ -174,12 +196,13 @@ class ModelSimulation {
   void place_tools();
   void solve();
   void record_cut_sheet(const BladeSweep& sweep);
-  void refresh_probe_surface();
+  void place_hand(ProbeAttachment& hand, const StepInputs& inputs);
+  void refresh_probe_surface(ProbeAttachment& hand);
   void check_finite(StepReport& report) const;
   void count_inverted_neighbourhoods();
   void record(const StepReport& report, double seconds);
 
-  /// what acts on the model beside its material this step: the probe or held tool, the posed bodies and the
+  /// what acts on the model beside its material this step: the hands or held tool, the posed bodies and the
   /// contact between the bodies
   /// (rebuilt each step from them; no allocation once it has held them all)
   DynamicForces* forces_this_step();
@@ -202,21 +225,13 @@ class ModelSimulation {
   std::vector<std::array<index_t, 2>> severed_log_;
   std::optional<std::array<Vec3, 4>> sheet_edge_;  ///< the last sheet's end edge: where it is now, and mapped back
   std::unique_ptr<Solver> solver_impl_;
-  StepInputs inputs_;
+  std::vector<StepInputs> inputs_ = std::vector<StepInputs>(1);  ///< per hand, at least one
   StepReport report_;
   StepDiagnostics diagnostics_;
-  std::optional<ProbeAttachment> probe_;
   std::unique_ptr<HeldTool> held_tool_;
-  /// The probe's contact with the surface split along the sheets of a revision, being made on a worker
-  /// thread in real time (declared last: destroyed first, it waits for the worker, which reads model_ or,
-  /// with levels of detail, the object's model, and then moves to the next active model's simulation).
-  struct SplitContact {
-    std::shared_ptr<const ObjectSurface> surface;  ///< over the object's points
-    std::optional<SurfaceContact> contact;         ///< over the model's, made with it without levels of detail
-    long long revision = 0;
-    double seconds = 0;
-  };
-  std::future<SplitContact> split_;
+  /// (declared last: destroyed first, a hand's surface split in flight waits for its worker, which reads model_
+  /// or, with levels of detail, the object's model; moved to the next active model's simulation)
+  std::vector<ProbeAttachment> hands_;
 };
 
 }  // namespace pointhaptics

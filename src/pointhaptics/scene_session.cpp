@@ -154,7 +154,11 @@ SceneSession open_scene(Scene scene, const SessionOptions& options) {
     s.interactive = scene_interactive_options(scene, s.simulation->model());
     // the probe pushes on the object's surface (with levels of detail, on the part the active set carries)
     s.interactive.surface = surface_of_object();
-    if (options.make_device) s.device = make_scene_device(scene);
+    for (HandOptions& hand : s.interactive.other_hands) hand.surface = surface_of_object();
+    if (options.make_device) {
+      s.device = make_scene_device(scene);
+      s.other_devices = make_other_hand_devices(scene, s.interactive);
+    }
   }
   s.scene = std::move(scene);
   s.setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -179,43 +183,72 @@ DeviceSpecs scene_device_specs(const DeviceSpec& d) {
 
 }  // namespace
 
-std::unique_ptr<Device> make_scene_device(const Scene& scene) {
-  const DeviceSpecs specs = scene_device_specs(scene.device);
-  if (scene.device.kind == "replay") return std::make_unique<ReplayDevice>(read_haptic_log(scene.device.log), specs);
-  if (scene.device.kind == "openhaptics")
-    return std::make_unique<OpenHapticsDevice>(scene.device.library);  // its own specs
-  if (scene.device.kind != "virtual")
-    throw Error(fmt::format("{}: device.kind = \"{}\" is not available", scene.path, scene.device.kind));
-  if (!scene.probe.trajectory.empty())
-    return std::make_unique<VirtualDevice>(Trajectory::from_csv(scene.probe.trajectory), specs);
+std::unique_ptr<Device> make_hand_device(const Scene& scene, const ProbeSpec& probe, const DeviceSpec& device) {
+  const DeviceSpecs specs = scene_device_specs(device);
+  if (device.kind == "replay") return std::make_unique<ReplayDevice>(read_haptic_log(device.log), specs);
+  if (device.kind == "openhaptics")
+    return std::make_unique<OpenHapticsDevice>(device.library, device.hd_device);  // its own specs
+  if (device.kind != "virtual")
+    throw Error(fmt::format("{}: device.kind = \"{}\" is not available", scene.path, device.kind));
+  if (!probe.trajectory.empty()) return std::make_unique<VirtualDevice>(Trajectory::from_csv(probe.trajectory), specs);
   std::vector<Keyframe> frames;
-  for (const auto& k : scene.probe.keyframes) frames.push_back({k[0], Vec3(k[1], k[2], k[3]), k[4] != 0});
+  for (const auto& k : probe.keyframes) frames.push_back({k[0], Vec3(k[1], k[2], k[3]), k[4] != 0});
   try {
     return std::make_unique<VirtualDevice>(Trajectory(std::move(frames)), specs);
   } catch (const Error& e) {
-    throw Error(fmt::format("{}:{}: probe.keyframes: {}", scene.path, scene.probe.line, e.what()));
+    throw Error(fmt::format("{}:{}: probe.keyframes: {}", scene.path, probe.line, e.what()));
   }
 }
 
-InteractiveOptions scene_interactive_options(const Scene& scene, const Model& model) {
-  InteractiveOptions o;
-  o.probe.radius = scene.probe.radius;
-  o.probe.mode = scene.probe.grab ? ProbeMode::GRAB : scene.probe.cut ? ProbeMode::CUT : ProbeMode::PUSH;
-  o.probe.cut_resistance = scene.probe.cut_resistance;
-  o.probe.stiffness = scene.probe.stiffness;
-  o.probe.object_stiffness = scene.probe.object_stiffness;
-  o.probe.non_negative_surface_map = scene.probe.non_negative_surface_map;
-  o.probe.sample_spacing = scene.probe.sample_spacing;
-  o.probe.friction = scene.probe.friction;
-  o.probe.length = scene.probe.capsule ? scene.probe.length : 0.0;
-  const auto& q = scene.probe.orientation;
-  o.probe.orientation = Eigen::Quaterniond(q[0], q[1], q[2], q[3]);
-  o.mapping.scale = scene.probe.scale;
-  if (scene.probe.origin.allFinite()) {
-    o.mapping.origin = scene.probe.origin;
+std::unique_ptr<Device> make_scene_device(const Scene& scene) {
+  return make_hand_device(scene, scene.probe, scene.device);
+}
+
+std::vector<std::unique_ptr<Device>> make_other_hand_devices(const Scene& scene, InteractiveOptions& options) {
+  if (options.other_hands.size() != scene.other_hands.size())
+    throw Error(fmt::format("{}: the interactive options are not the scene's (other hands)", scene.path));
+  std::vector<std::unique_ptr<Device>> devices;
+  for (std::size_t k = 0; k < scene.other_hands.size(); ++k) {
+    devices.push_back(make_hand_device(scene, scene.other_hands[k].probe, scene.other_hands[k].device));
+    options.other_hands[k].device = devices.back().get();
+  }
+  return devices;
+}
+
+namespace {
+
+// a device-driven tool's probe and workspace mapping (the device origin defaults to 2 probe radii above the
+// centre of the object's top)
+void hand_options(const ProbeSpec& p, const Model& model, ProbeParams& probe, WorkspaceMapping& mapping) {
+  probe.radius = p.radius;
+  probe.mode = p.grab ? ProbeMode::GRAB : p.cut ? ProbeMode::CUT : ProbeMode::PUSH;
+  probe.cut_resistance = p.cut_resistance;
+  probe.stiffness = p.stiffness;
+  probe.object_stiffness = p.object_stiffness;
+  probe.non_negative_surface_map = p.non_negative_surface_map;
+  probe.sample_spacing = p.sample_spacing;
+  probe.friction = p.friction;
+  probe.length = p.capsule ? p.length : 0.0;
+  const auto& q = p.orientation;
+  probe.orientation = Eigen::Quaterniond(q[0], q[1], q[2], q[3]);
+  mapping.scale = p.scale;
+  if (p.origin.allFinite()) {
+    mapping.origin = p.origin;
   } else {
     const Vec3 lo = model.X.rowwise().minCoeff(), hi = model.X.rowwise().maxCoeff();
-    o.mapping.origin = Vec3(0.5 * (lo.x() + hi.x()), hi.y() + 2 * scene.probe.radius, 0.5 * (lo.z() + hi.z()));
+    mapping.origin = Vec3(0.5 * (lo.x() + hi.x()), hi.y() + 2 * p.radius, 0.5 * (lo.z() + hi.z()));
+  }
+}
+
+}  // namespace
+
+InteractiveOptions scene_interactive_options(const Scene& scene, const Model& model) {
+  InteractiveOptions o;
+  hand_options(scene.probe, model, o.probe, o.mapping);
+  for (const SceneHand& h : scene.other_hands) {
+    HandOptions& hand = o.other_hands.emplace_back();
+    hand.name = h.name;
+    hand_options(h.probe, model, hand.probe, hand.mapping);
   }
   o.duration = scene.solver.duration;
   o.rules.passivity_control = scene.device.passivity_control;

@@ -23,6 +23,9 @@ struct SceneSession {
   std::unique_ptr<Simulation> simulation;
   /// With a [probe] and options.make_device: the device the scene names (make_scene_device()).
   std::unique_ptr<Device> device;
+  /// ... and the devices of its other device-driven tools (two hands), in interactive.other_hands' order (which
+  /// point to them)
+  std::vector<std::unique_ptr<Device>> other_devices;
   /// With a [probe]: the probe, workspace mapping and duration of the scene (scene_interactive_options()).
   InteractiveOptions interactive;
   double setup_seconds =
@@ -39,8 +42,15 @@ SceneSession open_scene_file(const std::string& path, const SessionOptions& opti
 /// The device a scene's [probe] and [device] describe: a virtual device following the trajectory or
 /// keyframes, a replay of a recorded log, or an OpenHaptics device. Throws Error naming the scene and the problem.
 std::unique_ptr<Device> make_scene_device(const Scene& scene);
+/// The same for any device-driven tool of the scene (the first is scene.probe and scene.device; the others are in
+/// scene.other_hands).
+std::unique_ptr<Device> make_hand_device(const Scene& scene, const ProbeSpec& probe, const DeviceSpec& device);
+/// The devices of the scene's other hands (scene.other_hands), each given to its hand in `options`
+/// (scene_interactive_options() of the scene).
+std::vector<std::unique_ptr<Device>> make_other_hand_devices(const Scene& scene, InteractiveOptions& options);
 /// The interactive options of a scene: probe, workspace mapping (the device origin defaults to 2 probe
-/// radii above the centre of the object's top), duration (solver.duration; a replay defaults to its log).
+/// radii above the centre of the object's top), duration (solver.duration; a replay defaults to its log), and
+/// its other hands (without devices: open_scene() gives them theirs).
 InteractiveOptions scene_interactive_options(const Scene& scene, const Model& model);
 
 }  // namespace pointhaptics

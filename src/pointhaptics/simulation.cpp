@@ -140,8 +140,17 @@ void Simulation::set_state(const State& state) {
 }
 
 void Simulation::attach_probe(const ProbeParams& params, double coupling_stiffness, double max_force,
-                              bool asynchronous_lod, std::shared_ptr<const ObjectSurface> surface) {
+                              bool asynchronous_lod, std::shared_ptr<const ObjectSurface> surface, std::string name) {
   ModelSimulation& sim = core();
+  if (!sim.hands().empty()) {
+    if (lod_)
+      throw Error(
+          "probe: a second hand with levels of detail is not supported yet (the active set follows one "
+          "contact)");
+    if (name.empty()) name = fmt::format("hand{}", sim.hands().size() + 1);
+    for (std::size_t k = 0; k < sim.hands().size(); ++k)
+      if (hand_name(k) == name) throw Error(fmt::format("probe: \"{}\" is already the name of a hand", name));
+  }
   if (sim.solver().kind == SolverKind::STATIC) throw Error("probe: needs a dynamic solver (explicit or implicit)");
   if (params.mode == ProbeMode::CUT && !(params.length > 0))
     throw Error("probe: a blade is a capsule whose axis is its edge: give it a length");
@@ -174,10 +183,22 @@ void Simulation::attach_probe(const ProbeParams& params, double coupling_stiffne
   if (surface)
     on_surface.emplace(probe_surface_contact(*surface, contact, probe_shape(params), sim.model(),
                                              lod_ ? &lod_->active_set() : nullptr));
-  sim.probe().emplace(
-      ProbeAttachment{ProbeTool(sim.model(), params, coupling_stiffness, max_force, std::move(on_surface)),
-                      asynchronous_lod, std::move(surface), contact, 0, nullptr, nullptr, nullptr});
-  sim.inputs() = StepInputs{};
+  sim.add_hand(ProbeAttachment{ProbeTool(sim.model(), params, coupling_stiffness, max_force, std::move(on_surface)),
+                               asynchronous_lod,
+                               std::move(surface),
+                               contact,
+                               0,
+                               nullptr,
+                               nullptr,
+                               nullptr,
+                               {}});
+  hand_names_.resize(sim.hands().size());
+  hand_names_.back() = std::move(name);
+}
+
+const std::string& Simulation::hand_name(std::size_t hand) const {
+  if (hand >= hands()) throw Error(fmt::format("probe: no hand {} (the simulation has {})", hand, hands()));
+  return hand == 0 ? tool_name_ : hand_names_[hand];
 }
 
 void Simulation::hold_tool(const ToolShape& shape, const ToolPose& pose, const TriangleMesh& mesh, SurfaceMap map,
@@ -276,18 +297,18 @@ void Simulation::set_tool_pose(const ToolPose& pose) {
 HeldTool* Simulation::held_tool() { return core().held_tool().get(); }
 
 void Simulation::detach_probe() {
-  core().probe().reset();
-  core().inputs() = StepInputs{};
+  core().remove_hands();
+  hand_names_.clear();
 }
 
-const ProbeTool* Simulation::probe() const {
-  const std::optional<ProbeAttachment>& p = core().probe();
-  return p ? &p->tool : nullptr;
+const ProbeTool* Simulation::probe(std::size_t hand) const {
+  const std::vector<ProbeAttachment>& hands = core().hands();
+  return hand < hands.size() ? &hands[hand].tool : nullptr;
 }
 
-void Simulation::grabbed_points(std::vector<index_t>& out) const {
+void Simulation::grabbed_points(std::vector<index_t>& out, std::size_t hand) const {
   out.clear();
-  const ProbeTool* p = probe();
+  const ProbeTool* p = probe(hand);
   if (!p) return;
   const ActiveSet* active = active_set();
   for (const index_t i : p->contact().grabbed()) out.push_back(active ? active->full_of[i] : i);
@@ -359,9 +380,9 @@ const char* tool_kind_name(const ToolShape& shape) {
 
 }  // namespace
 
-ToolSummary Simulation::tool_summary() {
+ToolSummary Simulation::tool_summary(std::size_t hand) {
   ModelSimulation& sim = core();
-  if (HeldTool* tool = sim.held_tool().get()) {
+  if (HeldTool* tool = sim.held_tool().get(); tool && hand == 0) {
     const ToolLoad load = tool->load(sim.model(), sim.state().u);
     return {true,
             tool_kind_name(tool->shape()),
@@ -372,7 +393,7 @@ ToolSummary Simulation::tool_summary() {
             load.penetration,
             load.friction};
   }
-  if (const ProbeTool* probe = this->probe()) {
+  if (const ProbeTool* probe = this->probe(hand)) {
     // the probe's local model at the last step's end: the force the object exerts on it there; on the surface
     // its load there, with the torque, the friction and the deepest vertex
     const ContactModel& c = probe->contact_model();
@@ -471,6 +492,7 @@ RunSummary Simulation::summary() {
   if (lod_) lod_->fill(s.lod);
   s.tool = tool_summary();
   s.tool_name = tool_name_;
+  for (std::size_t k = 1; k < hands(); ++k) s.tools.emplace_back(hand_names_[k], tool_summary(k));
   for (PosedBody& o : sim.posed_bodies()) {
     const ToolLoad load = o.contact.load(model, state.u);
     (o.role == PosedBody::Role::OBSTACLE ? s.obstacles : s.tools)

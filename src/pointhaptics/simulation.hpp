@@ -42,8 +42,9 @@ class Simulation {
   /// The steps run(duration) takes (1 for a static solve); throws Error as run() does.
   long long steps_in(double duration) const;
   static constexpr double max_run_steps = 1e12;
-  /// Filled by the caller before a step (MuJoCo's step1/step2).
-  StepInputs& inputs() { return core().inputs(); }
+  /// Filled by the caller before a step (MuJoCo's step1/step2), per hand (0: the first probe). Throws Error for a
+  /// hand the simulation does not have.
+  StepInputs& inputs(std::size_t hand = 0) { return core().inputs(hand); }
   const StepDiagnostics& diagnostics() const { return core().diagnostics(); }
 
   /// The object and its state (with levels of detail: the active state carried back to the object, absorbed
@@ -68,12 +69,21 @@ class Simulation {
   /// `surface`: the object's surface, which the probe then pushes on (issue 16) instead of the point
   /// spheres; with levels of detail the part of it that the active set carries (scenes do not ask for it:
   /// a slow real-time run diverged with it, tests/integration/realtime_lod_soak.py).
+  /// A second call adds a second hand (issue 47: two devices, each its own probe, placed toward inputs(1)), and so
+  /// on; each touches every body. `name`: what summary() reports a second or later hand under (empty: "hand2",
+  /// ...; the first is reported under set_tool_name()'s). Throws Error for a second hand with levels of detail
+  /// (the active set follows one contact) or a name already taken.
   void attach_probe(const ProbeParams& params, double coupling_stiffness, double max_force, bool asynchronous_lod,
-                    std::shared_ptr<const ObjectSurface> surface = nullptr);
+                    std::shared_ptr<const ObjectSurface> surface = nullptr, std::string name = {});
+  /// Every hand detached.
   void detach_probe();
-  /// The probe (nullptr without one): its position and last local contact model. Its contact's point
-  /// indices are the simulated model's; grabbed_points() gives the object's.
-  const ProbeTool* probe() const;
+  /// The hand's probe (nullptr without it; 0: the first): its position and last local contact model. Its
+  /// contact's point indices are the simulated model's; grabbed_points() gives the object's.
+  const ProbeTool* probe(std::size_t hand = 0) const;
+  /// Hands attached (attach_probe()).
+  std::size_t hands() const { return core().hands().size(); }
+  /// The name a hand is reported under.
+  const std::string& hand_name(std::size_t hand) const;
   /// A tool held at `pose` against the object's surface (`mesh`, carried by `map` over the object's points),
   /// for any solver: the static solver finds the equilibrium with it there; set_tool_pose() moves it between
   /// steps. Throws Error with levels of detail or a probe (one tool at a time).
@@ -105,8 +115,8 @@ class Simulation {
   void set_tool_pose(const ToolPose& pose);
   /// The held tool (nullptr without one).
   HeldTool* held_tool();
-  /// The object's points the probe holds (cleared first; allocates only to grow).
-  void grabbed_points(std::vector<index_t>& out) const;
+  /// The object's points the hand's probe holds (cleared first; allocates only to grow).
+  void grabbed_points(std::vector<index_t>& out, std::size_t hand = 0) const;
 
   /// A scripted blade from now on (a scene's [[cut]]): every dynamic step first cuts where the trail its edge has
   /// swept by the end of the step crosses the object (so material that moved back over the trail is cut too);
@@ -139,8 +149,9 @@ class Simulation {
   /// Selections made so far (0 without levels of detail): a new one means a new active set.
   long long lod_selections() const;
 
-  /// The tool (held, or the probe) at the current state: what the object does to it. Not present without one.
-  ToolSummary tool_summary();
+  /// The tool (held, or the hand's probe) at the current state: what the object does to it. Not present without
+  /// one.
+  ToolSummary tool_summary(std::size_t hand = 0);
   /// Results at the current state: energies (of what is simulated), reactions, residual, timing, and the
   /// levels of detail.
   RunSummary summary();
@@ -155,6 +166,7 @@ class Simulation {
   std::unique_ptr<ModelSimulation> object_;  ///< without levels of detail
   std::unique_ptr<LevelsOfDetail> lod_;      ///< with them (then object_ is empty)
   std::string tool_name_ = "probe";
+  std::vector<std::string> hand_names_;  ///< per hand (the first's unused: it is tool_name_)
   struct ScriptedCut {
     CutSpec spec;
     double done = 0;  ///< the share of its sweep already cut

@@ -84,13 +84,17 @@ std::string result_json(const Model& model, const State& state, const RunSummary
                      {"held_object_stray_mean_n", m.held_object_mean_n},
                      {"held_object_stray_max_n", m.held_object_max_n}}}};
   const auto tool_block = [&](const ToolSummary& t) {
-    return json{{"kind", t.kind},
-                {"position", vec(t.position)},
-                {"force", vec(t.force)},
-                {"torque", vec(t.torque)},
-                {"contacts", t.contacts},
-                {"penetration", t.penetration},
-                {"friction", vec(t.friction)}};
+    json block{{"kind", t.kind},
+               {"position", vec(t.position)},
+               {"force", vec(t.force)},
+               {"torque", vec(t.torque)},
+               {"contacts", t.contacts},
+               {"penetration", t.penetration},
+               {"friction", vec(t.friction)}};
+    if (t.haptic_ticks > 0)
+      block["haptic"] = {
+          {"ticks", t.haptic_ticks}, {"period_p99_us", t.haptic_period_p99_us}, {"max_force_n", t.haptic_max_force_n}};
+    return block;
   };
   if (s.tool.present) doc["tool"] = tool_block(s.tool);
   if (s.tool.present || !s.tools.empty()) {

@@ -47,6 +47,10 @@ struct ToolSummary {
   int contacts = 0;              ///< surface vertices (probe on points: points) pressing on it
   double penetration = 0;        ///< deepest surface vertex inside the tool, m (held tools)
   Vec3 friction = Vec3::Zero();  ///< N, the part of `force` friction makes (held tools with friction)
+  /// A device-driven tool (a hand): its own haptic loop's ticks, p99 period error (us) and largest force (N)
+  /// (the first hand's are also the top-level `haptic` block); 0 ticks: not driven by a device
+  long long haptic_ticks = 0;
+  double haptic_period_p99_us = 0, haptic_max_force_n = 0;
 };
 
 /// How far the haptic side's local model F(p) = f0 + K (p - p0) strays from the next update's force f0' at

@@ -162,7 +162,10 @@ struct DeviceSpec {
   double max_torque = 0;             ///< custom specs: the largest torque it renders, N m (0: none)
   std::string log;                   ///< replay: a recorded session (resolved path)
   std::string library = "libHD.so";  ///< openhaptics: the HD library to load
-  bool passivity_control = true;     ///< ForceRules::passivity_control
+  /// openhaptics: the device's configuration name in OpenHaptics' set-up ("Left Device"; empty: the default
+  /// device), so that two Touch devices drive two tools
+  std::string hd_device;
+  bool passivity_control = true;  ///< ForceRules::passivity_control
 };
 
 /// [[tool]] (issue 47): a named tool. Held at a `position`, or moved along `keyframes` by the scene (both in scene
@@ -176,6 +179,13 @@ struct ToolSpec {
   std::vector<std::array<double, 4>> path;
   std::string device;  ///< the [[device]] that drives it (empty: posed by the scene)
   int line = 0;
+};
+
+/// A second or later device-driven [[tool]] (issue 47: two hands): its keys and its [[device]]'s.
+struct SceneHand {
+  std::string name;
+  ProbeSpec probe;
+  DeviceSpec device;
 };
 
 /// [[device]] (issue 47): a named device, with [device]'s keys, that a [[tool]] names.
@@ -255,7 +265,8 @@ struct Scene {
   std::vector<LoadSpec> loads;
   std::vector<CutSpec> cuts;
   std::vector<ObstacleSpec> obstacles;
-  /// [[tool]] tables: the posed ones (position or keyframes); one driven by a device is `probe` and `device`
+  /// [[tool]] tables: the posed ones (position or keyframes); the first driven by a device is `probe` and
+  /// `device`, the others other_hands
   std::vector<ToolSpec> tools;
   std::vector<DeviceTable> devices;  ///< [[device]] tables
   ContactSpec contact;
@@ -263,6 +274,8 @@ struct Scene {
   ProbeSpec probe;
   std::string probe_name;  ///< the [[tool]] the probe was given as (empty: [probe])
   DeviceSpec device;
+  /// The device-driven [[tool]]s after the first (which is `probe` and `device`), in the file's order
+  std::vector<SceneHand> other_hands;
   LodSpec lod;
 };
 

@@ -776,7 +776,10 @@ void read_probe(TableReader& r, ProbeSpec& p, const Context& ctx) {
 
 void read_device(TableReader& r, DeviceSpec& d, const Context& ctx) {
   d.kind = r.choice("kind", "virtual", {"virtual", "replay", "openhaptics"});
-  if (d.kind == "openhaptics") d.library = r.string("library", d.library);
+  if (d.kind == "openhaptics") {
+    d.library = r.string("library", d.library);
+    d.hd_device = r.string("hd_device", d.hd_device);
+  }
   d.specs = r.choice("specs", "touch", {"touch", "omni", "falcon", "custom"});
   d.passivity_control = r.boolean("passivity_control", d.passivity_control);
   if (d.specs == "custom") {
@@ -908,9 +911,8 @@ void bind_tools(Scene& scene, bool device_section) {
         fail(scene.devices[a].line,
              fmt::format("device[{}].name: \"{}\" is already the name of device[{}] (names are unique)", a,
                          scene.devices[a].name, b));
-  std::vector<int> driven(scene.devices.size(), -1);  // the tool each device drives
-  int hands = 0;
-  std::size_t hand_tool = 0, hand_device = 0;  // the device-driven tool and its device
+  std::vector<int> driven(scene.devices.size(), -1);       // the tool each device drives
+  std::vector<std::pair<std::size_t, std::size_t>> hands;  // the device-driven tools and their devices
   for (std::size_t k = 0; k < scene.tools.size(); ++k) {
     const ToolSpec& t = scene.tools[k];
     if (t.device.empty()) continue;
@@ -928,15 +930,10 @@ void bind_tools(Scene& scene, bool device_section) {
       fail(t.line, fmt::format("tool[{}].device: \"{}\" already drives tool[{}] \"{}\" (one tool per device)", k,
                                t.device, driven[slot], scene.tools[static_cast<std::size_t>(driven[slot])].name));
     driven[slot] = static_cast<int>(k);
-    hand_tool = k;
-    hand_device = slot;
+    hands.emplace_back(k, slot);
     if (t.probe.held())
       fail(t.line, fmt::format("tool[{}].position: a tool driven by a device is not held at a position (leave out "
                                "position, or device)",
-                               k));
-    if (++hands > 1)
-      fail(t.line, fmt::format("tool[{}].device: a second tool driven by a device (two hands) is not supported yet: "
-                               "one tool follows a device, the others are posed (position or keyframes)",
                                k));
     if (scene.probe.present || device_section)
       fail(t.line, fmt::format("tool[{}].device: the scene's [probe] / [device] already make its device-driven tool "
@@ -948,12 +945,19 @@ void bind_tools(Scene& scene, bool device_section) {
       fail(scene.devices[k].line,
            fmt::format("device[{}]: \"{}\" drives no tool (a [[tool]] names it: device = \"{}\")", k,
                        scene.devices[k].name, scene.devices[k].name));
-  // the device-driven tool is the scene's probe, its device the scene's device
-  if (hands == 0) return;
-  scene.probe = scene.tools[hand_tool].probe;
-  scene.device = scene.devices[hand_device].spec;
-  scene.probe_name = scene.tools[hand_tool].name;
-  scene.tools.erase(scene.tools.begin() + static_cast<std::ptrdiff_t>(hand_tool));
+  // the first device-driven tool is the scene's probe, its device the scene's device; the others are more hands
+  if (hands.empty()) return;
+  for (std::size_t h = 0; h < hands.size(); ++h) {
+    const auto [tool, device] = hands[h];
+    if (h == 0) {
+      scene.probe = scene.tools[tool].probe;
+      scene.device = scene.devices[device].spec;
+      scene.probe_name = scene.tools[tool].name;
+    } else {
+      scene.other_hands.push_back({scene.tools[tool].name, scene.tools[tool].probe, scene.devices[device].spec});
+    }
+  }
+  std::erase_if(scene.tools, [](const ToolSpec& t) { return !t.device.empty(); });
 }
 
 // Each [[fixed]] and [[load]] names an [[object]] (optional with one, and for gravity, which loads every one), and
@@ -1088,27 +1092,39 @@ Scene parse_scene(std::string_view text, const std::string& name, const std::str
   bind_tools(scene, device_section);
   section("lod", [&](TableReader& r) { read_lod(r, scene.lod); });
   section("contact", [&](TableReader& r) { read_contact(r, scene.contact); });
-  if (scene.probe.present && !scene.probe.held() && scene.device.kind == "virtual" && scene.probe.trajectory.empty() &&
-      scene.probe.keyframes.empty())
-    throw Error(fmt::format(
-        "{}:{}: probe: a virtual device needs trajectory = \"probe.csv\" or keyframes = [[t, x, y, z], ...] "
-        "(or position = [x, y, z] for a tool held there)",
-        name, scene.probe.line));
-  if (scene.probe.present && !scene.probe.held() && scene.probe.friction > 0 && scene.lod.present)
-    throw Error(
-        fmt::format("{}:{}: probe.friction: a device's probe with levels of detail touches the point spheres, which "
-                    "are frictionless",
-                    name, scene.probe.line));
+  // each device-driven tool (a hand): [probe], or a [[tool]] with a device
+  const auto check_hand = [&](const ProbeSpec& probe, const DeviceSpec& device, const std::string& what) {
+    if (device.kind == "virtual" && probe.trajectory.empty() && probe.keyframes.empty())
+      throw Error(
+          fmt::format("{}:{}: {}: a virtual device needs trajectory = \"probe.csv\" or keyframes = [[t, x, y, z], ...] "
+                      "(or position = [x, y, z] for a tool held there)",
+                      name, probe.line, what));
+    if (probe.friction > 0 && scene.lod.present)
+      throw Error(
+          fmt::format("{}:{}: {}.friction: a device's probe with levels of detail touches the point spheres, which "
+                      "are frictionless",
+                      name, probe.line, what));
+    if (scene.solver.kind == SolverKind::STATIC)
+      throw Error(
+          fmt::format("{}:{}: {}: a static solve holds the tool at a position: give position = [x, y, z] (a probe "
+                      "driven by a device needs solver.kind = \"explicit\" or \"implicit\")",
+                      name, probe.line, what));
+  };
+  if (scene.probe.present && !scene.probe.held())
+    check_hand(scene.probe, scene.device, scene.probe_name.empty() ? "probe" : "tool \"" + scene.probe_name + "\"");
+  for (const SceneHand& hand : scene.other_hands) {
+    check_hand(hand.probe, hand.device, "tool \"" + hand.name + "\"");
+    if (scene.lod.present)
+      throw Error(
+          fmt::format("{}:{}: tool \"{}\": a second device-driven tool (two hands) is not yet with levels "
+                      "of detail (the active set follows one contact)",
+                      name, hand.probe.line, hand.name));
+  }
   if (scene.probe.held() && device_section)
     throw Error(
         fmt::format("{}:{}: probe: a tool held at a position is not driven by a [device]", name, scene.probe.line));
   if (device_section && !scene.probe.present)
     throw Error(fmt::format("{}: device: a [device] needs a [probe] to drive", name));
-  if (scene.probe.present && !scene.probe.held() && scene.solver.kind == SolverKind::STATIC)
-    throw Error(
-        fmt::format("{}:{}: probe: a static solve holds the tool at a position: give position = [x, y, z] (a probe "
-                    "driven by a device needs solver.kind = \"explicit\" or \"implicit\")",
-                    name, scene.probe.line));
   read_array_of_tables(top, "fixed", [&](TableReader& r) { scene.fixed.push_back(read_fixed(r)); });
   read_array_of_tables(top, "region", [&](TableReader& r) { scene.regions.push_back(read_region(r)); });
   read_array_of_tables(top, "load", [&](TableReader& r) { scene.loads.push_back(read_load(r)); });
