@@ -117,6 +117,27 @@ TEST(TwoHands, AreReadAsTheProbeAndOneMoreHand) {
   EXPECT_NE(s.interactive.other_hands[0].surface, nullptr) << "it pushes on the bodies' surface";
 }
 
+TEST(TwoHands, AViewerPutsTheToolItDrivesFirst) {
+  Scene scene = parse_scene(two_blocks_two_hands(0.016, 0.008), "scene.toml");
+  put_hand_first(scene, "b");
+  EXPECT_EQ(scene.probe_name, "b");
+  EXPECT_EQ(scene.probe.origin, Vec3(0.08, 0.03, 0.02));
+  ASSERT_EQ(scene.other_hands.size(), 1u);
+  EXPECT_EQ(scene.other_hands[0].name, "a");
+  EXPECT_EQ(scene.other_hands[0].probe.origin, Vec3(0.02, 0.03, 0.02));
+  put_hand_first(scene, "b");  // already first
+  EXPECT_EQ(scene.probe_name, "b");
+  try {
+    put_hand_first(scene, "c");
+    FAIL() << "no tool c";
+  } catch (const Error& e) {
+    EXPECT_NE(
+        std::string(e.what()).find("no device-driven tool is named \"c\" (the device-driven tools: \"b\", \"a\")"),
+        std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(TwoHands, MistakesAreNamed) {
   // a second hand with levels of detail
   const std::string lod = error_of(two_blocks_two_hands(0.01, 0.01, "explicit", "[lod]\nk1 = 1.0"), false);

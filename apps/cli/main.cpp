@@ -457,6 +457,9 @@ int cli_main(int argc, char** argv) {
                    "What drives the probe: auto (a device if present, else the mouse), mouse, "
                    "script (the scene's trajectory), device")
       ->check(CLI::IsMember({"auto", "mouse", "script", "device"}));
+  view_cmd->add_option("--tool", view.tool,
+                       "The device-driven [[tool]] the mouse (or --probe's source) drives; the scene's other hands "
+                       "keep their own devices (default: the first)");
   view_cmd
       ->add_option("--colour", view.colour,
                    "Colour the object by displacement, von Mises stress or level-of-detail band (seed Fig. 6)")

@@ -89,6 +89,61 @@ void build_spheres(const Prepared& p, const DisplayFrame& f, SceneView& view) {
   if (f.probe.allFinite()) view.spheres.push_back(sphere(f.probe, probe_colour_of(view), probe_radius));
   if (f.device.allFinite() && f.probe.allFinite() && (f.device - f.probe).norm() > 0.3 * probe_radius)
     view.spheres.push_back(sphere(f.device, {0.8f, 0.8f, 0.85f}, 0.25 * probe_radius));
+  for (const DisplayFrame::RigidShape& r : f.rigid)
+    add_rigid_shape(r,
+                    r.hand                                                             ? probe_colour_of(view)
+                    : r.shape.kind == ToolKind::PLANE || r.shape.kind == ToolKind::BOX ? obstacle_colour
+                                                                                       : posed_tool_colour,
+                    p.lo, p.hi, p.point_radius, view.spheres);
+}
+
+void add_rigid_shape(const DisplayFrame::RigidShape& r, const Rgb& colour, const Vec3& lo, const Vec3& hi,
+                     double dot_radius, std::vector<Sphere>& spheres) {
+  const ToolShape& s = r.shape;
+  const Vec3& at = r.pose.position;
+  if (!at.allFinite()) return;
+  const Eigen::Matrix3d axes = r.pose.orientation.toRotationMatrix();
+  // a row of spheres from a to b, at most half their radius apart (at most 64)
+  const auto row = [&](const Vec3& a, const Vec3& b, double radius) {
+    const int n = std::clamp(static_cast<int>(std::ceil((b - a).norm() / (0.5 * radius))), 1, 64);
+    for (int k = 0; k <= n; ++k) spheres.push_back(sphere(a + (b - a) * (static_cast<double>(k) / n), colour, radius));
+  };
+  switch (s.kind) {
+    case ToolKind::SPHERE: spheres.push_back(sphere(at, colour, s.radius)); break;
+    case ToolKind::CAPSULE: {
+      const Vec3 half = 0.5 * s.length * axes.col(2);
+      row(at - half, at + half, s.radius);
+      break;
+    }
+    case ToolKind::BOX: {  // its twelve edges
+      const Vec3 h = s.half_core.array() + s.radius;
+      const double radius = std::max(s.radius, h.maxCoeff() / 64.0);
+      for (int axis = 0; axis < 3; ++axis)
+        for (int a = -1; a <= 1; a += 2)
+          for (int b = -1; b <= 1; b += 2) {
+            Vec3 corner = Vec3::Zero();
+            corner[(axis + 1) % 3] = a * h[(axis + 1) % 3];
+            corner[(axis + 2) % 3] = b * h[(axis + 2) % 3];
+            Vec3 end = corner;
+            corner[axis] = -h[axis];
+            end[axis] = h[axis];
+            row(at + axes * corner, at + axes * end, radius);
+          }
+      break;
+    }
+    case ToolKind::PLANE: {  // a grid of dots under the objects, twice their extent
+      const Vec3 normal = axes.col(2);
+      const Vec3 centre = 0.5 * (lo + hi);
+      const Vec3 foot = centre - normal * normal.dot(centre - at);
+      const double extent = std::max((hi - lo).norm(), 1e-3);
+      const Vec3 t1 = axes.col(0), t2 = axes.col(1);
+      constexpr int n = 16;
+      for (int i = -n; i <= n; ++i)
+        for (int j = -n; j <= n; ++j)
+          spheres.push_back(sphere(foot + extent * (i * t1 + j * t2) / n, colour, 0.5 * dot_radius));
+      break;
+    }
+  }
 }
 
 void build_surface(const Prepared& p, const DisplayFrame& f, SceneView& view) {

@@ -43,6 +43,10 @@ inline constexpr double panel_width = 340;
 /// band; with levels of detail the points not simulated are paler) unless the surface is drawn without
 /// them, then the probe, then the device point when it is apart from the probe.
 void build_spheres(const Prepared& prepared, const DisplayFrame& frame, SceneView& view);
+/// A rigid shape (another hand's probe, an obstacle, a posed tool) as spheres: a sphere, a capsule's axis, a box's
+/// edges, a plane's grid of dots under the objects (between lo and hi).
+void add_rigid_shape(const DisplayFrame::RigidShape& shape, const Rgb& colour, const Vec3& lo, const Vec3& hi,
+                     double dot_radius, std::vector<Sphere>& spheres);
 
 /// Fill view.surface_vertices (and, for a new object, view.surface_indices) for the frame: the surface
 /// carried by the frame's displacements, smooth normals (area-weighted), each vertex coloured as its

@@ -1,5 +1,7 @@
 #include "viewer.hpp"
 
+#include <pointhaptics/scene_session.hpp>
+
 #include "gl_context.hpp"
 #include "panels.hpp"
 #include "point_renderer.hpp"
@@ -43,7 +45,12 @@ std::string default_scene() {
 
 namespace {
 
-Scene read_viewer_scene(const ViewerOptions& o) { return read_scene_file(o.scene.empty() ? default_scene() : o.scene); }
+// the scene, with the tool the mouse (or --probe's source) drives first among its device-driven tools
+Scene read_viewer_scene(const ViewerOptions& o) {
+  Scene scene = read_scene_file(o.scene.empty() ? default_scene() : o.scene);
+  if (!o.tool.empty()) put_hand_first(scene, o.tool);
+  return scene;
+}
 
 // ImGui without a platform backend (headless): the display size and a clock are all it needs
 void begin_headless_imgui_frame(int width, int height) {

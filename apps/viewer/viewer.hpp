@@ -12,6 +12,7 @@ struct ViewerOptions {
   double run_for = 0;      ///< window: close after this many seconds of wall time (0: when the user closes it)
   int width = 1280, height = 800;
   std::string probe = "auto";  ///< auto | mouse | script | device
+  std::string tool;  ///< the device-driven [[tool]] that source drives (empty: the first); the others keep theirs
   int threads = 0;
   int frames = 1;      ///< headless: draw this many frames (the camera turning) and report the time per frame
   bool panels = true;  ///< draw the panels (left column)

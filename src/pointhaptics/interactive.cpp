@@ -36,6 +36,16 @@ void publish_display(Simulation& sim, const HapticFrame& haptic, long long step,
     for (const index_t i : selection.selected) d.lod_band[i] = selection.band[i];
     d.lod_selections = sim.lod_selections();
   }
+  d.rigid.clear();  // the same shapes every frame: no allocation once each slot has held them
+  for (std::size_t k = 1; k < sim.hands(); ++k) {
+    const ProbeTool& hand = *sim.probe(k);
+    const SurfaceContact* on_surface = hand.surface_contact();
+    d.rigid.push_back(
+        {on_surface ? on_surface->shape() : probe_shape(hand.contact().params()),
+         ToolPose{hand.probe(), on_surface ? on_surface->pose().orientation : Eigen::Quaterniond::Identity()}, true});
+  }
+  for (const PosedBody& body : sim.posed_bodies())
+    d.rigid.push_back({body.contact.shape(), body.contact.pose(), false});
   if (d.cut_revision != sim.cut_sheets().revision) {  // after a cut (each slot catches up once)
     d.cut_sheets = sim.cut_sheets().triangles;
     d.cut_revision = sim.cut_sheets().revision;

@@ -30,6 +30,14 @@ struct DisplayFrame {
   /// a viewer splits the object's surface along them.
   std::vector<SheetTriangle> cut_sheets;
   long long cut_revision = 0;
+  /// The rigid shapes besides the first probe, where they are: the other hands' probes, the obstacles and the posed
+  /// tools (a viewer draws them)
+  struct RigidShape {
+    ToolShape shape;
+    ToolPose pose;
+    bool hand = false;  ///< a device's probe (else an obstacle or a posed tool)
+  };
+  std::vector<RigidShape> rigid;
 };
 
 /// A second (or later) hand of an interactive run (issue 47): its own device, probe and workspace, its own haptic

@@ -1,6 +1,7 @@
 #include <pointhaptics/scene_session.hpp>
 
 #include <pointhaptics/core/run_control.hpp>
+#include <pointhaptics/haptics/devices/haply_device.hpp>
 #include <pointhaptics/haptics/devices/openhaptics_device.hpp>
 #include <pointhaptics/haptics/devices/replay_device.hpp>
 #include <pointhaptics/haptics/devices/virtual_device.hpp>
@@ -188,6 +189,13 @@ std::unique_ptr<Device> make_hand_device(const Scene& scene, const ProbeSpec& pr
   if (device.kind == "replay") return std::make_unique<ReplayDevice>(read_haptic_log(device.log), specs);
   if (device.kind == "openhaptics")
     return std::make_unique<OpenHapticsDevice>(device.library, device.hd_device);  // its own specs
+  if (device.kind == "haply") {                                                    // its own specs
+    HaplyOptions haply;
+    haply.host = device.host;
+    haply.port = device.port;
+    haply.device_id = device.device_id;
+    return std::make_unique<HaplyDevice>(haply);
+  }
   if (device.kind != "virtual")
     throw Error(fmt::format("{}: device.kind = \"{}\" is not available", scene.path, device.kind));
   if (!probe.trajectory.empty()) return std::make_unique<VirtualDevice>(Trajectory::from_csv(probe.trajectory), specs);
@@ -202,6 +210,23 @@ std::unique_ptr<Device> make_hand_device(const Scene& scene, const ProbeSpec& pr
 
 std::unique_ptr<Device> make_scene_device(const Scene& scene) {
   return make_hand_device(scene, scene.probe, scene.device);
+}
+
+void put_hand_first(Scene& scene, const std::string& tool) {
+  const std::string first = scene.probe_name.empty() ? "probe" : scene.probe_name;
+  if (scene.probe.present && !scene.probe.held() && tool == first) return;
+  for (SceneHand& hand : scene.other_hands)
+    if (hand.name == tool) {
+      std::swap(hand.probe, scene.probe);
+      std::swap(hand.device, scene.device);
+      hand.name = first;
+      scene.probe_name = tool;
+      return;
+    }
+  std::string names = scene.probe.present && !scene.probe.held() ? "\"" + first + "\"" : "";
+  for (const SceneHand& hand : scene.other_hands) names += (names.empty() ? "\"" : ", \"") + hand.name + "\"";
+  throw Error(fmt::format("{}: no device-driven tool is named \"{}\" ({})", scene.path, tool,
+                          names.empty() ? std::string("the scene has none") : "the device-driven tools: " + names));
 }
 
 std::vector<std::unique_ptr<Device>> make_other_hand_devices(const Scene& scene, InteractiveOptions& options) {

@@ -45,6 +45,10 @@ std::unique_ptr<Device> make_scene_device(const Scene& scene);
 /// The same for any device-driven tool of the scene (the first is scene.probe and scene.device; the others are in
 /// scene.other_hands).
 std::unique_ptr<Device> make_hand_device(const Scene& scene, const ProbeSpec& probe, const DeviceSpec& device);
+/// Make the device-driven tool named `tool` the scene's first hand (its probe and device), the one a viewer's mouse
+/// drives; the first moves to its place among the other hands. Throws Error naming the device-driven tools when
+/// none is named so.
+void put_hand_first(Scene& scene, const std::string& tool);
 /// The devices of the scene's other hands (scene.other_hands), each given to its hand in `options`
 /// (scene_interactive_options() of the scene).
 std::vector<std::unique_ptr<Device>> make_other_hand_devices(const Scene& scene, InteractiveOptions& options);

@@ -101,6 +101,8 @@ class Simulation {
   /// over time, added to `pose` (empty: held at `pose`). Any number of them, beside a probe or held tool.
   void add_posed_tool(std::string name, const ToolShape& shape, const ToolPose& pose, const TriangleMesh& mesh,
                       SurfaceMap map, const SurfaceContactParams& params = {}, const Trajectory& path = {});
+  /// The obstacles and posed tools, in the order they were added.
+  const std::vector<PosedBody>& posed_bodies() const { return core().posed_bodies(); }
   /// What the bodies exert on each posed tool ([[tool]] with a position or keyframes) now, by name, in the order
   /// they were added: the rows of `run --tool-log`.
   std::vector<std::pair<std::string, ToolLoad>> posed_tool_loads();

@@ -156,8 +156,8 @@ struct ProbeSpec {
 
 /// [device]: which device drives the probe.
 struct DeviceSpec {
-  std::string kind = "virtual";                                                    ///< virtual | replay | openhaptics
-  std::string specs = "touch";                                                     ///< touch | omni | falcon | custom
+  std::string kind = "virtual";  ///< virtual | replay | openhaptics | haply
+  std::string specs = "touch";   ///< touch | omni | falcon | custom
   double max_force = 0, max_stiffness = 0, max_damping = 0, workspace_radius = 0;  ///< custom specs
   double max_torque = 0;             ///< custom specs: the largest torque it renders, N m (0: none)
   std::string log;                   ///< replay: a recorded session (resolved path)
@@ -165,6 +165,10 @@ struct DeviceSpec {
   /// openhaptics: the device's configuration name in OpenHaptics' set-up ("Left Device"; empty: the default
   /// device), so that two Touch devices drive two tools
   std::string hd_device;
+  /// haply: the Inverse Service's simulation channel (ws://host:port) and the Inverse3 to drive (empty: the first)
+  std::string host = "127.0.0.1";
+  int port = 10001;
+  std::string device_id;
   bool passivity_control = true;  ///< ForceRules::passivity_control
 };
 

@@ -775,10 +775,17 @@ void read_probe(TableReader& r, ProbeSpec& p, const Context& ctx) {
 }
 
 void read_device(TableReader& r, DeviceSpec& d, const Context& ctx) {
-  d.kind = r.choice("kind", "virtual", {"virtual", "replay", "openhaptics"});
+  d.kind = r.choice("kind", "virtual", {"virtual", "replay", "openhaptics", "haply"});
   if (d.kind == "openhaptics") {
     d.library = r.string("library", d.library);
     d.hd_device = r.string("hd_device", d.hd_device);
+  }
+  if (d.kind == "haply") {
+    d.host = r.string("host", d.host);
+    d.port = static_cast<int>(r.number(
+        "port", d.port, [](double x) { return x >= 1 && x <= 65535 && x == std::floor(x); },
+        "must be a whole number in [1, 65535]"));
+    d.device_id = r.string("device_id", d.device_id);
   }
   d.specs = r.choice("specs", "touch", {"touch", "omni", "falcon", "custom"});
   d.passivity_control = r.boolean("passivity_control", d.passivity_control);
