@@ -238,4 +238,83 @@ TEST(Tools, TwoKeyframedToolsLiftASampleOffTheTable) {
   EXPECT_GT(slipped.obstacles[0].second.contacts, 0);
 }
 
+// a grasper: capsule jaws of 5 mm radius and 16 mm (their axes along y), moved along `keyframes` [t, x, y, z, opening]
+std::string grasper(const std::string& keyframes, double mu = 0.5) {
+  return fmt::format(R"(
+[[tool]]
+name = "grasper"
+shape = "grasper"
+radius = 0.005
+length = 0.016
+orientation = [0.7071067811865476, -0.7071067811865476, 0.0, 0.0]
+friction = {}
+keyframes = {}
+)",
+                     mu, keyframes);
+}
+
+TEST(Tools, AGrasperIsReadAndItsMistakesNamed) {
+  const Scene scene =
+      parse_scene(sample("kind = \"implicit\"", grasper("[[0.0, 0.01, 0.0125, 0.01, 0.021], [0.1, 0.01, 0.0125, 0.01, "
+                                                        "0.018]]")),
+                  "scene.toml");
+  ASSERT_EQ(scene.tools.size(), 1u);
+  EXPECT_TRUE(scene.tools[0].probe.grasper);
+  EXPECT_EQ(scene.tools[0].opening, (std::vector<double>{0.021, 0.018}));
+  struct Case {
+    std::string text, message;
+  };
+  const std::vector<Case> cases = {
+      {grasper("[[0.0, 0.01, 0.0125, 0.01]]"), "each keyframe is [t, x, y, z, opening]"},
+      {grasper("[[0.0, 0.01, 0.0125, 0.01, 2.0]]"), "opening (the 5th value) must lie in [0, 1]"},
+      {"[[tool]]\nname = \"g\"\nshape = \"grasper\"\nlength = 0.01\nposition = [0.0, 0.03, 0.0]",
+       "needs opening = <m>"},
+      {"[[tool]]\nname = \"g\"\nshape = \"grasper\"\nposition = [0.0, 0.03, 0.0]\nopening = 0.01",
+       "a grasper needs length > 0"},
+      {"[[tool]]\nname = \"g\"\nposition = [0.0, 0.03, 0.0]\nopening = 0.01", "only a grasper has an opening"},
+      {"[probe]\nshape = \"grasper\"\nlength = 0.01\nkeyframes = [[0.0, 0.0, 0.0, 0.0]]",
+       "a grasper driven by a device (closed by its button) is not available yet"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.text);
+    const std::string message = error_of(sample("kind = \"implicit\"", c.text));
+    EXPECT_NE(message.find(c.message), std::string::npos) << message;
+    EXPECT_NE(message.find("scene.toml:"), std::string::npos) << message;
+  }
+}
+
+TEST(Tools, AGrasperLiftsCarriesAndLetsGo) {
+  // the jaws close 1.5 mm on each side of the sample (their gap 2.1 cm -> 1.8 cm), lift it 1 cm, carry it 2 cm
+  // sideways, open, and it falls back onto the table
+  const std::string table =
+      "[[obstacle]]\nname = \"table\"\nplane = { point = [0.0, 0.0, 0.0], normal = [0.0, 1.0, 0.0] }\nfriction = "
+      "0.5\n";
+  SceneSession s = open_scene(
+      parse_scene(sample("kind = \"implicit\"\ndt = 0.002",
+                         table + grasper("[[0.0, 0.01, 0.0125, 0.01, 0.021], [0.1, 0.01, 0.0125, 0.01, 0.018], "
+                                         "[0.3, 0.01, 0.0225, 0.01, 0.018], [0.5, 0.03, 0.0225, 0.01, 0.018], "
+                                         "[0.55, 0.03, 0.0225, 0.01, 0.026]]"))),
+      two_threads());
+  Simulation& sim = *s.simulation;
+  sim.run(0.5);
+  const RunSummary carried = sim.summary();
+  ASSERT_TRUE(carried.converged) << carried.failure;
+  const Points u = sim.state().u;
+  EXPECT_NEAR(u.row(0).mean(), 0.02, 0.002) << "carried 2 cm sideways";
+  EXPECT_NEAR(u.row(1).mean(), 0.01, 0.0015) << "and 1 cm up";
+  EXPECT_EQ(carried.obstacles.at(0).second.contacts, 0) << "off the table";
+  const ToolSummary& held = tool(carried, "grasper");
+  EXPECT_EQ(held.kind, "grasper");
+  EXPECT_NEAR(held.force.y(), -weight, 0.05 * weight) << "the grasper carries its weight";
+  EXPECT_NEAR(held.position.x(), 0.03, 1e-9) << "reported at the jaws' midpoint";
+  ASSERT_EQ(carried.tools.size(), 1u) << "one tool, its two jaws summed";
+  sim.run(0.3);  // opened at 0.55 s: let go
+  const RunSummary dropped = sim.summary();
+  ASSERT_TRUE(dropped.converged) << dropped.failure;
+  EXPECT_LT(sim.state().u.row(1).mean(), 0.002) << "back on the table";
+  EXPECT_NEAR(sim.state().u.row(0).mean(), 0.02, 0.003) << "where it was let go";
+  EXPECT_EQ(tool(dropped, "grasper").contacts, 0) << "the jaws hold nothing";
+  EXPECT_GT(dropped.obstacles.at(0).second.contacts, 0);
+}
+
 }  // namespace

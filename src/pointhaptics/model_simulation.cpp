@@ -46,6 +46,16 @@ SurfaceContact probe_surface_contact(ActiveSurface part, const SurfaceContactPar
   return contact;
 }
 
+ToolPose PosedBody::pose_at(double t) const {
+  ToolPose pose = start;
+  if (!path.keyframes().empty()) pose.position += path.position(t);
+  if (jaw != 0) {
+    const double gap = opening.keyframes().empty() ? 0.0 : opening.position(t).x();
+    pose.position += jaw * (0.5 * gap + contact.shape().radius) * (pose.orientation * Vec3::UnitX());
+  }
+  return pose;
+}
+
 ModelSimulation::ModelSimulation(Model model, const SolverSpec& solver, int n_threads, double stable_dt)
     : model_(std::move(model)),
       solver_(solver),
@@ -257,12 +267,9 @@ DynamicForces* ModelSimulation::forces_this_step() {
 
 void ModelSimulation::place_tools() {
   // keyframed obstacles and tools where they are at the step's end (the time the implicit and static solves are at)
-  for (PosedBody& o : posed_bodies_) {
-    if (o.path.keyframes().empty()) continue;
-    ToolPose pose = o.start;
-    pose.position += o.path.position(state_.time + (solver_.kind == SolverKind::STATIC ? 0.0 : solver_.dt));
-    o.contact.set_pose(pose);
-  }
+  for (PosedBody& o : posed_bodies_)
+    if (!o.path.keyframes().empty() || o.jaw != 0)
+      o.contact.set_pose(o.pose_at(state_.time + (solver_.kind == SolverKind::STATIC ? 0.0 : solver_.dt)));
   // a static solve starts with what presses already stuck (SurfaceContact::anchor_pressing): a body held by
   // tools' friction alone has no equilibrium in a first minimisation without it
   if (solver_.kind == SolverKind::STATIC) {

@@ -112,6 +112,12 @@ struct PosedBody {
   /// Keyframed: its translation over time from `start` (empty keyframes: static)
   Trajectory path;
   ToolPose start;
+  /// A grasper's jaw: its side (-1 or +1) along the grasper's local x (0: a whole body). The two jaws share the name;
+  /// `opening` gives the gap between their surfaces over time (x of its keyframes, m).
+  int jaw = 0;
+  Trajectory opening;
+  /// Where it is at time t (s): start moved along path, and a jaw half the opening and its radius to its side.
+  ToolPose pose_at(double t) const;
 };
 
 class ModelSimulation {

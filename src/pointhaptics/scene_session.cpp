@@ -137,8 +137,17 @@ SceneSession open_scene(Scene scene, const SessionOptions& options) {
     ToolPose start = pose;
     if (!frames.empty()) start.position.setZero();
     try {
-      s.simulation->add_posed_tool(t.name, shape, start, surface.mesh, surface.map, contact,
-                                   frames.empty() ? Trajectory() : Trajectory(std::move(frames)));
+      const Trajectory path = frames.empty() ? Trajectory() : Trajectory(std::move(frames));
+      if (t.probe.grasper) {
+        // its jaws' gap, held or one per keyframe
+        std::vector<Keyframe> gaps;
+        for (std::size_t f = 0; f < t.opening.size(); ++f)
+          gaps.push_back({t.path.empty() ? 0.0 : t.path[f][0], Vec3(t.opening[f], 0, 0), false});
+        s.simulation->add_grasper(t.name, shape, start, Trajectory(std::move(gaps)), surface.mesh, surface.map, contact,
+                                  path);
+      } else {
+        s.simulation->add_posed_tool(t.name, shape, start, surface.mesh, surface.map, contact, path);
+      }
     } catch (const Interrupted&) {
       throw;
     } catch (const Error& e) {

@@ -229,17 +229,27 @@ void Simulation::add_posed_tool(std::string name, const ToolShape& shape, const 
   add_posed_body(PosedBody::Role::TOOL, std::move(name), shape, pose, mesh, std::move(map), params, path);
 }
 
+void Simulation::add_grasper(std::string name, const ToolShape& jaw, const ToolPose& pose, const Trajectory& opening,
+                             const TriangleMesh& mesh, SurfaceMap map, const SurfaceContactParams& params,
+                             const Trajectory& path) {
+  if (jaw.kind != ToolKind::CAPSULE || !(jaw.length > 0)) throw Error("grasper: its jaws are capsules (give a length)");
+  if (opening.keyframes().empty()) throw Error("grasper: give its opening");
+  add_posed_body(PosedBody::Role::TOOL, name, jaw, pose, mesh, map, params, path, -1, opening);
+  add_posed_body(PosedBody::Role::TOOL, std::move(name), jaw, pose, mesh, std::move(map), params, path, +1, opening);
+}
+
 void Simulation::add_posed_body(PosedBody::Role role, std::string name, const ToolShape& shape, const ToolPose& pose,
                                 const TriangleMesh& mesh, SurfaceMap map, const SurfaceContactParams& params,
-                                const Trajectory& path) {
+                                const Trajectory& path, int jaw, const Trajectory& opening) {
   const bool obstacle = role == PosedBody::Role::OBSTACLE;
   const char* what = obstacle ? "obstacle" : "tool";
   if (lod_)
     throw Error(
         fmt::format("{}: not yet with levels of detail (an active set carries only part of the surface)", what));
   ModelSimulation& sim = core();
-  for (const PosedBody& o : sim.posed_bodies())
-    if (o.role == role && o.name == name) throw Error(fmt::format("\"{}\" is already the name of a {}", name, what));
+  if (jaw <= 0)  // (a grasper's second jaw shares its first's name)
+    for (const PosedBody& o : sim.posed_bodies())
+      if (o.role == role && o.name == name) throw Error(fmt::format("\"{}\" is already the name of a {}", name, what));
   SurfaceContactParams contact = params;
   // explicit steps: as a held tool's (hold_tool())
   if (sim.solver().kind == SolverKind::EXPLICIT && contact.max_point_stiffness <= 0)
@@ -252,25 +262,57 @@ void Simulation::add_posed_body(PosedBody::Role role, std::string name, const To
   // sliding up its sides, stalled an implicit step's Newton (its residual at 3e-3 after 300 iterations; the
   // same with the table frictionless converged), not yet understood
   held.update_after_step(!obstacle && sim.solver().kind == SolverKind::IMPLICIT);
-  ToolPose now = pose;
-  if (!path.keyframes().empty()) now.position += path.position(sim.state().time);
-  held.set_pose(now);
+  PosedBody body{std::move(name), role, std::move(held), path, pose, jaw, opening};
+  body.contact.set_pose(body.pose_at(sim.state().time));
   // an obstacle may not start inside the object: its surface's vertices (the reference ones) stay out of it (a
   // tool may: an indentation)
-  const ToolLoad at_rest = held.load(sim.model(), Points::Zero(3, sim.model().n_points));
-  if (obstacle && at_rest.penetration > held.contact().tolerance())
+  const ToolLoad at_rest = body.contact.load(sim.model(), Points::Zero(3, sim.model().n_points));
+  if (obstacle && at_rest.penetration > body.contact.contact().tolerance())
     throw Error(
         fmt::format("\"{}\" starts inside the object: its surface lies up to {:.3g} m inside it "
                     "(move it out, or the object)",
-                    name, at_rest.penetration));
-  sim.posed_bodies().push_back(PosedBody{std::move(name), role, std::move(held), path, pose});
+                    body.name, at_rest.penetration));
+  sim.posed_bodies().push_back(std::move(body));
 }
+
+namespace {
+
+// a posed tool's load, a grasper's two jaws summed into one (its torque about the midpoint of the jaws, its position)
+struct PosedToolLoad {
+  std::string name;
+  ToolLoad load;
+  Vec3 position = Vec3::Zero();
+  const PosedBody* body = nullptr;  ///< the first of its bodies
+};
+std::vector<PosedToolLoad> posed_tool_loads_of(ModelSimulation& sim, PosedBody::Role role) {
+  std::vector<PosedToolLoad> loads;
+  for (PosedBody& o : sim.posed_bodies()) {
+    if (o.role != role) continue;
+    const ToolLoad load = o.contact.load(sim.model(), sim.state().u);
+    const Vec3 at = o.contact.pose().position;
+    if (o.jaw > 0 && !loads.empty() && loads.back().name == o.name) {  // the grasper's second jaw
+      PosedToolLoad& g = loads.back();
+      const Vec3 first = g.position, centre = 0.5 * (first + at);
+      g.load.torque += (first - centre).cross(g.load.force) + load.torque + (at - centre).cross(load.force);
+      g.load.force += load.force;
+      g.load.friction += load.friction;
+      g.load.contacts += load.contacts;
+      g.load.penetration = std::max(g.load.penetration, load.penetration);
+      g.load.stiffness += load.stiffness;
+      g.position = centre;
+      continue;
+    }
+    loads.push_back({o.name, load, at, &o});
+  }
+  return loads;
+}
+
+}  // namespace
 
 std::vector<std::pair<std::string, ToolLoad>> Simulation::posed_tool_loads() {
   ModelSimulation& sim = core();
   std::vector<std::pair<std::string, ToolLoad>> loads;
-  for (PosedBody& o : sim.posed_bodies())
-    if (o.role == PosedBody::Role::TOOL) loads.emplace_back(o.name, o.contact.load(sim.model(), sim.state().u));
+  for (PosedToolLoad& t : posed_tool_loads_of(sim, PosedBody::Role::TOOL)) loads.emplace_back(t.name, t.load);
   return loads;
 }
 
@@ -493,12 +535,14 @@ RunSummary Simulation::summary() {
   s.tool = tool_summary();
   s.tool_name = tool_name_;
   for (std::size_t k = 1; k < hands(); ++k) s.tools.emplace_back(hand_names_[k], tool_summary(k));
-  for (PosedBody& o : sim.posed_bodies()) {
-    const ToolLoad load = o.contact.load(model, state.u);
-    (o.role == PosedBody::Role::OBSTACLE ? s.obstacles : s.tools)
-        .emplace_back(o.name, ToolSummary{true, tool_kind_name(o.contact.shape()), o.contact.pose().position,
-                                          load.force, load.torque, load.contacts, load.penetration, load.friction});
-  }
+  for (const PosedBody::Role role : {PosedBody::Role::OBSTACLE, PosedBody::Role::TOOL})
+    for (const PosedToolLoad& t : posed_tool_loads_of(sim, role)) {
+      const ToolLoad& load = t.load;
+      const std::string kind = t.body->jaw != 0 ? "grasper" : tool_kind_name(t.body->contact.shape());
+      (role == PosedBody::Role::OBSTACLE ? s.obstacles : s.tools)
+          .emplace_back(t.name, ToolSummary{true, kind, t.position, load.force, load.torque, load.contacts,
+                                            load.penetration, load.friction});
+    }
   if (model.n_bodies() > 1) body_summaries(model, state, sim.body_contact().get(), s);
   if (d.cuts > 0 || !scripted_cuts_.empty()) {
     // the object's cut (with levels of detail every cut of an active set reaches it)

@@ -103,6 +103,13 @@ class Simulation {
                       SurfaceMap map, const SurfaceContactParams& params = {}, const Trajectory& path = {});
   /// The obstacles and posed tools, in the order they were added.
   const std::vector<PosedBody>& posed_bodies() const { return core().posed_bodies(); }
+  /// A grasper the scene poses ([[tool]] shape = "grasper"), by name: two capsule jaws of `jaw` (a capsule) either
+  /// side of `pose` along its local x, their axes along its local z, `opening` apart (the gap between their surfaces
+  /// over time: x of its keyframes, m), moved along `path` as a posed tool. Each jaw is a posed tool's contact,
+  /// friction included; the grasper is reported as one tool (their forces summed, about its centre).
+  void add_grasper(std::string name, const ToolShape& jaw, const ToolPose& pose, const Trajectory& opening,
+                   const TriangleMesh& mesh, SurfaceMap map, const SurfaceContactParams& params = {},
+                   const Trajectory& path = {});
   /// What the bodies exert on each posed tool ([[tool]] with a position or keyframes) now, by name, in the order
   /// they were added: the rows of `run --tool-log`.
   std::vector<std::pair<std::string, ToolLoad>> posed_tool_loads();
@@ -161,7 +168,7 @@ class Simulation {
  private:
   void add_posed_body(PosedBody::Role role, std::string name, const ToolShape& shape, const ToolPose& pose,
                       const TriangleMesh& mesh, SurfaceMap map, const SurfaceContactParams& params,
-                      const Trajectory& path);
+                      const Trajectory& path, int jaw = 0, const Trajectory& opening = {});
   ModelSimulation& core() { return lod_ ? lod_->active() : *object_; }
   const ModelSimulation& core() const { return lod_ ? lod_->active() : *object_; }
 

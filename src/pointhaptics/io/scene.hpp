@@ -144,8 +144,11 @@ struct ProbeSpec {
   Vec3 direction = -Vec3::UnitY();
   std::array<double, 4> orientation{1, 0, 0, 0};  ///< unit quaternion w, x, y, z: tool to scene axes
   bool capsule = false;                           ///< shape = "capsule" (else "sphere")
-  double length = 0;                              ///< capsule: its axis segment, m, along the tool's local z
-  double friction = 0;                            ///< Coulomb's coefficient on the surface
+  /// shape = "grasper" ([[tool]] posed by the scene): two capsule jaws (radius, length) either side of the tool's
+  /// position along its local x, their axes along its local z, `opening` apart (the gap between their surfaces)
+  bool grasper = false;
+  double length = 0;              ///< capsule: its axis segment, m, along the tool's local z
+  double friction = 0;            ///< Coulomb's coefficient on the surface
   bool object_stiffness = false;  ///< local_stiffness = "object" (else "contact"): ProbeParams::object_stiffness
   bool non_negative_surface_map =
       false;                  ///< surface_map = "non_negative" (else "exact"): ProbeParams::non_negative_surface_map
@@ -181,6 +184,9 @@ struct ToolSpec {
   /// A posed tool moved by the scene: keyframes (t, x, y, z), where it is (scene axes, m), linear in between and
   /// held after the last (empty: held at probe.position, or driven by a device)
   std::vector<std::array<double, 4>> path;
+  /// A grasper: the gap between its jaws' surfaces, m: one value held at `position`, or one per keyframe (the 5th
+  /// value of [t, x, y, z, opening]), linear in between
+  std::vector<double> opening;
   std::string device;  ///< the [[device]] that drives it (empty: posed by the scene)
   int line = 0;
 };

@@ -594,17 +594,25 @@ CutSpec read_cut(TableReader& r) {
 // keyframes = [[t, a, b, c], ...] of a body the scene poses (an obstacle's translation, a tool's position): times
 // increasing from 0 s within 1e6 s, values within 1e6 m; `form` and `what` name them in the errors. Empty without
 // the key.
-std::vector<std::array<double, 4>> read_posed_keyframes(TableReader& r, std::string_view form, std::string_view what) {
+// `fifth`: each keyframe has a fifth value (a grasper's opening, m, in [0, 1]), put there
+std::vector<std::array<double, 4>> read_posed_keyframes(TableReader& r, std::string_view form, std::string_view what,
+                                                        std::vector<double>* fifth = nullptr) {
   std::vector<std::array<double, 4>> frames;
   const toml::node* node = r.find("keyframes");
   if (!node) return frames;
   const toml::array* rows = node->as_array();
   if (!rows || rows->empty()) r.fail_at(*node, "keyframes", fmt::format("expected keyframes = [{}, ...]", form));
+  const std::size_t columns = fifth ? 5 : 4;
   for (const toml::node& row : *rows) {
     const toml::array* k = row.as_array();
-    if (!k || k->size() != 4) r.fail_at(row, "keyframes", fmt::format("each keyframe is {} (s, m)", form));
+    if (!k || k->size() != columns) r.fail_at(row, "keyframes", fmt::format("each keyframe is {} (s, m)", form));
     std::array<double, 4> frame{};
     for (std::size_t a = 0; a < 4; ++a) frame[a] = r.as_number(*k->get(a), "keyframes");
+    if (fifth) {
+      fifth->push_back(r.as_number(*k->get(4), "keyframes"));
+      if (!(fifth->back() >= 0 && fifth->back() <= 1))
+        r.fail_at(row, "keyframes", "a grasper's opening (the 5th value) must lie in [0, 1] (m)");
+    }
     const double last_t = frames.empty() ? -1.0 : frames.back()[0];
     if (!(frame[0] > last_t) || frame[0] < 0 || frame[0] > 1e6)
       r.fail_at(row, "keyframes", "times must increase, from 0 s, and stay within 1e6 s");
@@ -710,9 +718,13 @@ std::string resolve(const Context& ctx, const std::string& file) {
 // friction, surface_map and sample_spacing
 void read_tool_shape(TableReader& r, ProbeSpec& p) {
   p.radius = r.number("radius", p.radius, positive_up_to(10), "must lie in (0, 10] (m)");
-  p.capsule = r.choice("shape", "sphere", {"sphere", "capsule"}) == "capsule";
+  const std::string shape = r.choice("shape", "sphere", {"sphere", "capsule", "grasper"});
+  p.grasper = shape == "grasper";
+  p.capsule = shape == "capsule" || p.grasper;  // a grasper's jaws are capsules
   p.length = r.number("length", p.length, non_negative_up_to(10), "must lie in [0, 10] (m)");
-  if (p.capsule && !(p.length > 0)) r.fail_table("length", "a capsule needs length > 0 (m): its axis segment");
+  if (p.capsule && !(p.length > 0))
+    r.fail_table("length", p.grasper ? "a grasper needs length > 0 (m): its jaws' axis segment"
+                                     : "a capsule needs length > 0 (m): its axis segment");
   if (!p.capsule && r.find("length"))
     r.fail_at(*r.find("length"), "length", "only a capsule has a length (shape = \"capsule\")");
   if (const toml::node* node = r.find("orientation")) {
@@ -734,6 +746,10 @@ void read_probe(TableReader& r, ProbeSpec& p, const Context& ctx) {
   p.present = true;
   p.line = r.line();
   read_tool_shape(r, p);
+  if (p.grasper)
+    r.fail_at(*r.find("shape"), "shape",
+              "a grasper driven by a device (closed by its button) is not available yet: make it a [[tool]] posed by "
+              "the scene, with position and opening or keyframes = [[t, x, y, z, opening], ...]");
   const std::string mode = r.choice("mode", "push", {"push", "grab", "cut"});
   p.grab = mode == "grab";
   p.cut = mode == "cut";
@@ -836,7 +852,21 @@ ToolSpec read_tool(TableReader& r, const Context& ctx) {
                  "y, z], ...] (scene axes, m): give one of them, or device = \"NAME\"");
   if (r.find("position")) t.probe.position = r.vec3("position", t.probe.position);
   read_press_direction(r, t.probe);
-  t.path = read_posed_keyframes(r, "[t, x, y, z]", "a position");
+  if (t.probe.grasper) {
+    // its jaws' gap: at its position, or the 5th value of each keyframe
+    if (r.find("position")) {
+      if (!r.find("opening"))
+        r.fail_table("opening", "a grasper held at a position needs opening = <m> (its jaws' gap)");
+      t.opening.push_back(r.number("opening", 0.0, non_negative_up_to(1), "must lie in [0, 1] (m)"));
+    } else if (const toml::node* node = r.find("opening")) {
+      r.fail_at(*node, "opening", "a keyframed grasper's opening is each keyframe's 5th value: [t, x, y, z, opening]");
+    }
+    t.path = read_posed_keyframes(r, "[t, x, y, z, opening]", "a position", &t.opening);
+  } else {
+    if (const toml::node* node = r.find("opening"))
+      r.fail_at(*node, "opening", "only a grasper has an opening (shape = \"grasper\")");
+    t.path = read_posed_keyframes(r, "[t, x, y, z]", "a position");
+  }
   return t;
 }
 
