@@ -202,7 +202,8 @@ class ModelSimulation {
   void place_tools();
   void solve();
   void record_cut_sheet(const BladeSweep& sweep);
-  void place_hand(ProbeAttachment& hand, const StepInputs& inputs);
+  /// places the hand's probe; a blade with its button held cuts (returns true)
+  bool place_hand(ProbeAttachment& hand, const StepInputs& inputs);
   void refresh_probe_surface(ProbeAttachment& hand);
   void check_finite(StepReport& report) const;
   void count_inverted_neighbourhoods();
