@@ -43,6 +43,13 @@ py::dict named_loads(const std::vector<std::pair<std::string, ph::ToolSummary>>&
     block["contacts"] = o.contacts;
     block["penetration"] = o.penetration;
     block["friction"] = vec(o.friction);
+    if (o.haptic_ticks > 0) {  // a device's hand: its own haptic loop
+      py::dict haptic;
+      haptic["ticks"] = o.haptic_ticks;
+      haptic["period_p99_us"] = o.haptic_period_p99_us;
+      haptic["max_force_n"] = o.haptic_max_force_n;
+      block["haptic"] = haptic;
+    }
     d[py::str(name)] = block;
   }
   return d;
@@ -637,12 +644,14 @@ names the problem.)doc")
           [](PySimulation& p) {
             const auto lock = locked(p);
             ph::RunSummary summary = p.sim->summary();
+            // after run_scene() with devices: each hand as the session left it
+            if (p.last_session) ph::add_interactive_summary(summary, *p.last_session);
             if (summary.tool.present) summary.tools.insert(summary.tools.begin(), {summary.tool_name, summary.tool});
             return named_loads(summary.tools);
           },
-          "The scene's tools by name ([[tool]] tables; a [probe] as \"probe\"), each a dict as the result JSON's tools "
-          "block: kind, position (m), force (what the object exerts on it now, N), torque (N m), contacts, "
-          "penetration (m), friction (N)")
+          "The scene's tools by name ([[tool]] tables; a [probe] as \"probe\"; after run_scene() every device-driven "
+          "hand as its session ended), each a dict as the result JSON's tools block: kind, position (m), force (what "
+          "the object exerts on it now, N), torque (N m), contacts, penetration (m), friction (N)")
       .def_property_readonly(
           "bodies",
           [](py::object self) {

@@ -203,15 +203,19 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
   result.log_dropped = loop.log_dropped();
   // before the probes are detached
   result.max_contacts = hands.front().max_contacts;
-  result.tool = sim.tool_summary();
+  // each hand's tool block with its own loop's figures
+  const auto with_haptics = [](ToolSummary tool, const HapticStats& haptic) {
+    tool.haptic_ticks = haptic.ticks;
+    tool.haptic_period_p99_us = haptic.period_p99_us;
+    tool.haptic_max_force_n = haptic.max_force_n;
+    return tool;
+  };
+  result.tool = with_haptics(sim.tool_summary(), result.haptic);
   result.local_model = hands.front().stray.summary();
   for (std::size_t k = 1; k < hands.size(); ++k) {
-    HandResult hand{sim.hand_name(k), hands[k].loop->stats(), sim.tool_summary(k), hands[k].max_contacts,
-                    hands[k].stray.summary()};
-    hand.tool.haptic_ticks = hand.haptic.ticks;
-    hand.tool.haptic_period_p99_us = hand.haptic.period_p99_us;
-    hand.tool.haptic_max_force_n = hand.haptic.max_force_n;
-    result.other_hands.push_back(std::move(hand));
+    const HapticStats haptic = hands[k].loop->stats();
+    result.other_hands.push_back({sim.hand_name(k), haptic, with_haptics(sim.tool_summary(k), haptic),
+                                  hands[k].max_contacts, hands[k].stray.summary()});
   }
   return result;
 }
