@@ -13,10 +13,10 @@
 #include <pointhaptics/mechanics/surface_map.hpp>
 #include <pointhaptics/mechanics/viscoelasticity.hpp>
 #include <pointhaptics/haptics/devices/virtual_device.hpp>
-#include <pointhaptics/interactive.hpp>
+#include <pointhaptics/session/interactive.hpp>
 #include <pointhaptics/io/output_file.hpp>
-#include <pointhaptics/scene_builder.hpp>
-#include <pointhaptics/simulation.hpp>
+#include <pointhaptics/session/scene_builder.hpp>
+#include <pointhaptics/world/simulation.hpp>
 #include <pointhaptics/solvers/explicit_solver.hpp>
 #include <pointhaptics/solvers/sparse_cholesky.hpp>
 

@@ -3,12 +3,12 @@
 // resistance against the blade's move, the work it does is the resistance times the cut area, and the force
 // felt is continuous, bounded and finite.
 #include <pointhaptics/haptics/devices/virtual_device.hpp>
-#include <pointhaptics/interactive.hpp>
+#include <pointhaptics/session/interactive.hpp>
 #include <pointhaptics/lod/active_surface.hpp>
 #include <pointhaptics/io/scene_toml.hpp>
-#include <pointhaptics/cut_surface.hpp>
-#include <pointhaptics/object_surface.hpp>
-#include <pointhaptics/scene_builder.hpp>
+#include <pointhaptics/surface/cut_surface.hpp>
+#include <pointhaptics/surface/object_surface.hpp>
+#include <pointhaptics/session/scene_builder.hpp>
 
 #include <gtest/gtest.h>
 

@@ -3,10 +3,10 @@
 // momentum, and a block resting on a block on a table, each carrying what is above it.
 #include <pointhaptics/io/scene_toml.hpp>
 #include <pointhaptics/mechanics/energy.hpp>
-#include <pointhaptics/scene_builder.hpp>
-#include <pointhaptics/scene_session.hpp>
-#include <pointhaptics/simulation.hpp>
-#include <pointhaptics/vtk_output.hpp>
+#include <pointhaptics/session/scene_builder.hpp>
+#include <pointhaptics/session/scene_session.hpp>
+#include <pointhaptics/world/simulation.hpp>
+#include <pointhaptics/output/vtk_output.hpp>
 
 #include "support/scene_sessions.hpp"
 

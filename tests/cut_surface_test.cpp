@@ -3,11 +3,11 @@
 // carried by that side's points only, so pulling the pieces apart moves each side rigidly and opens the gap
 // (the unsplit surface spans it); a slit gains faces of twice its area carried by the points on their side;
 // no sheet, or one outside the object, changes nothing; random sheets give a finite surface whose rows sum to 1.
-#include <pointhaptics/cut_surface.hpp>
+#include <pointhaptics/surface/cut_surface.hpp>
 #include <pointhaptics/geometry/shape_surfaces.hpp>
 #include <pointhaptics/io/scene_toml.hpp>
 #include <pointhaptics/mechanics/cut.hpp>
-#include <pointhaptics/scene_builder.hpp>
+#include <pointhaptics/session/scene_builder.hpp>
 
 #include <gtest/gtest.h>
 

@@ -1,9 +1,9 @@
 // Deep compression (issue 17, item 2): a soft block bonded between two plates and compressed statically, a
 // flat punch pressed 5 mm into soft tissue, and a probe pushed to half a soft block's thickness. St.
 // Venant-Kirchhoff collapses and inverts, which must be reported instead of "converged"; neo-Hookean holds.
-#include <pointhaptics/interactive.hpp>
+#include <pointhaptics/session/interactive.hpp>
 #include <pointhaptics/io/scene_toml.hpp>
-#include <pointhaptics/scene_session.hpp>
+#include <pointhaptics/session/scene_session.hpp>
 
 #include <gtest/gtest.h>
 #include <fmt/format.h>

@@ -2,10 +2,10 @@
 // closed-loop stability, the device force limit, a fast probe through the object, a failing device,
 // and a short threaded run in real time.
 #include <pointhaptics/haptics/devices/virtual_device.hpp>
-#include <pointhaptics/interactive.hpp>
+#include <pointhaptics/session/interactive.hpp>
 #include <pointhaptics/io/scene_toml.hpp>
-#include <pointhaptics/object_surface.hpp>
-#include <pointhaptics/scene_builder.hpp>
+#include <pointhaptics/surface/object_surface.hpp>
+#include <pointhaptics/session/scene_builder.hpp>
 
 #include <gtest/gtest.h>
 

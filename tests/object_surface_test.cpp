@@ -11,8 +11,8 @@
 #include <pointhaptics/io/mesh_file.hpp>
 #include <pointhaptics/io/scene_toml.hpp>
 #include <pointhaptics/mechanics/model_builder.hpp>
-#include <pointhaptics/object_surface.hpp>
-#include <pointhaptics/scene_builder.hpp>
+#include <pointhaptics/surface/object_surface.hpp>
+#include <pointhaptics/session/scene_builder.hpp>
 
 #include "support/test_scenes.hpp"
 

@@ -2,10 +2,10 @@
 // tables with named errors; a block resting on a table, a box or a sphere under gravity is carried by it (the
 // support force its weight), in static solves by contact and friction alone and in dynamics after a drop; a tool
 // pressing the block onto the table has its force balanced by the table's; an obstacle may not start inside.
-#include <pointhaptics/interactive.hpp>
+#include <pointhaptics/session/interactive.hpp>
 #include <pointhaptics/io/scene_toml.hpp>
-#include <pointhaptics/scene_session.hpp>
-#include <pointhaptics/simulation.hpp>
+#include <pointhaptics/session/scene_session.hpp>
+#include <pointhaptics/world/simulation.hpp>
 
 #include "support/scene_sessions.hpp"
 

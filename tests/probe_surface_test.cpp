@@ -3,10 +3,10 @@
 // reached (a static solve with a tool held at the probe's final position, which meets the contact constraint
 // exactly): the probe is a proxy kept on the surface by the contact's multipliers.
 #include <pointhaptics/haptics/devices/virtual_device.hpp>
-#include <pointhaptics/interactive.hpp>
+#include <pointhaptics/session/interactive.hpp>
 #include <pointhaptics/io/scene_toml.hpp>
-#include <pointhaptics/scene_builder.hpp>
-#include <pointhaptics/scene_session.hpp>
+#include <pointhaptics/session/scene_builder.hpp>
+#include <pointhaptics/session/scene_session.hpp>
 
 #include <gtest/gtest.h>
 

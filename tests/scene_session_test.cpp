@@ -1,10 +1,10 @@
 // Tests for scene_session: a scene becomes its simulation, levels of detail, device and interactive options
 // in one place, with the same defaults for every front end; bad scenes are named errors.
-#include <pointhaptics/scene_session.hpp>
+#include <pointhaptics/session/scene_session.hpp>
 
 #include <pointhaptics/haptics/devices/virtual_device.hpp>
 #include <pointhaptics/io/scene_toml.hpp>
-#include <pointhaptics/simulation.hpp>
+#include <pointhaptics/world/simulation.hpp>
 
 #include "support/test_scenes.hpp"
 

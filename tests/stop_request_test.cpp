@@ -5,8 +5,8 @@
 #include <pointhaptics/geometry/shape_surfaces.hpp>
 #include <pointhaptics/geometry/triangle_mesh.hpp>
 #include <pointhaptics/io/scene_toml.hpp>
-#include <pointhaptics/scene_builder.hpp>
-#include <pointhaptics/simulation.hpp>
+#include <pointhaptics/session/scene_builder.hpp>
+#include <pointhaptics/world/simulation.hpp>
 
 #include "support/test_scenes.hpp"
 

@@ -4,8 +4,8 @@
 // pinch is below the weight over 2 mu; two keyframed tools lift a block off a table in implicit dynamics.
 #include <pointhaptics/io/result_json.hpp>
 #include <pointhaptics/io/scene_toml.hpp>
-#include <pointhaptics/scene_session.hpp>
-#include <pointhaptics/simulation.hpp>
+#include <pointhaptics/session/scene_session.hpp>
+#include <pointhaptics/world/simulation.hpp>
 
 #include "support/scene_sessions.hpp"
 

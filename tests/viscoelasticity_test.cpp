@@ -9,7 +9,7 @@
 #include <pointhaptics/mechanics/forces.hpp>
 #include <pointhaptics/mechanics/model_builder.hpp>
 #include <pointhaptics/mechanics/viscoelasticity.hpp>
-#include <pointhaptics/scene_session.hpp>
+#include <pointhaptics/session/scene_session.hpp>
 
 #include <gtest/gtest.h>
 #include <fmt/format.h>

@@ -1,6 +1,6 @@
 #include "viewer.hpp"
 
-#include <pointhaptics/scene_session.hpp>
+#include <pointhaptics/session/scene_session.hpp>
 
 #include "gl_context.hpp"
 #include "panels.hpp"

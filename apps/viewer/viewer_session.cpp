@@ -1,7 +1,7 @@
 #include "viewer_session.hpp"
 
 #include <pointhaptics/haptics/devices/openhaptics_device.hpp>
-#include <pointhaptics/scene_session.hpp>
+#include <pointhaptics/session/scene_session.hpp>
 
 #include <fmt/format.h>
 #include <oneapi/tbb/task_arena.h>

@@ -3,8 +3,8 @@
 /// with the 1 kHz haptic loop on another, a probe driven by the mouse (or a real device, or the scene's
 /// script), and rebuilds from edited parameters on a worker thread while the old run goes on.
 #include <pointhaptics/haptics/devices/mouse_device.hpp>
-#include <pointhaptics/interactive.hpp>
-#include <pointhaptics/object_surface.hpp>
+#include <pointhaptics/session/interactive.hpp>
+#include <pointhaptics/surface/object_surface.hpp>
 
 #include <atomic>
 #include <chrono>

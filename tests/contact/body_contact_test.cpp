@@ -3,8 +3,8 @@
 // differences), its forces sum to zero (equal and opposite), and the multipliers' update meets the constraint.
 #include <pointhaptics/contact/body_contact.hpp>
 #include <pointhaptics/io/scene_toml.hpp>
-#include <pointhaptics/object_surface.hpp>
-#include <pointhaptics/scene_builder.hpp>
+#include <pointhaptics/surface/object_surface.hpp>
+#include <pointhaptics/session/scene_builder.hpp>
 
 #include <gtest/gtest.h>
 

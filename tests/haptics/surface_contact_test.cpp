@@ -11,7 +11,7 @@
 #include <pointhaptics/haptics/surface_contact.hpp>
 #include <pointhaptics/mechanics/model_builder.hpp>
 #include <pointhaptics/mechanics/tangent_matrix.hpp>
-#include <pointhaptics/simulation.hpp>
+#include <pointhaptics/world/simulation.hpp>
 
 #include <gtest/gtest.h>
 

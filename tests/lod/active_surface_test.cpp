@@ -1,8 +1,8 @@
 // Tests for lod/active_surface: the part of the object's surface an active set carries is whole around the
 // contact, out to the selection's bands.
 #include <pointhaptics/lod/active_surface.hpp>
-#include <pointhaptics/object_surface.hpp>
-#include <pointhaptics/scene_session.hpp>
+#include <pointhaptics/surface/object_surface.hpp>
+#include <pointhaptics/session/scene_session.hpp>
 
 #include <gtest/gtest.h>
 

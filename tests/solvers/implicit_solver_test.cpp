@@ -2,7 +2,7 @@
 // 90-point beam from soft to stiff materials, settling on the static solution, and the real-time budget.
 #include <pointhaptics/core/error.hpp>
 #include <pointhaptics/mechanics/energy.hpp>
-#include <pointhaptics/scene_builder.hpp>
+#include <pointhaptics/session/scene_builder.hpp>
 #include <pointhaptics/io/scene_toml.hpp>
 #include <pointhaptics/solvers/implicit_solver.hpp>
 #include <pointhaptics/solvers/static_solver.hpp>

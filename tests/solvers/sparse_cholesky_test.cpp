@@ -4,7 +4,7 @@
 // two-level preconditioner (solvers/coarse_correction.hpp), whose coarse level is such a factor.
 #include <pointhaptics/core/run_control.hpp>
 #include <pointhaptics/mechanics/tangent.hpp>
-#include <pointhaptics/scene_builder.hpp>
+#include <pointhaptics/session/scene_builder.hpp>
 #include <pointhaptics/io/scene_toml.hpp>
 #include <pointhaptics/solvers/coarse_correction.hpp>
 #include <pointhaptics/solvers/implicit_solver.hpp>

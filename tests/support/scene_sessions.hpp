@@ -2,7 +2,7 @@
 // Opening scenes in the tests: on two threads, and the error a scene's text gets (read, and opened).
 #include <pointhaptics/core/error.hpp>
 #include <pointhaptics/io/scene_toml.hpp>
-#include <pointhaptics/scene_session.hpp>
+#include <pointhaptics/session/scene_session.hpp>
 
 #include <string>
 #include <utility>

@@ -1,4 +1,4 @@
-#include <pointhaptics/object_surface.hpp>
+#include <pointhaptics/surface/object_surface.hpp>
 
 #include <pointhaptics/core/run_control.hpp>
 
@@ -11,7 +11,7 @@
 #include <pointhaptics/io/volume_file.hpp>
 #include <pointhaptics/mechanics/kernels.hpp>
 
-#include <pointhaptics/scene_builder.hpp>
+#include <pointhaptics/session/scene_builder.hpp>
 
 #include <fmt/format.h>
 

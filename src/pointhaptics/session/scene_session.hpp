@@ -2,7 +2,7 @@
 /// @file One scene made ready to run, the same way for the command line, the viewer and Python: the model
 /// built, the simulation with its levels of detail, and with a [probe] its device and interactive options.
 /// Every default a run depends on is set here once.
-#include <pointhaptics/interactive.hpp>
+#include <pointhaptics/session/interactive.hpp>
 #include <pointhaptics/io/scene.hpp>
 #include <pointhaptics/io/scene_toml.hpp>
 

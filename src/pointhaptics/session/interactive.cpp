@@ -1,4 +1,4 @@
-#include <pointhaptics/interactive.hpp>
+#include <pointhaptics/session/interactive.hpp>
 
 #include <pointhaptics/core/run_control.hpp>
 #include <pointhaptics/io/haptic_log.hpp>

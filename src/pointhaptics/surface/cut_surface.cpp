@@ -1,4 +1,4 @@
-#include <pointhaptics/cut_surface.hpp>
+#include <pointhaptics/surface/cut_surface.hpp>
 
 #include <pointhaptics/geometry/mesh_distance.hpp>
 #include <pointhaptics/geometry/remesh.hpp>

@@ -1,4 +1,4 @@
-#include <pointhaptics/vtk_output.hpp>
+#include <pointhaptics/output/vtk_output.hpp>
 
 #include <pointhaptics/mechanics/point_fields.hpp>
 

@@ -7,7 +7,7 @@
 ///
 /// The sheets are kept in the reference configuration, where the surface is defined (ModelSimulation maps
 /// each blade step's new strip back by the displacement around it).
-#include <pointhaptics/object_surface.hpp>
+#include <pointhaptics/surface/object_surface.hpp>
 
 #include <array>
 #include <optional>

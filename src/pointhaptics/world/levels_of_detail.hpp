@@ -5,7 +5,7 @@
 #include <pointhaptics/io/result_json.hpp>
 #include <pointhaptics/geometry/kd_tree.hpp>
 #include <pointhaptics/lod/active_set.hpp>
-#include <pointhaptics/model_simulation.hpp>
+#include <pointhaptics/world/model_simulation.hpp>
 
 #include <future>
 #include <limits>

@@ -1,8 +1,8 @@
 #pragma once
 /// @file A simulation's state as ParaView frames (io/vtk.hpp): the fields design.md names.
 #include <pointhaptics/io/vtk.hpp>
-#include <pointhaptics/object_surface.hpp>
-#include <pointhaptics/simulation.hpp>
+#include <pointhaptics/surface/object_surface.hpp>
+#include <pointhaptics/world/simulation.hpp>
 
 namespace pointhaptics {
 

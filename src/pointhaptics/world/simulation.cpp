@@ -1,4 +1,4 @@
-#include <pointhaptics/simulation.hpp>
+#include <pointhaptics/world/simulation.hpp>
 
 #include <pointhaptics/core/stage_timer.hpp>
 

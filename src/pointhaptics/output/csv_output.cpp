@@ -1,8 +1,8 @@
-#include <pointhaptics/csv_output.hpp>
+#include <pointhaptics/output/csv_output.hpp>
 
 #include <pointhaptics/core/error.hpp>
 #include <pointhaptics/io/output_file.hpp>
-#include <pointhaptics/vtk_output.hpp>
+#include <pointhaptics/output/vtk_output.hpp>
 
 #include <fmt/format.h>
 #include <fmt/os.h>

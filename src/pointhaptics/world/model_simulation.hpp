@@ -11,8 +11,8 @@
 #include <pointhaptics/lod/active_set.hpp>
 #include <pointhaptics/lod/active_surface.hpp>
 #include <pointhaptics/mechanics/cut.hpp>
-#include <pointhaptics/cut_surface.hpp>
-#include <pointhaptics/object_surface.hpp>
+#include <pointhaptics/surface/cut_surface.hpp>
+#include <pointhaptics/surface/object_surface.hpp>
 
 #include <future>
 #include <pointhaptics/solvers/force_set.hpp>

@@ -1,4 +1,4 @@
-#include <pointhaptics/model_simulation.hpp>
+#include <pointhaptics/world/model_simulation.hpp>
 
 #include <pointhaptics/lod/active_surface.hpp>
 

@@ -1,4 +1,4 @@
-#include <pointhaptics/scene_builder.hpp>
+#include <pointhaptics/session/scene_builder.hpp>
 
 #include <pointhaptics/mechanics/join_models.hpp>
 

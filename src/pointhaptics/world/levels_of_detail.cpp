@@ -1,4 +1,4 @@
-#include <pointhaptics/levels_of_detail.hpp>
+#include <pointhaptics/world/levels_of_detail.hpp>
 
 #include <pointhaptics/core/error.hpp>
 #include <pointhaptics/mechanics/cut.hpp>

@@ -2,7 +2,7 @@
 /// @file An interactive run: the simulation and the haptic loop together, a probe driven by a device.
 #include <pointhaptics/haptics/haptic_loop.hpp>
 #include <pointhaptics/haptics/device.hpp>
-#include <pointhaptics/simulation.hpp>
+#include <pointhaptics/world/simulation.hpp>
 
 #include <atomic>
 #include <functional>

@@ -1,6 +1,6 @@
 #pragma once
 /// @file A simulation's state as a CSV table, one row per point of the object.
-#include <pointhaptics/simulation.hpp>
+#include <pointhaptics/world/simulation.hpp>
 
 #include <string>
 

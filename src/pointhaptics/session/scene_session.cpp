@@ -1,4 +1,4 @@
-#include <pointhaptics/scene_session.hpp>
+#include <pointhaptics/session/scene_session.hpp>
 
 #include <pointhaptics/core/run_control.hpp>
 #include <pointhaptics/haptics/devices/haply_device.hpp>
@@ -7,8 +7,8 @@
 #include <pointhaptics/haptics/devices/virtual_device.hpp>
 #include <pointhaptics/io/haptic_log.hpp>
 #include <pointhaptics/io/scene_toml.hpp>
-#include <pointhaptics/object_surface.hpp>
-#include <pointhaptics/scene_builder.hpp>
+#include <pointhaptics/surface/object_surface.hpp>
+#include <pointhaptics/session/scene_builder.hpp>
 
 #include <fmt/format.h>
 

@@ -4,9 +4,9 @@
 /// indices: model() and state() are the whole object's, whatever is simulated.
 #include <pointhaptics/io/result_json.hpp>
 #include <pointhaptics/io/scene.hpp>
-#include <pointhaptics/levels_of_detail.hpp>
-#include <pointhaptics/model_simulation.hpp>
-#include <pointhaptics/object_surface.hpp>
+#include <pointhaptics/world/levels_of_detail.hpp>
+#include <pointhaptics/world/model_simulation.hpp>
+#include <pointhaptics/surface/object_surface.hpp>
 
 #include <functional>
 #include <memory>
