@@ -1,4 +1,4 @@
-// Tests for the blade (ProbeMode::CUT, haptics/probe_tool.cpp with mechanics/cut.cpp): a device's blade passed
+// Tests for the blade (ProbeMode::CUT, tools/probe_tool.cpp with mechanics/cut.cpp): a device's blade passed
 // through the cantilever near its root with the button held cuts it in two, the hand feels the cutting
 // resistance against the blade's move, the work it does is the resistance times the cut area, and the force
 // felt is continuous, bounded and finite.

@@ -1,11 +1,11 @@
-// Tests for haptics/coupling and haptics/probe_tool: the coupling solve balances the contact model and caps
+// Tests for haptics/coupling and tools/probe_tool: the coupling solve balances the contact model and caps
 // the force at the device's maximum; the probe tool settles where the coupling spring balances the object's
 // contact forces, and its forces, springs and renumbering are those of its contact. On the surface the probe is
 // a god-object: its centre is not taken into the surface between vertices, and it is put back on the surface
 // when the surface flowed over it; its multipliers build at the same rate per second whatever the step.
 #include <pointhaptics/core/workspace.hpp>
 #include <pointhaptics/haptics/coupling.hpp>
-#include <pointhaptics/haptics/probe_tool.hpp>
+#include <pointhaptics/tools/probe_tool.hpp>
 
 #include <pointhaptics/geometry/sampling.hpp>
 #include <pointhaptics/geometry/shape_surfaces.hpp>

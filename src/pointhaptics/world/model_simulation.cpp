@@ -292,13 +292,7 @@ bool ModelSimulation::place_hand(ProbeAttachment& hand, const StepInputs& inputs
   // a blade with its button held cuts the strips its edge swept over its last steps (ProbeTool::blade_trail;
   // nothing on the step a cut starts)
   if (tool.cutting()) {
-    const std::vector<std::array<Vec3, 2>>& trail = tool.blade_trail();
-    const std::array<Vec3, 2> edge = tool.blade_edge();
-    blade_strips_.clear();  // allocates only to grow
-    for (std::size_t k = 0; k < trail.size(); ++k) {
-      const std::array<Vec3, 2>& to = k + 1 < trail.size() ? trail[k + 1] : edge;
-      blade_strips_.push_back(BladeSweep{trail[k][0], trail[k][1], to[0], to[1]});
-    }
+    tool.blade_sweeps(blade_strips_);
     tool.resist_cut(model_, blade_strips_.empty() ? CutReport{} : cut(blade_strips_), solver_.dt);
     return true;
   }

@@ -5,8 +5,8 @@
 #include <pointhaptics/core/state.hpp>
 #include <pointhaptics/core/workspace.hpp>
 #include <pointhaptics/contact/body_contact.hpp>
-#include <pointhaptics/haptics/held_tool.hpp>
-#include <pointhaptics/haptics/probe_tool.hpp>
+#include <pointhaptics/tools/held_tool.hpp>
+#include <pointhaptics/tools/probe_tool.hpp>
 #include <pointhaptics/haptics/trajectory.hpp>
 #include <pointhaptics/lod/active_set.hpp>
 #include <pointhaptics/lod/active_surface.hpp>

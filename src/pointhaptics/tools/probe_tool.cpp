@@ -1,4 +1,4 @@
-#include <pointhaptics/haptics/probe_tool.hpp>
+#include <pointhaptics/tools/probe_tool.hpp>
 
 #include <pointhaptics/haptics/coupling.hpp>
 
@@ -284,6 +284,15 @@ void ProbeTool::remap(const Model& model, const std::vector<index_t>& new_index,
   compliance_ws_.reset();
   compliance_load_.resize(3, 0);
   compliance_contacts_ = 0;
+}
+
+void ProbeTool::blade_sweeps(std::vector<BladeSweep>& out) const {
+  out.clear();
+  const std::array<Vec3, 2> edge = blade_edge();
+  for (std::size_t k = 0; k < trail_.size(); ++k) {
+    const std::array<Vec3, 2>& to = k + 1 < trail_.size() ? trail_[k + 1] : edge;
+    out.push_back(BladeSweep{trail_[k][0], trail_[k][1], to[0], to[1]});
+  }
 }
 
 }  // namespace pointhaptics

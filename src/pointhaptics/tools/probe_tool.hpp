@@ -52,6 +52,9 @@ class ProbeTool final : public DynamicForces {
   /// pair that moved back over a strip the edge had passed would escape a blade that cut only its last strip
   /// (a device's blade through the cantilever missed 6 of 169 pairs and left it whole).
   const std::vector<std::array<Vec3, 2>>& blade_trail() const { return trail_; }
+  /// The strips a cutting blade sweeps this step: from each edge of its trail to the next, the last to blade_edge()
+  /// (none on the step a cut starts). `out` is cleared first; it allocates only to grow.
+  void blade_sweeps(std::vector<BladeSweep>& out) const;
   /// Steps in the cutting resistance's history, at most cut_history_steps (a second at 1 kHz: a blade crawling
   /// slower than a spacing a second feels the area over its last second).
   std::size_t cut_history_size() const { return cut_history_.size(); }
