@@ -192,9 +192,7 @@ void HaplyDevice::command(const Vec3& force) {
 void HaplyDevice::stop() {
   Connection& c = *connection_;
   if (!c.open) return;
-  c.open = false;
   try {
-    c.open = true;
     if (c.awaiting) c.receive();
     c.send(c.command("set_cursor_force", {{"vector", to_haply(Vec3::Zero())}}));
     c.within_timeout("close", [&](auto handler) {
