@@ -555,7 +555,8 @@ names the problem.)doc")
             return py::make_tuple(vertices, triangles, static_cast<long long>(split.cut_faces));
           },
           "The object's surface split along the cuts so far (docs/cutting.md): (vertices, triangles, cut_faces), copies "
-          "at the current state; the last cut_faces triangles are the faces of the cuts. Without cuts, the surface of "
+          "at the current state; the last cut_faces triangles are the faces of the cuts (with several bodies, each cut "
+          "body's come last among its own). Without cuts, the surface of "
           "surface_vertices and surface_triangles (whose size stays as it was built: they stay the uncut surface).")
       .def(
           "run_scene",

@@ -4,9 +4,13 @@
 #include <pointhaptics/io/scene_toml.hpp>
 #include <pointhaptics/mechanics/energy.hpp>
 #include <pointhaptics/session/scene_builder.hpp>
+#include <pointhaptics/session/interactive.hpp>
 #include <pointhaptics/session/scene_session.hpp>
 #include <pointhaptics/world/simulation.hpp>
 #include <pointhaptics/output/vtk_output.hpp>
+#include <pointhaptics/mechanics/cut.hpp>
+#include <pointhaptics/surface/cut_surface.hpp>
+#include <pointhaptics/surface/object_surface.hpp>
 
 #include "support/scene_sessions.hpp"
 
@@ -95,6 +99,11 @@ TEST(Bodies, TablesAreReadAndTheirMistakesNamed) {
         "load[0].object: \"a\" names an [[object]], but the scene has one [object]");
   fails(two_blocks(0.0, "kind = \"explicit\"", "[lod]\ncontact = [0.0, 0.0, 0.0]"),
         "lod: not yet with several [[object]] tables");
+  const std::string cut =
+      "[[cut]]\nedge = [[0.0, 0.05, 0.0], [0.0, 0.05, 0.04]]\nto = [[0.04, 0.05, 0.0], [0.04, 0.05, 0.04]]";
+  fails(two_blocks(0.0, "kind = \"explicit\"", cut), "cut[0].object: missing: with several [[object]] tables");
+  fails(two_blocks(0.0, "kind = \"explicit\"", cut + "\nobject = \"top\""),
+        "cut[0].object: no [[object]] is named \"top\"");
   std::string coloured = two_blocks(0.0, "kind = \"static\"");
   coloured.replace(coloured.find("material = {"), 12, "material = { colour = 1,");
   fails(coloured, "object[1].material.colour: unknown key");
@@ -318,6 +327,120 @@ TEST(Bodies, ContactTablesAreReadAndTheirMistakesNamed) {
         "contact.pairs[0].bodies: expected bodies = [\"NAME\", \"NAME\"]");
   fails("[object]\nsize = [0.01, 0.01, 0.01]\n[contact]\nfriction = 0.3",
         "contact: [contact] is between several [[object]] tables");
+}
+
+}  // namespace
+
+namespace {
+
+// a slab held at its left end 1 cm above a block held at its base; a scripted blade drawn down through both near the
+// slab's root cuts the slab alone (the one it names): its free piece falls onto the block and comes to rest there,
+// the block carrying its weight; the bodies' contact then goes on over the slab's surface split along the cut
+TEST(Bodies, AScriptedCutCutsTheBodyItNamesAndItsPieceFallsOntoTheOther) {
+  const std::string text = R"(
+[material]
+young = 1e6
+poisson = 0.3
+density = 1000.0
+damping = 20.0
+[[object]]
+name = "block"
+shape = "box"
+origin = [0.01, 0.0, 0.0]
+size = [0.05, 0.02, 0.02]
+spacing = 0.005
+[[object]]
+name = "slab"
+shape = "box"
+origin = [0.0, 0.03, 0.0]
+size = [0.06, 0.01, 0.02]
+spacing = 0.005
+[[fixed]]
+object = "block"
+box = { min = [-1.0, -1.0, -1.0], max = [1.0, 0.001, 1.0] }
+[[fixed]]
+object = "slab"
+box = { min = [-1.0, -1.0, -1.0], max = [0.006, 1.0, 1.0] }
+[[load]]
+kind = "gravity"
+[[cut]]
+object = "slab"
+edge = [[0.0175, 0.05, -0.01], [0.0175, 0.05, 0.03]]
+to = [[0.0175, 0.005, -0.01], [0.0175, 0.005, 0.03]]
+start = 0.0
+duration = 0.02
+[solver]
+kind = "implicit"
+dt = 2e-3
+)";
+  SceneSession s = open_scene(parse_scene(text, "scene.toml"), two_threads());
+  Simulation& sim = *s.simulation;
+  const Model& model = sim.model();
+  ASSERT_EQ(model.n_bodies(), 2);
+  // the slab's piece beyond the cut: its weight is what the block must carry
+  double falling = 0;
+  for (index_t i = model.body_start[1]; i < model.body_start[2]; ++i)
+    if (model.X(0, i) > 0.0175) falling += model.mass[i] * 9.81;
+  sim.run(0.8);
+  const RunSummary summary = sim.summary();
+  ASSERT_TRUE(summary.converged) << summary.failure;
+  // the blade passed through both, but severed the slab's pairs alone: three pieces, the block whole
+  std::vector<index_t> piece_of;
+  EXPECT_EQ(piece_sizes(sim.model(), piece_of).size(), 3u);
+  for (index_t i = model.body_start[0]; i < model.body_start[1]; ++i)
+    for (index_t e = model.neighbours.begin(i); e < model.neighbours.end(i); ++e)
+      ASSERT_FALSE(!sim.model().severed.empty() && sim.model().severed[e]) << "a pair of the block was cut";
+  // the piece fell the 1 cm gap and rests on the block, which carries its weight
+  EXPECT_NEAR(body(summary, "block").contact_force.y(), -falling, 0.01 * falling);
+  EXPECT_NEAR(body(summary, "slab").contact_force.y(), falling, 0.01 * falling);
+  EXPECT_LT(summary.body_contact.penetration, 0.01 * spacing);
+  index_t below = 0;
+  for (index_t i = model.body_start[1]; i < model.body_start[2]; ++i)
+    if (model.X(0, i) > 0.03) below += sim.state().u(1, i) < -0.009;
+  EXPECT_GT(below, 0) << "the free piece came down the gap";
+  EXPECT_LT(summary.kinetic_energy, 1e-6);
+  // the contact goes on over the split surface: the slab's part has the cut's faces, the block's is as it was
+  const ObjectSurface whole = build_object_surface(parse_scene(text, "scene.toml"), model);
+  const ObjectSurface split = split_surface(whole, sim.model(), sim.cut_sheets().triangles);
+  EXPECT_GT(split.cut_faces, 0);
+  EXPECT_EQ(split.body_vertex_start[1], whole.body_vertex_start[1]) << "the block's surface is not split";
+  EXPECT_EQ(split.body_face_start[1], whole.body_face_start[1]);
+  EXPECT_GT(split.body_vertex_start[2], whole.body_vertex_start[2]) << "the slab's is";
+  ASSERT_NE(sim.body_contact(), nullptr);
+  EXPECT_EQ(sim.body_contact()->vertex_start(), split.body_vertex_start) << "the bodies touch by the split surface";
+  EXPECT_GE(summary.cut.surface_splits, 1);
+}
+
+}  // namespace
+
+namespace {
+
+// the shipped scene of two layers, one cut while the other is pressed: by the time the blade has passed (0.2 s) the
+// upper layer is in two pieces and the lower one whole, the probe on the lower layer feels it, and the bodies touch
+// by the upper layer's split surface
+TEST(Bodies, TheShippedSceneCutsOneLayerWhileTheOtherIsPressed) {
+  SceneSession s = open_scene_file(PH_SCENES "/two_layers_cut_and_pressed.toml", two_threads());
+  InteractiveOptions options = s.interactive;
+  options.real_time = false;
+  options.log = false;
+  options.duration = 0.25;
+  const InteractiveResult result = run_interactive(*s.simulation, *s.device, options);
+  const Simulation& sim = *s.simulation;
+  const Model& model = sim.model();
+  ASSERT_FALSE(sim.diagnostics().failed);
+  std::vector<index_t> piece_of;
+  const std::vector<index_t> pieces = piece_sizes(model, piece_of);
+  ASSERT_EQ(pieces.size(), 3u);
+  EXPECT_EQ(pieces[0], model.body_start[1]) << "the lower layer is one piece";
+  EXPECT_GT(result.tool.force.y(), 0.1) << "the probe presses the lower layer";
+  const RunSummary summary = s.simulation->summary();
+  EXPECT_GT(body(summary, "upper").contact_force.y(), 0.5 * 0.04 * 0.01 * 0.04 * 1000.0 * 9.81)
+      << "the lower layer holds the upper one up";
+  EXPECT_EQ(summary.cut.surface_splits, 2) << "the probe's and the bodies' surfaces, each split once the cut stopped";
+  const ObjectSurface whole = build_object_surface(s.scene, model);
+  const std::vector<index_t>& touching = s.simulation->body_contact()->vertex_start();
+  EXPECT_EQ(touching[1], whole.body_vertex_start[1]) << "the lower layer's surface is whole";
+  EXPECT_GT(touching[2], whole.body_vertex_start[2]) << "the upper layer's is split along the cut";
 }
 
 }  // namespace

@@ -85,7 +85,9 @@ origin = [0.08, 0.03, 0.02]
 struct TwoHandRun {
   InteractiveResult result;
   RunSummary summary;
-  nlohmann::json json;  ///< the result document
+  nlohmann::json json;                  ///< the result document
+  std::vector<HapticLogRow> first_log;  ///< each hand's force log, streamed
+  std::vector<HapticLogRow> second_log;
 };
 
 TwoHandRun run(const std::string& text, bool real_time = false) {
@@ -94,6 +96,9 @@ TwoHandRun run(const std::string& text, bool real_time = false) {
   options.real_time = real_time;
   options.log = false;
   TwoHandRun r;
+  options.log_sink = [&r](const HapticLogRow& row) { r.first_log.push_back(row); };
+  if (!options.other_hands.empty())
+    options.other_hands[0].log_sink = [&r](const HapticLogRow& row) { r.second_log.push_back(row); };
   r.result = run_interactive(*s.simulation, *s.device, options);
   r.summary = s.simulation->summary();
   add_interactive_summary(r.summary, r.result);
@@ -184,6 +189,20 @@ TEST(TwoHands, OneHandsForceIsItsOwnWhateverTheOtherDoes) {
   EXPECT_LT(alone.result.other_hands[0].haptic.max_force_n, 1e-3 * alone.result.haptic.max_force_n)
       << "b touches nothing: its device is commanded nothing while a presses";
   EXPECT_GT(both.result.other_hands[0].haptic.max_force_n, 0.5 * both.result.haptic.max_force_n);
+  // each hand's force log is its own: a row per tick of its loop, carrying the force its device was commanded
+  const auto largest = [](const std::vector<HapticLogRow>& log) {
+    double f = 0;
+    for (const HapticLogRow& row : log) f = std::max(f, row.force.norm());
+    return f;
+  };
+  for (const TwoHandRun* r : {&alone, &both}) {
+    EXPECT_EQ(r->first_log.size(), 600u);
+    EXPECT_EQ(r->second_log.size(), 600u);
+    EXPECT_EQ(r->result.other_hands[0].log_dropped, 0);
+    EXPECT_NEAR(largest(r->first_log), r->result.haptic.max_force_n, 1e-9);
+    EXPECT_NEAR(largest(r->second_log), r->result.other_hands[0].haptic.max_force_n, 1e-9);
+  }
+  EXPECT_LT(largest(alone.second_log), 1e-3 * largest(alone.first_log)) << "b's log is b's, not a's";
   // the result: both hands in `tools`, each with its own haptic figures
   const nlohmann::json& doc = both.json;
   ASSERT_TRUE(doc.contains("tools")) << doc.dump();

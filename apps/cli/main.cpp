@@ -28,6 +28,8 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <deque>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
@@ -164,6 +166,12 @@ struct OutputErrors {
   }
 };
 
+// a second or later hand's force log, beside the first's: force.csv -> force-left.csv
+std::string hand_log_path(const std::string& force_log, const std::string& hand) {
+  const std::filesystem::path p = force_log;
+  return (p.parent_path() / (p.stem().string() + "-" + hand + p.extension().string())).string();
+}
+
 int run_command(const RunOptions& opt) {
   // the ParaView folder first (made with its parents, so other outputs may go beside it), then every output
   // is checked before anything is computed: a long run must not end in "cannot write"
@@ -239,10 +247,17 @@ int run_command(const RunOptions& opt) {
     // the force log is streamed to its file as the run goes: any length in bounded memory
     options.log = false;
     std::optional<ph::TextOutput> force_log;
+    // every other hand's beside it: force.csv, force-finger.csv, ... (a deque: the sinks hold their addresses)
+    std::deque<ph::TextOutput> hand_logs;
     if (!opt.force_log.empty()) {
       force_log.emplace(opt.force_log, "--force-log");
       ph::print_haptic_log_header(*force_log);
       options.log_sink = [&force_log](const ph::HapticLogRow& row) { ph::print_haptic_log_row(*force_log, row); };
+      for (ph::HandOptions& hand : options.other_hands) {
+        ph::TextOutput& log = hand_logs.emplace_back(hand_log_path(opt.force_log, hand.name), "--force-log");
+        ph::print_haptic_log_header(log);
+        hand.log_sink = [&log](const ph::HapticLogRow& row) { ph::print_haptic_log_row(log, row); };
+      }
     }
     // ParaView frames every --vtk-every steps (default: the first and last states only, since a real-time
     // run's step count is not known in advance)
@@ -252,10 +267,16 @@ int run_command(const RunOptions& opt) {
       };
     interactive = ph::run_interactive(sim, *session.device, options);
     if (force_log) errors.attempt([&] { force_log->commit(); });
-    if (interactive.log_dropped > 0)
-      errors.messages.push_back(
-          fmt::format("--force-log {}: {} haptic ticks were not logged (the simulation thread fell behind)",
-                      opt.force_log, interactive.log_dropped));
+    for (ph::TextOutput& log : hand_logs) errors.attempt([&] { log.commit(); });
+    const auto dropped = [&](const std::string& path, long long ticks) {
+      if (ticks > 0)
+        errors.messages.push_back(fmt::format(
+            "--force-log {}: {} haptic ticks were not logged (the simulation thread fell behind)", path, ticks));
+    };
+    dropped(opt.force_log, interactive.log_dropped);
+    if (!opt.force_log.empty())
+      for (const ph::HandResult& hand : interactive.other_hands)
+        dropped(hand_log_path(opt.force_log, hand.name), hand.log_dropped);
   } else {
     // the posed tools' forces at every step (and the start): t, tool, force, its friction part, contacts, depth
     std::optional<ph::TextOutput> tool_log;
@@ -410,7 +431,8 @@ int cli_main(int argc, char** argv) {
       ->transform(CLI::AsSizeValue(false));
   run_cmd->add_flag("--quiet,-q", run.quiet, "Print nothing but errors");
   run_cmd->add_option("--force-log", run.force_log,
-                      "With a [probe]: write the haptic log (CSV, one row per tick) to FILE");
+                      "With a [probe]: write the haptic log (CSV, one row per tick) to FILE; with several hands, "
+                      "each other hand's beside it, named FILE's stem-HAND (force.csv, force-left.csv)");
   run_cmd->add_option("--tool-log", run.tool_log,
                       "With [[tool]] tables held or moved by the scene: write each tool's force at every step (CSV: t, "
                       "tool, fx, fy, fz, friction_x, friction_y, friction_z, contacts, penetration)");

@@ -88,13 +88,26 @@ index_t range_of(const std::vector<index_t>& starts, index_t i) {
 index_t BodyContact::body_of_vertex(index_t v) const { return range_of(vertex_start_, v); }
 index_t BodyContact::body_of_face(index_t t) const { return range_of(face_start_, t); }
 
+void BodyContact::carry_multipliers(const BodyContact& from, std::span<const index_t> from_vertex) {
+  if (refreshed_ || from_vertex.size() != static_cast<std::size_t>(mesh_.V.cols()))
+    throw Error("body contact: multipliers are carried over before the first refresh, one source per vertex");
+  std::vector<double> multiplier(static_cast<std::size_t>(from.mesh_.V.cols()), 0.0);
+  for (const Pair& p : from.pairs_) multiplier[static_cast<std::size_t>(p.vertex)] = p.multiplier;
+  previous_multiplier_.assign(from_vertex.size(), 0.0);
+  for (std::size_t v = 0; v < from_vertex.size(); ++v)
+    if (from_vertex[v] >= 0) previous_multiplier_[v] = multiplier[static_cast<std::size_t>(from_vertex[v])];
+}
+
 void BodyContact::refresh(const Model& model, const Points& u) {
-  refreshed_ = true;
   const index_t nv = static_cast<index_t>(mesh_.V.cols()), nf = static_cast<index_t>(mesh_.F.size());
   carry_surface(map_, mesh_.V, u, y_);
-  // the multipliers of the vertices paired now, kept for those paired again
-  previous_multiplier_.assign(static_cast<std::size_t>(nv), 0.0);
-  for (const Pair& p : pairs_) previous_multiplier_[static_cast<std::size_t>(p.vertex)] = p.multiplier;
+  // the multipliers of the vertices paired now, kept for those paired again (at the first refresh, those
+  // carry_multipliers() gave, if any)
+  if (refreshed_ || previous_multiplier_.size() != static_cast<std::size_t>(nv)) {
+    previous_multiplier_.assign(static_cast<std::size_t>(nv), 0.0);
+    for (const Pair& p : pairs_) previous_multiplier_[static_cast<std::size_t>(p.vertex)] = p.multiplier;
+  }
+  refreshed_ = true;
 
   // the deformed triangles' centroids, reach and normals; the vertices' normals (area-weighted)
   centroid_.resize(3, nf);

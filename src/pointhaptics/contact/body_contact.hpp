@@ -31,6 +31,7 @@
 #include <array>
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <vector>
 
 namespace pointhaptics {
@@ -82,6 +83,11 @@ class BodyContact final : public DynamicForces, public EnergyTerm {
   /// The loads on the bodies at u, with the pairs and multipliers as they are.
   BodyLoads loads(const Model& model, const Points& u) const;
   double tolerance() const { return tolerance_; }
+  /// Body k's vertices are [vertex_start()[k], vertex_start()[k + 1]).
+  const std::vector<index_t>& vertex_start() const { return vertex_start_; }
+  /// Before the first refresh: take `from`'s multipliers, vertex v's from its vertex from_vertex[v] (-1: none),
+  /// so that a contact rebuilt over a changed surface (split along a cut) goes on pressing as the last did.
+  void carry_multipliers(const BodyContact& from, std::span<const index_t> from_vertex);
   index_t pairs() const { return static_cast<index_t>(pairs_.size()); }
 
   // DynamicForces: explicit steps evaluate the term at each sub-step; the pairs are refreshed after each step

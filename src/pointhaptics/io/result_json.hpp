@@ -32,8 +32,8 @@ struct CutSummary {
   double mean_update_ms = 0;          ///< the updates' mean, ms
   std::vector<index_t> piece_points;  ///< points per connected piece, in the order of their lowest point
   long long sheet_triangles = 0;      ///< the cuts' sheets (reference configuration) the surface splits along
-  long long surface_splits = 0;       ///< a probe's surface split along them (once per blade stroke)
-  double max_split_ms = 0;            ///< the longest split, ms (on a worker in real time)
+  long long surface_splits = 0;  ///< a probe's or the bodies' contact surface split along them (once per stroke or cut)
+  double max_split_ms = 0;       ///< the longest split, ms (on a worker in real time)
 };
 
 /// What a run reports besides the points: solver outcome, energies, timing, support reactions.

@@ -220,6 +220,9 @@ struct CutSpec {
   std::array<Vec3, 2> to{Vec3::Zero(), Vec3::Zero()};    ///< m, scene axes
   double start = 0;                                      ///< s
   double duration = 0;                                   ///< s (0: the whole sweep at once, at `start`)
+  /// The [[object]] it cuts (required with several: a blade drawn through two layers cuts only the one named;
+  /// empty with one object)
+  std::string object;
   int line = 0;
 };
 

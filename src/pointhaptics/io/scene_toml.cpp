@@ -588,6 +588,7 @@ CutSpec read_cut(TableReader& r) {
       "start", c.start, [](double t) { return t >= 0 && t <= 1e6; }, "must lie in [0, 1e6] (s)");
   c.duration = r.number(
       "duration", c.duration, [](double t) { return t >= 0 && t <= 1e6; }, "must lie in [0, 1e6] (s)");
+  c.object = r.string("object", "");
   return c;
 }
 
@@ -1026,6 +1027,7 @@ void check_body_names(const Scene& scene) {
     check(scene.fixed[k].object, "fixed", k, scene.fixed[k].line, false);
   for (std::size_t k = 0; k < scene.loads.size(); ++k)
     check(scene.loads[k].object, "load", k, scene.loads[k].line, scene.loads[k].kind == LoadKind::GRAVITY);
+  for (std::size_t k = 0; k < scene.cuts.size(); ++k) check(scene.cuts[k].object, "cut", k, scene.cuts[k].line, false);
   for (std::size_t k = 0; k < scene.contact.pairs.size(); ++k)
     for (const std::string& name : scene.contact.pairs[k].bodies)
       if (!known(name))
@@ -1048,9 +1050,9 @@ void check_body_names(const Scene& scene) {
   refuse(scene.lod.present, scene.lod.line, "lod", "an active set is one object's");
   refuse(!scene.refine.empty(), scene.refine.empty() ? 0 : scene.refine.front().line, "refine",
          "a refinement resamples one object");
-  refuse(!scene.cuts.empty(), scene.cuts.empty() ? 0 : scene.cuts.front().line, "cut",
-         "a cut's surface is built on one object's");
-  refuse(scene.probe.cut, scene.probe.line, "probe.mode", "a blade cuts one object's surface");
+  const std::string_view blade = "a device's blade cuts one object; a [[cut]] names the one it cuts";
+  refuse(scene.probe.cut, scene.probe.line, "probe.mode", blade);
+  for (const SceneHand& other : scene.other_hands) refuse(other.probe.cut, other.probe.line, "tool.mode", blade);
   refuse(!scene.regions.empty(), scene.regions.empty() ? 0 : scene.regions.front().line, "region",
          "give each [[object]] its own material = { ... }");
 }

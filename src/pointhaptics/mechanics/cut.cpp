@@ -50,7 +50,11 @@ std::vector<index_t> pairs_crossing(const Model& model, const Points& x, const B
   const std::array<CrossingTriangle, 2> swept{CrossingTriangle(sweep.a0, sweep.b0, sweep.b1),
                                               CrossingTriangle(sweep.a0, sweep.b1, sweep.a1)};
   std::vector<index_t> crossing;
-  for (index_t i = 0; i < model.n_points; ++i) {
+  // (no pair leaves a body: its points' range is all the body's pairs)
+  const bool one_body = sweep.body >= 0 && !model.body_start.empty();
+  const index_t first = one_body ? model.body_start[static_cast<std::size_t>(sweep.body)] : 0;
+  const index_t end = one_body ? model.body_start[static_cast<std::size_t>(sweep.body) + 1] : model.n_points;
+  for (index_t i = first; i < end; ++i) {
     if (!inside(i)) continue;
     const Vec3 p = x.col(i);
     const std::array<double, 2> side_p{swept[0].side(p), swept[1].side(p)};

@@ -24,6 +24,9 @@ struct BladeSweep {
   /// sweep). A blade cuts at its edge: with a trail swept over many steps, material that later moves across
   /// the trail far behind the edge (where the blade's body would stand in its way) is not cut.
   double edge_reach = std::numeric_limits<double>::infinity();
+  /// Only this body's pairs are cut (Model::body_start; -1: every body the sweep crosses): a scripted blade drawn
+  /// through two layers cuts the one it names.
+  index_t body = -1;
 };
 
 /// The pairs e = (i, j), i < j, not yet severed, whose segment between the points' positions `x` (3 x n: the

@@ -113,8 +113,8 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
                           const std::string& name) {
     const CouplingGains gains = coupling_budget(device.specs(), mapping.scale, options.coupling_safety);
     sim.attach_probe(probe, gains.stiffness, device.specs().max_force, options.real_time, std::move(surface), name);
-    const std::size_t log_rows =
-        k == 0 && (options.log || streamed) ? static_cast<std::size_t>(4 * options.haptic_rate) + 64 : 0;
+    const bool logged = k == 0 ? options.log || streamed : static_cast<bool>(options.other_hands[k - 1].log_sink);
+    const std::size_t log_rows = logged ? static_cast<std::size_t>(4 * options.haptic_rate) + 64 : 0;
     hands[k].loop = std::make_unique<HapticLoop>(device, mapping, gains, options.rules, options.haptic_rate, log_rows);
   };
   attach(0, device, options.probe, options.surface, options.mapping, {});
@@ -127,6 +127,8 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
   const auto take_log = [&] {
     if (streamed) loop.take_log(options.log_sink);
     else if (options.log) loop.take_log([&](const HapticLogRow& row) { result.log.push_back(row); });
+    for (std::size_t k = 1; k < hands.size(); ++k)
+      if (options.other_hands[k - 1].log_sink) hands[k].loop->take_log(options.other_hands[k - 1].log_sink);
   };
   const auto stopped = [&options] {
     return stop_requested() || (options.stop && options.stop->load(std::memory_order_acquire));
@@ -215,7 +217,7 @@ InteractiveResult run_interactive(Simulation& sim, Device& device, const Interac
   for (std::size_t k = 1; k < hands.size(); ++k) {
     const HapticStats haptic = hands[k].loop->stats();
     result.other_hands.push_back({sim.hand_name(k), haptic, with_haptics(sim.tool_summary(k), haptic),
-                                  hands[k].max_contacts, hands[k].stray.summary()});
+                                  hands[k].max_contacts, hands[k].stray.summary(), hands[k].loop->log_dropped()});
   }
   return result;
 }

@@ -48,6 +48,9 @@ struct HandOptions {
   ProbeParams probe;
   std::shared_ptr<const ObjectSurface> surface;  ///< as InteractiveOptions::surface
   WorkspaceMapping mapping;
+  /// If set, this hand's force log (one row per haptic tick of its own loop) is streamed here, as
+  /// InteractiveOptions::log_sink streams the first hand's.
+  std::function<void(const HapticLogRow&)> log_sink;
 };
 
 struct InteractiveOptions {
@@ -91,6 +94,7 @@ struct HandResult {
   ToolSummary tool;  ///< its probe at the end, with its haptic figures
   int max_contacts = 0;
   LocalModelSummary local_model;
+  long long log_dropped = 0;  ///< ticks its log_sink did not get (the simulation thread did not take them in time)
 };
 
 struct InteractiveResult {

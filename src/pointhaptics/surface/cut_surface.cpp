@@ -329,14 +329,11 @@ void CutSheets::add_strip(const Vec3& A0, const Vec3& B0, const Vec3& A1, const 
   triangles.push_back({A0, B1, A1});
 }
 
-ObjectSurface split_surface(const ObjectSurface& whole, const Model& model, std::span<const SheetTriangle> given) {
-  // (a sheet that is not finite, from a state that was not, splits nothing)
-  std::vector<SheetTriangle> finite;
-  finite.reserve(given.size());
-  for (const SheetTriangle& t : given)
-    if (t[0].allFinite() && t[1].allFinite() && t[2].allFinite()) finite.push_back(t);
-  const std::span<const SheetTriangle> sheets(finite);
-  if (sheets.empty()) return whole;
+namespace {
+
+// One body's surface split (`body`: its index, whose points alone carry it; -1: the model's one body)
+ObjectSurface split_body_surface(const ObjectSurface& whole, const Model& model, std::span<const SheetTriangle> sheets,
+                                 index_t body) {
   const TriangleMesh& mesh = whole.mesh;
   const index_t n_whole = static_cast<index_t>(mesh.V.cols());
   const double edge = mean_edge_length(mesh);
@@ -379,7 +376,7 @@ ObjectSurface split_surface(const ObjectSurface& whole, const Model& model, std:
     Y.col(static_cast<Eigen::Index>(r)) = out.vertex[static_cast<std::size_t>(remap[r])];
   const VertexSees sees = [&](index_t r, index_t j) {
     const std::size_t v = static_cast<std::size_t>(remap[static_cast<std::size_t>(r)]);
-    return (model.X.col(j) - out.vertex[v]).squaredNorm() <= reach * reach &&
+    return (body < 0 || model.body_of(j) == body) && (model.X.col(j) - out.vertex[v]).squaredNorm() <= reach * reach &&
            !grid.crosses(out.from[v], model.X.col(j));
   };
   std::vector<char> uncarried;
@@ -424,6 +421,47 @@ ObjectSurface split_surface(const ObjectSurface& whole, const Model& model, std:
       sheets.size() == 1 ? "" : "s", split.cut_faces,
       dropped_faces ? fmt::format(", {} triangles dropped: too few points to carry them", dropped_faces) : "");
   return split;
+}
+
+// whether any of body k's pairs is severed
+bool body_is_cut(const Model& model, index_t k) {
+  if (model.severed.empty()) return false;
+  const Csr& nbr = model.neighbours;
+  const auto b = static_cast<std::size_t>(k);
+  for (index_t i = model.body_start[b]; i < model.body_start[b + 1]; ++i)
+    for (index_t e = nbr.begin(i); e < nbr.end(i); ++e)
+      if (model.severed[static_cast<std::size_t>(e)]) return true;
+  return false;
+}
+
+}  // namespace
+
+ObjectSurface split_surface(const ObjectSurface& whole, const Model& model, std::span<const SheetTriangle> given) {
+  // (a sheet that is not finite, from a state that was not, splits nothing)
+  std::vector<SheetTriangle> finite;
+  finite.reserve(given.size());
+  for (const SheetTriangle& t : given)
+    if (t[0].allFinite() && t[1].allFinite() && t[2].allFinite()) finite.push_back(t);
+  const std::span<const SheetTriangle> sheets(finite);
+  if (sheets.empty()) return whole;
+  if (whole.body_vertex_start.size() < 3 || model.body_start.size() < 3)
+    return split_body_surface(whole, model, sheets, -1);
+  // several bodies: each split alone, carried by its own points. A cut names its body, and its sheet may pass
+  // through others (a blade drawn through two layers to cut the upper one): a body none of whose pairs a cut
+  // severed keeps its surface whole
+  ObjectSurface joined;
+  std::string split_bodies;
+  for (index_t k = 0; k + 1 < static_cast<index_t>(whole.body_vertex_start.size()); ++k) {
+    ObjectSurface part = body_surface(whole, k);
+    if (body_is_cut(model, k)) {
+      part.source = fmt::format("\"{}\"", model.body_names[static_cast<std::size_t>(k)]);
+      part = split_body_surface(part, model, sheets, k);
+      split_bodies += "; " + part.source;
+    }
+    append_body_surface(joined, part);
+  }
+  joined.source = whole.source + split_bodies;
+  return joined;
 }
 
 }  // namespace pointhaptics

@@ -138,9 +138,6 @@ void check_bodies_apart(const Scene& scene, const Model& model, const ObjectSurf
 // every body's surface, each carried by its own points
 ObjectSurface bodies_surface(const Scene& scene, const Model& model) {
   ObjectSurface joined;
-  joined.mesh.V.resize(3, 0);
-  joined.body_vertex_start.push_back(0);
-  joined.body_face_start.push_back(0);
   for (std::size_t k = 0; k < scene.bodies.size(); ++k) {
     const BodySpec& body = scene.bodies[k];
     const std::string name = fmt::format("{}:{}: object[{}] \"{}\"", scene.path, body.object.line, k, body.name);
@@ -153,19 +150,9 @@ ObjectSurface bodies_surface(const Scene& scene, const Model& model) {
     ObjectSurface part = object_mesh(body.object, model);
     check_closed_manifold(part.mesh, name + "'s surface");
     const auto own = static_cast<index_t>(k);
-    const SurfaceMap map =
+    part.map =
         build_surface_map(model, part.mesh.V, nullptr, [&](index_t, index_t j) { return model.body_of(j) == own; });
-    const index_t v0 = static_cast<index_t>(joined.mesh.V.cols());
-    joined.mesh.V.conservativeResize(3, v0 + part.mesh.V.cols());
-    joined.mesh.V.rightCols(part.mesh.V.cols()) = part.mesh.V;
-    for (const auto& t : part.mesh.F) joined.mesh.F.push_back({t[0] + v0, t[1] + v0, t[2] + v0});
-    const index_t e0 = joined.map.points.n_entries();
-    for (index_t v = 0; v < map.n_vertices(); ++v) joined.map.points.offset.push_back(e0 + map.points.offset[v + 1]);
-    joined.map.points.index.insert(joined.map.points.index.end(), map.points.index.begin(), map.points.index.end());
-    joined.map.weight.insert(joined.map.weight.end(), map.weight.begin(), map.weight.end());
-    joined.map.widened += map.widened;
-    joined.body_vertex_start.push_back(static_cast<index_t>(joined.mesh.V.cols()));
-    joined.body_face_start.push_back(static_cast<index_t>(joined.mesh.F.size()));
+    append_body_surface(joined, part);
     joined.source += fmt::format("{}\"{}\": {}", k ? "; " : "", body.name, part.source);
   }
   check_bodies_apart(scene, model, joined);
@@ -194,6 +181,48 @@ Points deformed_surface(const ObjectSurface& surface, const Points& u) {
   Points y;
   carry_surface(surface.map, surface.mesh.V, u, y);
   return y;
+}
+
+void append_body_surface(ObjectSurface& joined, const ObjectSurface& part) {
+  if (joined.body_vertex_start.empty()) {
+    joined.mesh.V.resize(3, 0);
+    joined.body_vertex_start.push_back(static_cast<index_t>(joined.mesh.V.cols()));
+    joined.body_face_start.push_back(static_cast<index_t>(joined.mesh.F.size()));
+  }
+  const index_t v0 = static_cast<index_t>(joined.mesh.V.cols());
+  joined.mesh.V.conservativeResize(3, v0 + part.mesh.V.cols());
+  joined.mesh.V.rightCols(part.mesh.V.cols()) = part.mesh.V;
+  for (const auto& t : part.mesh.F) joined.mesh.F.push_back({t[0] + v0, t[1] + v0, t[2] + v0});
+  const SurfaceMap& map = part.map;
+  const index_t e0 = joined.map.points.n_entries();
+  for (index_t v = 0; v < map.n_vertices(); ++v) joined.map.points.offset.push_back(e0 + map.points.offset[v + 1]);
+  joined.map.points.index.insert(joined.map.points.index.end(), map.points.index.begin(), map.points.index.end());
+  joined.map.weight.insert(joined.map.weight.end(), map.weight.begin(), map.weight.end());
+  joined.map.widened += map.widened;
+  joined.cut_faces += part.cut_faces;
+  joined.body_vertex_start.push_back(static_cast<index_t>(joined.mesh.V.cols()));
+  joined.body_face_start.push_back(static_cast<index_t>(joined.mesh.F.size()));
+}
+
+ObjectSurface body_surface(const ObjectSurface& joined, index_t k) {
+  const auto b = static_cast<std::size_t>(k);
+  const index_t v0 = joined.body_vertex_start[b], v1 = joined.body_vertex_start[b + 1];
+  ObjectSurface part;
+  part.mesh.V = joined.mesh.V.middleCols(v0, v1 - v0);
+  for (index_t f = joined.body_face_start[b]; f < joined.body_face_start[b + 1]; ++f) {
+    const auto& t = joined.mesh.F[static_cast<std::size_t>(f)];
+    part.mesh.F.push_back({t[0] - v0, t[1] - v0, t[2] - v0});
+  }
+  const SurfaceMap& map = joined.map;
+  part.map.points.offset.assign(1, 0);
+  for (index_t v = v0; v < v1; ++v) {
+    for (index_t e = map.points.begin(v); e < map.points.end(v); ++e) {
+      part.map.points.index.push_back(map.points.index[static_cast<std::size_t>(e)]);
+      part.map.weight.push_back(map.weight[static_cast<std::size_t>(e)]);
+    }
+    part.map.points.offset.push_back(part.map.points.n_entries());
+  }
+  return part;
 }
 
 }  // namespace pointhaptics

@@ -22,6 +22,14 @@ struct ObjectSurface {
   std::vector<index_t> body_vertex_start, body_face_start;
 };
 
+/// Several bodies' surfaces as one (ObjectSurface::body_vertex_start): `part`, one body's, appended to `joined`
+/// as its next body (its vertices, triangles and map rows after the others'; its cut faces counted). Start from
+/// an empty ObjectSurface.
+void append_body_surface(ObjectSurface& joined, const ObjectSurface& part);
+/// Body k's surface alone out of a joined one (vertices and triangles renumbered from 0; the map's rows, over the
+/// same model's points, as they are).
+ObjectSurface body_surface(const ObjectSurface& joined, index_t k);
+
 /// The surface of a solid known only by its points (a point cloud, a volume image): the half level of their
 /// smoothed indicator, the kernel density phi(x) = sum_j V_j w(|x - X_j|, h_j) with the model's kernel,
 /// supports and volumes (about 1 inside, 0 outside, 1/2 on a flat boundary), by marching tetrahedra over a

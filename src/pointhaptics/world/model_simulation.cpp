@@ -79,6 +79,7 @@ void ModelSimulation::continue_from(ModelSimulation&& previous) {
   // the hands, with a split of the surface along the cuts' sheets in flight (it reads the object's model)
   hands_ = std::move(previous.hands_);
   cut_sheets_ = std::move(previous.cut_sheets_);
+  cuts_seen_revision_ = previous.cuts_seen_revision_;
   sheet_edge_ = previous.sheet_edge_;
   log_severed_ = true;
 }
@@ -278,12 +279,45 @@ void ModelSimulation::place_tools() {
   }
   bool cutting = false;
   for (std::size_t k = 0; k < hands_.size(); ++k) cutting = place_hand(hands_[k], inputs_[k]) || cutting;
-  // once no blade cuts (it lifted, or a scripted cut went on), the hands push on the surface split along the cuts:
-  // one split per stroke. (A second hand re-split while the other cut took 25 ms a step on 3k points.)
+  // once the cuts stop (no blade cuts, and a step added no sheet: a scripted cut adds a strip every step it runs),
+  // the hands push on the surface split along them, and the bodies touch by it: one split per stroke or cut. (A
+  // second hand re-split while the other cut took 25 ms a step on 3k points, and a hand re-split at every step of
+  // a scripted cut 29 ms.)
   if (cutting) return;
+  const bool cuts_stopped = cut_sheets_.revision == cuts_seen_revision_;
+  cuts_seen_revision_ = cut_sheets_.revision;
+  if (!cuts_stopped) return;
   for (ProbeAttachment& hand : hands_)
     if (hand.surface && (hand.split_in_flight.valid() || hand.surface_revision != cut_sheets_.revision))
       refresh_probe_surface(hand);
+  if (body_contact_ && body_surface_revision_ != cut_sheets_.revision) refresh_body_surface();
+}
+
+void ModelSimulation::set_body_contact(std::shared_ptr<const ObjectSurface> surface, const BodyContactParams& params) {
+  body_contact_ = std::make_unique<BodyContact>(model_, surface->mesh, surface->map, surface->body_vertex_start,
+                                                surface->body_face_start, params);
+  body_surface_ = std::move(surface);
+  body_contact_params_ = params;
+  body_surface_revision_ = cuts_seen_revision_ = cut_sheets_.revision;
+}
+
+void ModelSimulation::refresh_body_surface() {
+  const StageClock clock;
+  const ObjectSurface split = split_surface(*body_surface_, model_, cut_sheets_.triangles);
+  auto next = std::make_unique<BodyContact>(model_, split.mesh, split.map, split.body_vertex_start,
+                                            split.body_face_start, body_contact_params_);
+  // each body's split surface keeps its uncut vertices first, in their order (split_surface()), as the last one did
+  const std::vector<index_t>& whole = body_surface_->body_vertex_start;
+  const std::vector<index_t>& last = body_contact_->vertex_start();
+  std::vector<index_t> last_vertex(static_cast<std::size_t>(split.mesh.V.cols()), -1);
+  for (std::size_t k = 0; k + 1 < whole.size(); ++k)
+    for (index_t v = 0; v < whole[k + 1] - whole[k]; ++v)
+      last_vertex[static_cast<std::size_t>(split.body_vertex_start[k] + v)] = last[k] + v;
+  next->carry_multipliers(*body_contact_, last_vertex);
+  body_contact_ = std::move(next);
+  body_surface_revision_ = cut_sheets_.revision;
+  ++diagnostics_.surface_splits;
+  diagnostics_.max_split_seconds = std::max(diagnostics_.max_split_seconds, clock.seconds());
 }
 
 bool ModelSimulation::place_hand(ProbeAttachment& hand, const StepInputs& inputs) {

@@ -56,10 +56,11 @@ struct StepDiagnostics {
   double max_step_seconds = 0;  ///< the longest step, s (Simulation::step: the active set's selection included)
   double step_seconds = 0;      ///< wall time in steps, s, and in its stages:
   double active_set_seconds = 0, tools_seconds = 0, solve_seconds = 0;
-  long long cuts = 0;            ///< cut updates (ModelSimulation::cut: a blade step's sweeps)
-  double max_cut_seconds = 0;    ///< the longest of them, the stable step and the solver's rebuild included, s
-  double cut_seconds = 0;        ///< all of them, s
-  long long surface_splits = 0;  ///< a probe's surface split along the cuts' sheets (when it stops cutting)
+  long long cuts = 0;          ///< cut updates (ModelSimulation::cut: a blade step's sweeps)
+  double max_cut_seconds = 0;  ///< the longest of them, the stable step and the solver's rebuild included, s
+  double cut_seconds = 0;      ///< all of them, s
+  long long surface_splits =
+      0;  ///< a probe's or the bodies' contact surface split along the cuts' sheets (when they stop)
   double max_split_seconds = 0;  ///< the longest split, s (off the simulation's thread in real time)
 };
 
@@ -184,7 +185,11 @@ class ModelSimulation {
   std::vector<PosedBody>& posed_bodies() { return posed_bodies_; }
   const std::vector<PosedBody>& posed_bodies() const { return posed_bodies_; }
   /// Contact between the model's bodies (several [[object]] tables); nullptr with one body.
-  std::unique_ptr<BodyContact>& body_contact() { return body_contact_; }
+  BodyContact* body_contact() { return body_contact_.get(); }
+  /// Contact between the model's bodies over `surface` (every body's, ObjectSurface::body_vertex_start), from now
+  /// on. Once the cuts stop (a step that adds no sheet), it takes the surface split along them
+  /// (refresh_body_surface()): the pieces of a cut body touch the others by their own faces.
+  void set_body_contact(std::shared_ptr<const ObjectSurface> surface, const BodyContactParams& params);
 
   // ---- for the layer above that carries a simulation's pipeline from one model to the next (levels of
   // detail: each active set is a new ModelSimulation)
@@ -205,6 +210,9 @@ class ModelSimulation {
   /// places the hand's probe; a blade with its button held cuts (returns true)
   bool place_hand(ProbeAttachment& hand, const StepInputs& inputs);
   void refresh_probe_surface(ProbeAttachment& hand);
+  /// the bodies' contact over their surface split along the cuts, each vertex the split kept carrying its
+  /// multiplier over
+  void refresh_body_surface();
   void check_finite(StepReport& report) const;
   void count_inverted_neighbourhoods();
   void record(const StepReport& report, double seconds);
@@ -216,6 +224,10 @@ class ModelSimulation {
   ForceSet forces_;
   std::vector<PosedBody> posed_bodies_;
   std::unique_ptr<BodyContact> body_contact_;
+  std::shared_ptr<const ObjectSurface> body_surface_;  ///< every body's surface, uncut
+  BodyContactParams body_contact_params_;
+  long long body_surface_revision_ = 0;  ///< the cuts' revision body_contact_'s surface is split along
+  long long cuts_seen_revision_ = 0;     ///< the cuts' revision at the last step (they stopped: it did not change)
   Model model_;
   SolverSpec solver_;
   State state_;

@@ -12,9 +12,11 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 namespace pointhaptics {
 
@@ -60,7 +62,19 @@ const StepReport& Simulation::run_step_stages() {
   return report;
 }
 
-void Simulation::add_scripted_cut(const CutSpec& cut) { scripted_cuts_.push_back({cut, 0.0}); }
+void Simulation::add_scripted_cut(const CutSpec& cut) {
+  const Model& model = this->model();
+  index_t body = -1;
+  if (model.n_bodies() > 1) {
+    const auto named = std::find(model.body_names.begin(), model.body_names.end(), cut.object);
+    if (named == model.body_names.end())
+      throw Error(fmt::format(
+          "cut: {} (with several bodies a cut names the one it cuts)",
+          cut.object.empty() ? std::string("no object named") : fmt::format("no body is named \"{}\"", cut.object)));
+    body = static_cast<index_t>(named - model.body_names.begin());
+  }
+  scripted_cuts_.push_back({cut, 0.0, body});
+}
 
 CutReport Simulation::cut(std::span<const BladeSweep> sweeps) {
   CutReport report = core().cut(sweeps);
@@ -86,8 +100,9 @@ void Simulation::apply_scripted_cuts() {
     auto at = [&](int end, double u) -> Vec3 { return s.edge[end] + u * (s.to[end] - s.edge[end]); };
     const Model& model = this->model();
     const double reach = model.support.size() ? model.support.maxCoeff() : model.h;
-    const BladeSweep trail{at(0, 0.0), at(1, 0.0), at(0, c.done), at(1, c.done), reach};
-    const BladeSweep strip{at(0, c.done), at(1, c.done), at(0, share), at(1, share)};
+    const BladeSweep trail{at(0, 0.0), at(1, 0.0), at(0, c.done), at(1, c.done), reach, c.body};
+    const BladeSweep strip{
+        at(0, c.done), at(1, c.done), at(0, share), at(1, share), std::numeric_limits<double>::infinity(), c.body};
     if (c.done > 0) {
       const std::array<BladeSweep, 2> both{trail, strip};
       cut(both);
@@ -96,8 +111,9 @@ void Simulation::apply_scripted_cuts() {
     }
     c.done = share;
   }
-  // a piece the cuts set free has no equilibrium: say so before the static solve fails on it
-  if (spec.kind == SolverKind::STATIC) {
+  // a piece the cuts set free has no equilibrium: say so before the static solve fails on it (with several
+  // bodies it may rest on another by contact)
+  if (spec.kind == SolverKind::STATIC && this->model().n_bodies() == 1) {
     const Model& model = lod_ ? lod_->settled_object_model() : object_->model();
     std::vector<index_t> piece_of;
     const std::vector<index_t> size = piece_sizes(model, piece_of);
@@ -325,11 +341,10 @@ void Simulation::add_body_contact(const ObjectSurface& surface, const BodyContac
   if (sim.solver().kind == SolverKind::EXPLICIT && contact.max_point_stiffness <= 0)
     contact.max_point_stiffness = sim.model().material.young * sim.model().spacing;
   contact.update_after_step = sim.solver().kind != SolverKind::STATIC;
-  sim.body_contact() = std::make_unique<BodyContact>(sim.model(), surface.mesh, surface.map, surface.body_vertex_start,
-                                                     surface.body_face_start, contact);
+  sim.set_body_contact(std::make_shared<const ObjectSurface>(surface), contact);
 }
 
-BodyContact* Simulation::body_contact() { return core().body_contact().get(); }
+BodyContact* Simulation::body_contact() { return core().body_contact(); }
 
 void Simulation::set_tool_pose(const ToolPose& pose) {
   if (!core().held_tool()) throw Error("tool: no held tool to move");
@@ -543,7 +558,7 @@ RunSummary Simulation::summary() {
           .emplace_back(t.name, ToolSummary{true, kind, t.position, load.force, load.torque, load.contacts,
                                             load.penetration, load.friction});
     }
-  if (model.n_bodies() > 1) body_summaries(model, state, sim.body_contact().get(), s);
+  if (model.n_bodies() > 1) body_summaries(model, state, sim.body_contact(), s);
   if (d.cuts > 0 || !scripted_cuts_.empty()) {
     // the object's cut (with levels of detail every cut of an active set reaches it)
     const Model& object = lod_ ? lod_->settled_object_model() : model;

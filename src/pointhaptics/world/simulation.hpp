@@ -129,7 +129,8 @@ class Simulation {
 
   /// A scripted blade from now on (a scene's [[cut]]): every dynamic step first cuts where the trail its edge has
   /// swept by the end of the step crosses the object (so material that moved back over the trail is cut too);
-  /// a static solve first cuts its whole sweep.
+  /// a static solve first cuts its whole sweep. With several bodies it cuts only cut.object's (an Error names an
+  /// unknown one, or a missing one).
   void add_scripted_cut(const CutSpec& cut);
   /// Cut now, between steps, where the sweeps cross the object at its current positions (ModelSimulation::cut).
   /// With levels of detail the active model is cut, and the cut reaches the object
@@ -178,7 +179,8 @@ class Simulation {
   std::vector<std::string> hand_names_;  ///< per hand (the first's unused: it is tool_name_)
   struct ScriptedCut {
     CutSpec spec;
-    double done = 0;  ///< the share of its sweep already cut
+    double done = 0;    ///< the share of its sweep already cut
+    index_t body = -1;  ///< the body it cuts (spec.object's; -1: the one object)
   };
   std::vector<ScriptedCut> scripted_cuts_;
   void apply_scripted_cuts();
