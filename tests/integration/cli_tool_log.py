@@ -2,6 +2,7 @@
 CSV rows t, tool, fx, fy, fz, friction, contacts, penetration. On the shipped pinch-and-lift scene: two rows a
 step in time order, the jaws open at the start (no contact), and at the end carrying the sample's weight between
 them by friction, as the result JSON's tools block says.
+With two hands, `--force-log FILE` writes one log per hand (FILE, and FILE-HAND beside it).
 Usage: cli_tool_log.py CLI SCENES WORK
 """
 import csv
@@ -30,3 +31,16 @@ assert abs(lift - weight) < 0.01 * weight, (lift, weight)
 assert abs(float(last["left"]["fy"]) - doc["tools"]["left"]["force"][1]) < 1e-9, last["left"]
 assert float(last["left"]["friction_y"]) < 0, last["left"]
 print(f"tool log: {len(rows)} rows over {steps} steps; the jaws carry {lift:.5g} N of the {weight:.5g} N weight")
+
+# two hands, each with its own force log: --force-log FILE writes the first hand's to FILE and the other's beside it
+# under FILE's stem and its name (the shipped two-hands scene for 0.1 s, deterministic: 100 ticks each)
+force = os.path.join(work, "force.csv")
+subprocess.run([cli, "run", os.path.join(scenes, "two_hands_two_layers.toml"), "--quiet", "--deterministic",
+                "--set", "solver.duration=0.1", "--force-log", force, "--json", result], check=True, timeout=300)
+doc = json.load(open(result))
+for path, hand in ((force, "finger"), (os.path.join(work, "force-probe.csv"), "probe")):
+    ticks = list(csv.DictReader(open(path)))
+    assert len(ticks) == doc["tools"][hand]["haptic"]["ticks"] == 100, (path, len(ticks))
+    largest = max((float(r["fx"])**2 + float(r["fy"])**2 + float(r["fz"])**2)**0.5 for r in ticks)
+    assert abs(largest - doc["tools"][hand]["haptic"]["max_force_n"]) < 1e-6, (path, largest)
+print("force logs: one per hand, each its own loop's ticks")
