@@ -444,3 +444,137 @@ TEST(Bodies, TheShippedSceneCutsOneLayerWhileTheOtherIsPressed) {
 }
 
 }  // namespace
+
+namespace {
+
+// one body cut in two: a block held at its base, sawn through horizontally at mid-height; its top piece rests on the
+// bottom one by their cut faces (without the contact between the pieces it falls through: 0.8 m in 0.4 s), and the
+// base carries the whole weight
+TEST(Bodies, ThePiecesOfACutBodyTouch) {
+  const std::string text = R"(
+[object]
+shape = "box"
+size = [0.02, 0.02, 0.02]
+spacing = 0.0025
+[material]
+young = 1e5
+poisson = 0.3
+density = 1000.0
+damping = 20.0
+[[fixed]]
+box = { min = [-1.0, -1.0, -1.0], max = [1.0, 0.0005, 1.0] }
+[[load]]
+kind = "gravity"
+[[cut]]
+edge = [[-0.01, 0.01125, -0.01], [-0.01, 0.01125, 0.03]]
+to = [[0.03, 0.01125, -0.01], [0.03, 0.01125, 0.03]]
+duration = 0.02
+[solver]
+kind = "implicit"
+dt = 2e-3
+)";
+  SceneSession s = open_scene(parse_scene(text, "scene.toml"), two_threads());
+  Simulation& sim = *s.simulation;
+  EXPECT_EQ(sim.body_contact(), nullptr) << "one body in one piece touches nothing";
+  sim.run(0.4);
+  const RunSummary summary = sim.summary();
+  ASSERT_TRUE(summary.converged) << summary.failure;
+  const Model& model = sim.model();
+  std::vector<index_t> piece_of;
+  ASSERT_EQ(piece_sizes(model, piece_of).size(), 2u);
+  ASSERT_NE(sim.body_contact(), nullptr);
+  double top_mass = 0, top_moment = 0;
+  for (index_t i = 0; i < model.n_points; ++i)
+    if (model.X(1, i) > 0.01125) {
+      top_mass += model.mass[i];
+      top_moment += model.mass[i] * sim.state().u(1, i);
+    }
+  EXPECT_GT(top_moment / top_mass, -0.05 * 0.0025) << "the top piece rests on the bottom one";
+  EXPECT_TRUE(summary.body_contact.present);
+  EXPECT_GT(summary.body_contact.contacts, 0);
+  EXPECT_LT(summary.body_contact.penetration, 0.01 * 0.0025);
+  ASSERT_EQ(summary.reactions.size(), 1u);
+  const double weight = model.mass.sum() * 9.81;
+  EXPECT_NEAR(summary.reactions[0].y(), weight, 0.01 * weight) << "the base carries both pieces";
+  EXPECT_LT(summary.kinetic_energy, 1e-6);
+  const nlohmann::json doc = nlohmann::json::parse(result_json(model, sim.state(), summary));
+  EXPECT_GT(doc["body_contact"]["contacts"].get<int>(), 0);
+  EXPECT_FALSE(doc.contains("bodies")) << "one body: no bodies block";
+}
+
+}  // namespace
+
+namespace {
+
+// two blocks apart on a table (explicit), a resting free, b held at its base: once at rest both sleep (their stencils
+// are not evaluated); a hand that comes down on b wakes it and feels what it would have felt had b never slept, and
+// a sleeps on, where it would have been had it stayed awake
+TEST(Bodies, ABodyAtRestThatNothingTouchesSleepsAndWakesWhenTouched) {
+  const auto scene = [](bool sleep) {
+    return fmt::format(R"(
+[material]
+young = 1e5
+poisson = 0.3
+density = 1000.0
+damping = 20.0
+[[object]]
+name = "a"
+shape = "box"
+size = [0.02, 0.01, 0.02]
+spacing = 0.0025
+[[object]]
+name = "b"
+shape = "box"
+origin = [0.03, 0.0, 0.0]
+size = [0.02, 0.01, 0.02]
+spacing = 0.0025
+[[fixed]]
+object = "b"
+box = {{ min = [0.0, -1.0, -1.0], max = [1.0, 0.0005, 1.0] }}
+[[load]]
+kind = "gravity"
+[[obstacle]]
+name = "table"
+plane = {{ point = [0.0, 0.0, 0.0], normal = [0.0, 1.0, 0.0] }}
+[solver]
+kind = "explicit"
+dt = 1e-3
+duration = 1.3
+sleep = {}
+[device]
+kind = "virtual"
+[probe]
+radius = 0.004
+origin = [0.04, 0.02, 0.01]
+keyframes = [[0.0, 0.0, 0.0, 0.0], [0.8, 0.0, 0.0, 0.0], [1.1, 0.0, -0.009, 0.0], [1.3, 0.0, -0.009, 0.0]]
+)",
+                       sleep);
+  };
+  const auto run = [](const std::string& text) {
+    SceneSession s = open_scene(parse_scene(text, "scene.toml"), two_threads());
+    InteractiveOptions options = s.interactive;
+    options.real_time = false;
+    options.log = false;
+    const InteractiveResult result = run_interactive(*s.simulation, *s.device, options);
+    RunSummary summary = s.simulation->summary();
+    add_interactive_summary(summary, result);
+    return summary;
+  };
+  const RunSummary sleeping = run(scene(true)), awake = run(scene(false));
+  ASSERT_TRUE(sleeping.converged) << sleeping.failure;
+  EXPECT_TRUE(body(sleeping, "a").asleep) << "a rests, and nothing touches it";
+  EXPECT_GT(body(sleeping, "a").slept_steps, 200);
+  EXPECT_FALSE(body(sleeping, "b").asleep) << "the hand came down on b";
+  EXPECT_GT(body(sleeping, "b").slept_steps, 50) << "b slept before the hand came";
+  EXPECT_GT(sleeping.tool.force.y(), 0.1) << "b wakes under the hand, which feels it";
+  EXPECT_NEAR(sleeping.tool.force.y(), awake.tool.force.y(), 0.01 * awake.tool.force.y());
+  EXPECT_EQ(body(awake, "a").slept_steps, 0) << "sleep = false";
+  // asleep, a stays where it came to rest
+  EXPECT_NEAR(body(sleeping, "a").mean_displacement.y(), body(awake, "a").mean_displacement.y(),
+              0.01 * std::abs(body(awake, "a").mean_displacement.y()));
+  ASSERT_EQ(sleeping.obstacles.size(), 1u);
+  const double weight = 0.02 * 0.01 * 0.02 * 1000.0 * 9.81;
+  EXPECT_GT(-sleeping.obstacles[0].second.force.y(), weight) << "the table carries a, asleep on it";
+}
+
+}  // namespace

@@ -1,6 +1,7 @@
 #include <pointhaptics/contact/body_contact.hpp>
 
 #include <pointhaptics/core/error.hpp>
+#include <pointhaptics/mechanics/cut.hpp>
 #include <pointhaptics/mechanics/tangent_matrix.hpp>
 
 #include <algorithm>
@@ -30,9 +31,20 @@ BodyContact::BodyContact(const Model& model, TriangleMesh mesh, SurfaceMap map, 
       vertex_start_(std::move(vertex_start)),
       face_start_(std::move(face_start)) {
   const index_t nv = static_cast<index_t>(mesh_.V.cols());
-  if (map_.n_vertices() != nv || vertex_start_.size() < 3 || vertex_start_.size() != face_start_.size() ||
-      vertex_start_.back() != nv || face_start_.back() != static_cast<index_t>(mesh_.F.size()))
-    throw Error("body contact: the surface's bodies do not match its vertices and triangles (at least two bodies)");
+  if (map_.n_vertices() != nv || vertex_start_.size() < 2 || vertex_start_.size() != face_start_.size() ||
+      vertex_start_.back() != nv || face_start_.back() != static_cast<index_t>(mesh_.F.size()) ||
+      static_cast<index_t>(vertex_start_.size()) - 1 != model.n_bodies())
+    throw Error("body contact: the surface's bodies do not match its vertices and triangles, or the model's bodies");
+  std::vector<index_t> piece_of;
+  connected_pieces(model, piece_of);
+  vertex_piece_.assign(static_cast<std::size_t>(nv), -1);
+  for (index_t v = 0; v < nv; ++v)
+    if (map_.points.row_size(v) > 0)
+      vertex_piece_[static_cast<std::size_t>(v)] =
+          piece_of[static_cast<std::size_t>(map_.points.index[map_.points.begin(v)])];
+  face_piece_.reserve(mesh_.F.size());
+  for (const auto& f : mesh_.F) face_piece_.push_back(vertex_piece_[static_cast<std::size_t>(f[0])]);
+  piece_box_.resize(static_cast<std::size_t>(*std::max_element(piece_of.begin(), piece_of.end())) + 1);
   const double spacing = model.spacing;
   tolerance_ = params.tolerance > 0 ? params.tolerance : 1e-3 * spacing;
   reach_ = params.reach > 0 ? params.reach : spacing;
@@ -109,9 +121,13 @@ void BodyContact::refresh(const Model& model, const Points& u) {
   }
   refreshed_ = true;
 
-  // the deformed triangles' centroids, reach and normals; the vertices' normals (area-weighted)
+  // the deformed triangles' centroids, reach and unit normals, and each piece's box; the vertices' normals
+  // (area-weighted)
   centroid_.resize(3, nf);
+  face_normal_.resize(3, nf);
   vertex_normal_.setZero(3, nv);
+  for (Eigen::AlignedBox3d& box : piece_box_)
+    box.setEmpty();  // (sized by the pieces: no allocation once they are known)
   max_circumradius_ = 0;
   for (index_t t = 0; t < nf; ++t) {
     const auto& f = mesh_.F[static_cast<std::size_t>(t)];
@@ -120,9 +136,21 @@ void BodyContact::refresh(const Model& model, const Points& u) {
     centroid_.col(t) = centre;
     max_circumradius_ = std::max({max_circumradius_, (a - centre).norm(), (b - centre).norm(), (c - centre).norm()});
     const Vec3 twice_area = (b - a).cross(c - a);
+    face_normal_.col(t) = twice_area.normalized();
     for (index_t v : f) vertex_normal_.col(v) += twice_area;
+    const index_t piece = face_piece_[static_cast<std::size_t>(t)];
+    if (piece < 0) continue;
+    if (static_cast<std::size_t>(piece) >= piece_box_.size()) piece_box_.resize(static_cast<std::size_t>(piece) + 1);
+    for (const Vec3& corner : {a, b, c}) piece_box_[static_cast<std::size_t>(piece)].extend(corner);
   }
   grid_.rebuild(centroid_);
+  // a vertex farther than the reach from every other piece's box meets no face of it: no grid search (most of a
+  // body's surface, away from the others)
+  const auto near_another_piece = [&](const Vec3& y, index_t own) {
+    for (std::size_t q = 0; q < piece_box_.size(); ++q)
+      if (static_cast<index_t>(q) != own && piece_box_[q].exteriorDistance(y) <= reach_) return true;
+    return false;
+  };
 
   pairs_.clear();
   coefficient_.clear();
@@ -134,11 +162,17 @@ void BodyContact::refresh(const Model& model, const Points& u) {
     Vec3 nearest_normal = Vec3::Zero();
     double nearest_distance = 0;
     std::array<double, 3> beta{0, 0, 0};
+    const index_t piece = vertex_piece_[static_cast<std::size_t>(v)];
+    Anchor& anchor = anchors_[static_cast<std::size_t>(v)];
+    if (piece < 0 || !near_another_piece(y, piece)) {
+      anchor = Anchor{};
+      continue;
+    }
     grid_.for_each_within(centroid_, y, reach_ + max_circumradius_, [&](index_t t) {
-      if (body_of_face(t) == body) return;
+      if (face_piece_[static_cast<std::size_t>(t)] == piece) return;
       const auto& f = mesh_.F[static_cast<std::size_t>(t)];
       const Vec3 a = y_.col(f[0]), b = y_.col(f[1]), c = y_.col(f[2]);
-      const Vec3 normal = (b - a).cross(c - a).normalized();
+      const Vec3 normal = face_normal_.col(t);
       // surfaces that face each other only, within 60 degrees: not the far side of a thin body, nor a side face
       // met edge on (a base's vertex beside a block standing on it, paired with the block's side, held the block
       // from sliding as the side's plane came to it)
@@ -157,7 +191,6 @@ void BodyContact::refresh(const Model& model, const Points& u) {
         beta = coordinates;
       }
     });
-    Anchor& anchor = anchors_[static_cast<std::size_t>(v)];
     if (nearest < 0) {
       anchor = Anchor{};
       continue;

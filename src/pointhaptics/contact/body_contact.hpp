@@ -28,6 +28,8 @@
 #include <pointhaptics/solvers/newton.hpp>
 #include <pointhaptics/solvers/solver.hpp>
 
+#include <Eigen/Geometry>
+
 #include <array>
 #include <cstdint>
 #include <limits>
@@ -73,7 +75,10 @@ struct BodyLoads {
 class BodyContact final : public DynamicForces, public EnergyTerm {
  public:
   /// `mesh`: every body's reference surface, body k's vertices [vertex_start[k], vertex_start[k + 1]) and
-  /// triangles [face_start[k], face_start[k + 1]); `map` carries them with `model`'s points.
+  /// triangles [face_start[k], face_start[k + 1]); `map` carries them with `model`'s points. A vertex touches the
+  /// faces of every other piece of material (mechanics/cut.hpp's connected_pieces() of `model`: the other bodies,
+  /// and the pieces cuts made of its own body, whose surface is then split along the cuts, cut_surface.hpp), so
+  /// one body, cut in pieces, is enough.
   BodyContact(const Model& model, TriangleMesh mesh, SurfaceMap map, std::vector<index_t> vertex_start,
               std::vector<index_t> face_start, const BodyContactParams& params = {});
 
@@ -165,6 +170,9 @@ class BodyContact final : public DynamicForces, public EnergyTerm {
   void update_friction(const Points& u);
   index_t body_of_vertex(index_t v) const;
   index_t body_of_face(index_t t) const;
+  /// The piece of material a vertex moves with (its first carrying point's; -1: carried by none) and a face's (its
+  /// first corner's): a vertex is paired with the faces of the other pieces only.
+  std::vector<index_t> vertex_piece_, face_piece_;
   /// the coefficients of y_v - sum_b beta_b y_{t_b} over the points (appended to coefficient_), and its value at u = 0
   Vec3 append_difference(index_t v, index_t triangle, const std::array<double, 3>& beta);
 
@@ -184,6 +192,8 @@ class BodyContact final : public DynamicForces, public EnergyTerm {
   // refresh's scratch
   Points y_, centroid_;
   Points vertex_normal_;
+  Points face_normal_;                          ///< unit, deformed
+  std::vector<Eigen::AlignedBox3d> piece_box_;  ///< each piece's deformed faces' box
   SpatialGrid grid_;
   std::vector<double> previous_multiplier_;  ///< per vertex, across a refresh
 };

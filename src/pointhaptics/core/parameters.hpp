@@ -148,6 +148,9 @@ struct SolverSpec {
   Preconditioner preconditioner = Preconditioner::BLOCK_JACOBI;  ///< static, implicit
   int refactor_iterations = 8;  ///< cholesky: refactorise after a CG solve of more iterations than this
   Refactorisation refactorisation = Refactorisation::AUTO;  ///< cholesky: where refactorisations run
+  /// explicit, several bodies: a body at rest that nothing touches sleeps (its stencils are not evaluated, its
+  /// points not moved) until something touches it (world/model_simulation.hpp)
+  bool sleep = true;
 };
 
 /// The one table per enum of the names the scene file, the command line and Python use: to_string(),

@@ -2,6 +2,7 @@
 /// @file Solver-owned scratch memory, sized once per model so that a step never allocates.
 #include <pointhaptics/core/model.hpp>
 
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -66,6 +67,12 @@ class Workspace {
   double viscous_shear_factor = 1;
   bool overstress_active = false;
   Eigen::Matrix<double, 6, Eigen::Dynamic> overstress;
+  /// The points that sleep (a body at rest that nothing touches, issue 47): explicit steps neither evaluate their
+  /// stencils nor move them, and `awake` lists the point ranges [first, last) that do not (empty when all sleep).
+  /// `asleep` empty: none sleeps.
+  /// Set between steps by the one who decides (ModelSimulation); only explicit steps read them.
+  std::vector<char> asleep;
+  std::vector<std::array<index_t, 2>> awake;
   std::vector<PaddedPoints> chunk_forces;  ///< per-chunk scatter targets, summed into the result  (n_threads)
   std::vector<double> chunk_scalars;       ///< one value per chunk for reductions without atomics  (n_threads)
   /// The solvers' scratch, sized for the model on the first call (explicit dynamics never pays for it);

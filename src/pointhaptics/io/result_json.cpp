@@ -55,11 +55,13 @@ std::string result_json(const Model& model, const State& state, const RunSummary
     doc["solver"]["factor_bytes"] = s.factor_bytes;
   }
   doc["energy"] = {{"strain", s.strain_energy}, {"kinetic", s.kinetic_energy}};
-  doc["timing"] = {{"wall_s", s.wall_s},
-                   {"step_ms_mean", s.step_ms_mean},
-                   {"step_ms_max", s.step_ms_max},
-                   {"steps_per_s", s.steps_per_s},
-                   {"stages", {{"active_set_s", s.active_set_s}, {"tools_s", s.tools_s}, {"solve_s", s.solve_s}}}};
+  doc["timing"] = {
+      {"wall_s", s.wall_s},
+      {"step_ms_mean", s.step_ms_mean},
+      {"step_ms_max", s.step_ms_max},
+      {"steps_per_s", s.steps_per_s},
+      {"stages",
+       {{"active_set_s", s.active_set_s}, {"tools_s", s.tools_s}, {"solve_s", s.solve_s}, {"contact_s", s.contact_s}}}};
   json constraints = json::array();
   for (size_t g = 0; g < model.fixed_groups.size(); ++g)
     constraints.push_back({{"points", model.fixed_groups[g].points.size()},
@@ -126,12 +128,15 @@ std::string result_json(const Model& model, const State& state, const RunSummary
                         {"mean_displacement", vec(b.mean_displacement)},
                         {"max_displacement", b.max_displacement},
                         {"contact_force", vec(b.contact_force)},
-                        {"constraints", held}};
+                        {"constraints", held},
+                        {"asleep", b.asleep},
+                        {"slept_steps", b.slept_steps}};
     }
+  }
+  if (!s.bodies.empty() || s.body_contact.present)
     doc["body_contact"] = {{"pairs", s.body_contact.pairs},
                            {"contacts", s.body_contact.contacts},
                            {"penetration", s.body_contact.penetration}};
-  }
   if (s.cut.present) {
     const CutSummary& c = s.cut;
     doc["cut"] = {{"sweeps", c.sweeps},

@@ -73,9 +73,13 @@ struct BodySummary {
   double max_displacement = 0;            ///< m
   Vec3 contact_force = Vec3::Zero();      ///< what the other bodies exert on it, N
   std::vector<int> constraints;           ///< its [[fixed]] groups (indices into `constraints`)
+  bool asleep = false;                    ///< at the end (explicit steps: a body at rest that nothing touches)
+  long long slept_steps = 0;              ///< the steps it slept
 };
-/// The contact between the bodies: its vertex-triangle pairs, pressing vertices, and deepest vertex.
+/// The contact between the bodies, and between the pieces cuts made of one (the JSON's `body_contact`, with several
+/// bodies or once a cut has parted one).
 struct BodyContactSummary {
+  bool present = false;
   long long pairs = 0, contacts = 0;
   double penetration = 0;  ///< m
 };
@@ -92,6 +96,7 @@ struct RunSummary {
   /// wall time in the step pipeline's stages, s: following the contact (levels of detail), placing the
   /// tools, the solver
   double active_set_s = 0, tools_s = 0, solve_s = 0;
+  double contact_s = 0;                     ///< the part of solve_s the contacts took (tools, obstacles, bodies)
   double stable_dt = 0;                     ///< explicit: the stable sub-step, s
   long long substeps = 0;                   ///< explicit: sub-steps taken in all; static: load increments
   long long cg_iterations = 0;              ///< static, implicit: conjugate-gradient iterations in all

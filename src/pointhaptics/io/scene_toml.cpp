@@ -458,6 +458,7 @@ void read_solver(TableReader& r, SolverSpec& s) {
   s.preconditioner = r.enumeration("preconditioner", s.preconditioner);
   s.refactor_iterations = count("refactor_iterations", s.refactor_iterations, 1, 1000);
   s.refactorisation = r.enumeration("refactorisation", s.refactorisation);
+  s.sleep = r.boolean("sleep", s.sleep);
 }
 
 // box = { min, max }, sphere = { centre, radius } or cylinder = { centre, axis, radius, half_length }: exactly one

@@ -90,8 +90,12 @@ SceneSession open_scene(Scene scene, const SessionOptions& options) {
       object_surface = std::make_shared<const ObjectSurface>(build_object_surface(scene, s.simulation->model()));
     return object_surface;
   };
-  // several bodies touch on their surfaces (each carried by its own points)
-  if (s.simulation->model().n_bodies() > 1) {
+  // several bodies touch on their surfaces (each carried by its own points), and so do the pieces a cut makes of
+  // one (not yet with levels of detail: an active set carries part of the surface)
+  const bool cuts =
+      !scene.cuts.empty() || scene.probe.cut ||
+      std::any_of(scene.other_hands.begin(), scene.other_hands.end(), [](const SceneHand& h) { return h.probe.cut; });
+  if (s.simulation->model().n_bodies() > 1 || (cuts && !scene.lod.present)) {
     BodyContactParams contact;
     const std::size_t n = scene.bodies.size();
     contact.pair_friction.assign(n * n, scene.contact.friction);

@@ -163,7 +163,7 @@ StepReport explicit_step(const Model& model, State& state, Workspace& ws, double
     ws.for_each_chunk([&](int chunk) {
       first_bad[chunk] = -1;
       for (index_t i = ws.chunk_begin(chunk); i < ws.chunk_end(chunk); ++i) {
-        if (model.fixed[i]) continue;
+        if (model.fixed[i] || (!ws.asleep.empty() && ws.asleep[static_cast<std::size_t>(i)])) continue;
         auto v = state.velocity.col(i);
         auto u = state.u.col(i);
         Vec3 f = ws.f_int.col(i) + model.f_ext.col(i);

@@ -1,5 +1,6 @@
 #include <pointhaptics/solvers/force_set.hpp>
 
+#include <pointhaptics/core/stage_timer.hpp>
 #include <pointhaptics/mechanics/tangent_matrix.hpp>
 
 namespace pointhaptics {
@@ -14,14 +15,24 @@ void ForceSet::add_member(DynamicForces* forces) {
   if (EnergyTerm* term = forces->energy_term()) terms_.members.push_back(term);
 }
 
+double ForceSet::take_seconds() {
+  const double seconds = seconds_ + terms_.seconds;
+  seconds_ = terms_.seconds = 0;
+  return seconds;
+}
+
 void ForceSet::add(const Model& model, const State& state, Points& f) {
-  for (DynamicForces* m : members_) m->add(model, state, f);
+  timed_stage(seconds_, [&] {
+    for (DynamicForces* m : members_) m->add(model, state, f);
+  });
 }
 
 bool ForceSet::add_stiffness(const Model& model, const State& state,
                              Eigen::Matrix<double, 9, Eigen::Dynamic>& springs) {
   bool any = false;
-  for (DynamicForces* m : members_) any = m->add_stiffness(model, state, springs) || any;
+  timed_stage(seconds_, [&] {
+    for (DynamicForces* m : members_) any = m->add_stiffness(model, state, springs) || any;
+  });
   return any;
 }
 
@@ -33,30 +44,42 @@ double ForceSet::max_point_stiffness() const {
 
 bool ForceSet::add_beyond_energy(const Model& model, const State& state, Points& f) {
   bool any = false;
-  for (DynamicForces* m : members_) any = m->add_beyond_energy(model, state, f) || any;
+  timed_stage(seconds_, [&] {
+    for (DynamicForces* m : members_) any = m->add_beyond_energy(model, state, f) || any;
+  });
   return any;
 }
 
 void ForceSet::after_step(const Model& model, const State& state, Workspace& ws) {
-  for (DynamicForces* m : members_) m->after_step(model, state, ws);
+  timed_stage(seconds_, [&] {
+    for (DynamicForces* m : members_) m->after_step(model, state, ws);
+  });
 }
 
 double ForceSet::Terms::energy(const Model& model, const Points& u) {
   double sum = 0;
-  for (EnergyTerm* t : members) sum += t->energy(model, u);
+  timed_stage(seconds, [&] {
+    for (EnergyTerm* t : members) sum += t->energy(model, u);
+  });
   return sum;
 }
 
 void ForceSet::Terms::add_forces(const Model& model, const Points& u, Points& f) {
-  for (EnergyTerm* t : members) t->add_forces(model, u, f);
+  timed_stage(seconds, [&] {
+    for (EnergyTerm* t : members) t->add_forces(model, u, f);
+  });
 }
 
 void ForceSet::Terms::linearise(const Model& model, const Points& u, TangentMode mode) {
-  for (EnergyTerm* t : members) t->linearise(model, u, mode);
+  timed_stage(seconds, [&] {
+    for (EnergyTerm* t : members) t->linearise(model, u, mode);
+  });
 }
 
 void ForceSet::Terms::add_tangent_product(const Points& dx, Points& out) const {
-  for (const EnergyTerm* t : members) t->add_tangent_product(dx, out);
+  timed_stage(seconds, [&] {
+    for (const EnergyTerm* t : members) t->add_tangent_product(dx, out);
+  });
 }
 
 void ForceSet::Terms::add_diagonal_blocks(Eigen::Matrix<double, 9, Eigen::Dynamic>& blocks) const {
@@ -78,7 +101,9 @@ bool ForceSet::Terms::add_to_matrix(TangentMatrix& K) const {
 
 bool ForceSet::Terms::update_multipliers(const Model& model, const Points& u) {
   bool met = true;
-  for (EnergyTerm* t : members) met = t->update_multipliers(model, u) && met;
+  timed_stage(seconds, [&] {
+    for (EnergyTerm* t : members) met = t->update_multipliers(model, u) && met;
+  });
   return met;
 }
 

@@ -16,6 +16,9 @@ class ForceSet final : public DynamicForces {
   /// Add a member; the caller keeps it alive while it is in the set.
   void add_member(DynamicForces* forces);
   bool empty() const { return members_.empty(); }
+  /// The wall time its members took since the last call (every call through the set: forces, energies, tangents,
+  /// multipliers, after_step), s: a step's contact stage, which the solvers interleave with the material's.
+  double take_seconds();
 
   void add(const Model& model, const State& state, Points& f) override;
   bool add_stiffness(const Model& model, const State& state,
@@ -39,7 +42,9 @@ class ForceSet final : public DynamicForces {
     bool add_to_matrix(TangentMatrix& K) const override;
     /// Every member checks and updates its own: met when all are.
     bool update_multipliers(const Model& model, const Points& u) override;
+    mutable double seconds = 0;  ///< the members' wall time in these calls, s
   };
+  double seconds_ = 0;  ///< the members' wall time in the set's own calls, s
   std::vector<DynamicForces*> members_;
   Terms terms_;
 };

@@ -4,6 +4,7 @@
 
 #include <pointhaptics/core/error.hpp>
 #include <pointhaptics/core/stage_timer.hpp>
+#include <pointhaptics/mechanics/cut.hpp>
 #include <pointhaptics/mechanics/inversion.hpp>
 #include <pointhaptics/solvers/explicit_solver.hpp>
 
@@ -242,6 +243,7 @@ const StepReport& ModelSimulation::step() {
   // checks: a state that is not finite is not a result, whatever the solver said; nor is an inverted one (counted)
   check_finite(report_);
   count_inverted_neighbourhoods();
+  update_sleep();
   // diagnostics
   record(report_, clock.seconds());
   return report_;
@@ -252,12 +254,87 @@ void ModelSimulation::solve() {
   solver_impl_->set_real_time(
       std::any_of(hands_.begin(), hands_.end(), [](const ProbeAttachment& h) { return h.asynchronous_lod; }));
   report_ = solver_impl_->step(model_, state_, ws_, tools);
+  dynamic_forces_ = tools != nullptr;
   if (tools && report_.status != StepStatus::FAILED) tools->after_step(model_, state_, ws_);
+  diagnostics_.contact_seconds += forces_.take_seconds();
+}
+
+namespace {
+
+// A body sleeps once every point of it has been slower than this for sleep_time with nothing touching it, and wakes
+// when the contacts' force on it moves from what it was by more than wake_share of its weight and that force (a
+// body resting on a table: the table's support steady to 1e-4 of the weight; a hand or a tool that arrives, a body
+// that lands on it or one under it that moves change it by far more)
+constexpr double sleep_speed = 1e-4;  // m/s
+constexpr double sleep_time = 0.1;    // s
+constexpr double wake_share = 0.02;
+
+}  // namespace
+
+void ModelSimulation::update_sleep() {
+  const index_t n_bodies = model_.n_bodies();
+  if (!solver_.sleep || solver_.kind != SolverKind::EXPLICIT || n_bodies < 2 || !model_.material.prony.empty() ||
+      report_.status == StepStatus::FAILED)
+    return;
+  if (sleep_.size() != static_cast<std::size_t>(n_bodies)) sleep_.assign(static_cast<std::size_t>(n_bodies), {});
+  // a cut wakes every body (it changes what holds them); a hand wakes the bodies whose points it touches
+  const bool cut = cut_sheets_.revision != sleep_cuts_revision_;
+  sleep_cuts_revision_ = cut_sheets_.revision;
+  bool changed = false;
+  for (index_t k = 0; k < n_bodies; ++k) {
+    BodySleep& body = sleep_[static_cast<std::size_t>(k)];
+    const index_t first = model_.body_start[static_cast<std::size_t>(k)],
+                  last = model_.body_start[static_cast<std::size_t>(k) + 1];
+    const auto in_body = [&](index_t i) { return i >= first && i < last; };
+    const bool touched = std::any_of(hands_.begin(), hands_.end(), [&](const ProbeAttachment& hand) {
+      return std::any_of(hand.tool.touched().begin(), hand.tool.touched().end(), in_body);
+    });
+    Vec3 force = Vec3::Zero(), weight = Vec3::Zero();
+    for (index_t i = first; i < last; ++i) {
+      if (dynamic_forces_) force += ws_.acceleration.col(i);
+      weight += model_.f_ext.col(i);
+    }
+    if (body.asleep) {
+      ++body.slept_steps;
+      ++diagnostics_.sleeping_body_steps;
+      if (cut || touched ||
+          (force - body.dynamic_force).norm() > wake_share * (weight.norm() + body.dynamic_force.norm()) + 1e-12) {
+        body.asleep = false;
+        body.quiet = 0;
+        changed = true;
+      }
+      continue;
+    }
+    double fastest = 0;
+    for (index_t i = first; i < last; ++i) fastest = std::max(fastest, state_.velocity.col(i).squaredNorm());
+    body.quiet = fastest < sleep_speed * sleep_speed && !touched && !cut ? body.quiet + solver_.dt : 0.0;
+    if (body.quiet >= sleep_time) {
+      body.asleep = true;
+      body.dynamic_force = force;
+      state_.velocity.middleCols(first, last - first).setZero();
+      changed = true;
+    }
+  }
+  if (!changed) return;
+  // the workspace's view: which points sleep, and the ranges that do not (none sleeping: both empty)
+  const bool any = std::any_of(sleep_.begin(), sleep_.end(), [](const BodySleep& b) { return b.asleep; });
+  ws_.asleep.clear();
+  ws_.awake.clear();
+  if (!any) return;
+  ws_.asleep.assign(static_cast<std::size_t>(model_.n_points), 0);
+  for (index_t k = 0; k < n_bodies; ++k) {
+    const index_t first = model_.body_start[static_cast<std::size_t>(k)],
+                  last = model_.body_start[static_cast<std::size_t>(k) + 1];
+    if (sleep_[static_cast<std::size_t>(k)].asleep)
+      std::fill(ws_.asleep.begin() + first, ws_.asleep.begin() + last, char{1});
+    else if (!ws_.awake.empty() && ws_.awake.back()[1] == first) ws_.awake.back()[1] = last;
+    else ws_.awake.push_back({first, last});
+  }
 }
 
 DynamicForces* ModelSimulation::forces_this_step() {
-  if (hands_.size() <= 1 && posed_bodies_.empty() && !body_contact_)
-    return hands_.empty() ? held_tool_.get() : static_cast<DynamicForces*>(&hands_.front().tool);
+  // (through the set even for one member: it times the contact stage, which the solvers interleave with the rest)
+  if (hands_.empty() && !held_tool_ && posed_bodies_.empty() && !body_contact_) return nullptr;
   forces_.clear();
   for (ProbeAttachment& hand : hands_) forces_.add_member(&hand.tool);
   if (held_tool_) forces_.add_member(held_tool_.get());
@@ -290,32 +367,58 @@ void ModelSimulation::place_tools() {
   for (ProbeAttachment& hand : hands_)
     if (hand.surface && (hand.split_in_flight.valid() || hand.surface_revision != cut_sheets_.revision))
       refresh_probe_surface(hand);
-  if (body_contact_ && body_surface_revision_ != cut_sheets_.revision) refresh_body_surface();
+  if (body_surface_ && body_surface_revision_ != cut_sheets_.revision) refresh_body_surface();
 }
 
+namespace {
+
+// a surface's vertex and face ranges per body (one range for a surface of one body, which has none)
+std::vector<index_t> vertex_ranges(const ObjectSurface& s) {
+  return s.body_vertex_start.empty() ? std::vector<index_t>{0, static_cast<index_t>(s.mesh.V.cols())}
+                                     : s.body_vertex_start;
+}
+std::vector<index_t> face_ranges(const ObjectSurface& s) {
+  return s.body_face_start.empty() ? std::vector<index_t>{0, static_cast<index_t>(s.mesh.F.size())} : s.body_face_start;
+}
+
+}  // namespace
+
 void ModelSimulation::set_body_contact(std::shared_ptr<const ObjectSurface> surface, const BodyContactParams& params) {
-  body_contact_ = std::make_unique<BodyContact>(model_, surface->mesh, surface->map, surface->body_vertex_start,
-                                                surface->body_face_start, params);
   body_surface_ = std::move(surface);
   body_contact_params_ = params;
   body_surface_revision_ = cuts_seen_revision_ = cut_sheets_.revision;
+  // one body in one piece touches nothing until a cut parts it
+  std::vector<index_t> piece_of;
+  body_contact_ =
+      connected_pieces(model_, piece_of) > 1
+          ? std::make_unique<BodyContact>(model_, body_surface_->mesh, body_surface_->map,
+                                          vertex_ranges(*body_surface_), face_ranges(*body_surface_), params)
+          : nullptr;
 }
 
 void ModelSimulation::refresh_body_surface() {
   const StageClock clock;
-  const ObjectSurface split = split_surface(*body_surface_, model_, cut_sheets_.triangles);
-  auto next = std::make_unique<BodyContact>(model_, split.mesh, split.map, split.body_vertex_start,
-                                            split.body_face_start, body_contact_params_);
-  // each body's split surface keeps its uncut vertices first, in their order (split_surface()), as the last one did
-  const std::vector<index_t>& whole = body_surface_->body_vertex_start;
-  const std::vector<index_t>& last = body_contact_->vertex_start();
-  std::vector<index_t> last_vertex(static_cast<std::size_t>(split.mesh.V.cols()), -1);
-  for (std::size_t k = 0; k + 1 < whole.size(); ++k)
-    for (index_t v = 0; v < whole[k + 1] - whole[k]; ++v)
-      last_vertex[static_cast<std::size_t>(split.body_vertex_start[k] + v)] = last[k] + v;
-  next->carry_multipliers(*body_contact_, last_vertex);
-  body_contact_ = std::move(next);
   body_surface_revision_ = cut_sheets_.revision;
+  std::vector<index_t> piece_of;
+  if (connected_pieces(model_, piece_of) < 2) {  // a slit: one body, still one piece, touches nothing
+    body_contact_ = nullptr;
+    return;
+  }
+  const ObjectSurface split = split_surface(*body_surface_, model_, cut_sheets_.triangles);
+  const std::vector<index_t> split_start = vertex_ranges(split);
+  auto next = std::make_unique<BodyContact>(model_, split.mesh, split.map, split_start, face_ranges(split),
+                                            body_contact_params_);
+  // each body's split surface keeps its uncut vertices first, in their order (split_surface()), as the last one did
+  if (body_contact_) {
+    const std::vector<index_t> whole = vertex_ranges(*body_surface_);
+    const std::vector<index_t>& last = body_contact_->vertex_start();
+    std::vector<index_t> last_vertex(static_cast<std::size_t>(split.mesh.V.cols()), -1);
+    for (std::size_t k = 0; k + 1 < whole.size(); ++k)
+      for (index_t v = 0; v < whole[k + 1] - whole[k]; ++v)
+        last_vertex[static_cast<std::size_t>(split_start[k] + v)] = last[k] + v;
+    next->carry_multipliers(*body_contact_, last_vertex);
+  }
+  body_contact_ = std::move(next);
   ++diagnostics_.surface_splits;
   diagnostics_.max_split_seconds = std::max(diagnostics_.max_split_seconds, clock.seconds());
 }

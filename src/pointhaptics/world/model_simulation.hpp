@@ -56,9 +56,12 @@ struct StepDiagnostics {
   double max_step_seconds = 0;  ///< the longest step, s (Simulation::step: the active set's selection included)
   double step_seconds = 0;      ///< wall time in steps, s, and in its stages:
   double active_set_seconds = 0, tools_seconds = 0, solve_seconds = 0;
-  long long cuts = 0;          ///< cut updates (ModelSimulation::cut: a blade step's sweeps)
-  double max_cut_seconds = 0;  ///< the longest of them, the stable step and the solver's rebuild included, s
-  double cut_seconds = 0;      ///< all of them, s
+  /// the part of solve_seconds the contacts took (every tool's, obstacle's and the bodies': ForceSet::take_seconds)
+  double contact_seconds = 0;
+  long long cuts = 0;                 ///< cut updates (ModelSimulation::cut: a blade step's sweeps)
+  double max_cut_seconds = 0;         ///< the longest of them, the stable step and the solver's rebuild included, s
+  double cut_seconds = 0;             ///< all of them, s
+  long long sleeping_body_steps = 0;  ///< steps a body slept (summed over the bodies), its stencils not evaluated
   long long surface_splits =
       0;  ///< a probe's or the bodies' contact surface split along the cuts' sheets (when they stop)
   double max_split_seconds = 0;  ///< the longest split, s (off the simulation's thread in real time)
@@ -186,6 +189,14 @@ class ModelSimulation {
   const std::vector<PosedBody>& posed_bodies() const { return posed_bodies_; }
   /// Contact between the model's bodies (several [[object]] tables); nullptr with one body.
   BodyContact* body_contact() { return body_contact_.get(); }
+  /// Body k's sleep (SolverSpec::sleep): whether it sleeps now, and the steps it slept.
+  struct BodySleep {
+    bool asleep = false;
+    long long slept_steps = 0;
+    double quiet = 0;                   ///< s its points have been slower than the sleeping speed, nothing touching it
+    Vec3 dynamic_force = Vec3::Zero();  ///< the contacts' force on it when it fell asleep, N
+  };
+  const std::vector<BodySleep>& body_sleep() const { return sleep_; }
   /// Contact between the model's bodies over `surface` (every body's, ObjectSurface::body_vertex_start), from now
   /// on. Once the cuts stop (a step that adds no sheet), it takes the surface split along them
   /// (refresh_body_surface()): the pieces of a cut body touch the others by their own faces.
@@ -214,6 +225,9 @@ class ModelSimulation {
   /// multiplier over
   void refresh_body_surface();
   void check_finite(StepReport& report) const;
+  /// a body at rest that nothing touches falls asleep, one whose contacts' force changed or that a hand touches
+  /// or a cut reaches wakes (explicit steps of several bodies)
+  void update_sleep();
   void count_inverted_neighbourhoods();
   void record(const StepReport& report, double seconds);
 
@@ -224,6 +238,9 @@ class ModelSimulation {
   ForceSet forces_;
   std::vector<PosedBody> posed_bodies_;
   std::unique_ptr<BodyContact> body_contact_;
+  std::vector<BodySleep> sleep_;  ///< per body (sized at the first step that may put one to sleep)
+  long long sleep_cuts_revision_ = 0;
+  bool dynamic_forces_ = false;  ///< the last step had dynamic forces (ws_.acceleration holds their last sub-step's)
   std::shared_ptr<const ObjectSurface> body_surface_;  ///< every body's surface, uncut
   BodyContactParams body_contact_params_;
   long long body_surface_revision_ = 0;  ///< the cuts' revision body_contact_'s surface is split along

@@ -335,7 +335,6 @@ std::vector<std::pair<std::string, ToolLoad>> Simulation::posed_tool_loads() {
 void Simulation::add_body_contact(const ObjectSurface& surface, const BodyContactParams& params) {
   ModelSimulation& sim = core();
   if (lod_) throw Error("body contact: not yet with levels of detail (an active set is one body's)");
-  if (sim.model().n_bodies() < 2) throw Error("body contact: the model has one body");
   if (sim.body_contact()) throw Error("body contact: already on");
   BodyContactParams contact = params;
   if (sim.solver().kind == SolverKind::EXPLICIT && contact.max_point_stiffness <= 0)
@@ -473,8 +472,17 @@ ToolSummary Simulation::tool_summary(std::size_t hand) {
 namespace {
 
 // each body's block: its points, mass, motion, held groups and what the others do to it
-void body_summaries(const Model& model, const State& state, const BodyContact* contact, RunSummary& s) {
+// each body's block (with several) and the contact between them and between the pieces of a cut one
+void body_summaries(const Model& model, const State& state, const BodyContact* contact,
+                    const std::vector<ModelSimulation::BodySleep>& sleep, RunSummary& s) {
   const BodyLoads loads = contact ? contact->loads(model, state.u) : BodyLoads{};
+  if (contact) {
+    s.body_contact.present = true;
+    s.body_contact.pairs = contact->pairs();
+    s.body_contact.contacts = loads.contacts;
+    s.body_contact.penetration = loads.penetration;
+  }
+  if (model.n_bodies() < 2) return;
   for (index_t k = 0; k < model.n_bodies(); ++k) {
     BodySummary b;
     b.name = model.body_names[static_cast<std::size_t>(k)];
@@ -492,12 +500,11 @@ void body_summaries(const Model& model, const State& state, const BodyContact* c
     for (std::size_t g = 0; g < model.fixed_groups.size(); ++g)
       if (!model.fixed_groups[g].points.empty() && model.body_of(model.fixed_groups[g].points.front()) == k)
         b.constraints.push_back(static_cast<int>(g));
+    if (static_cast<std::size_t>(k) < sleep.size()) {
+      b.asleep = sleep[static_cast<std::size_t>(k)].asleep;
+      b.slept_steps = sleep[static_cast<std::size_t>(k)].slept_steps;
+    }
     s.bodies.push_back(std::move(b));
-  }
-  if (contact) {
-    s.body_contact.pairs = contact->pairs();
-    s.body_contact.contacts = loads.contacts;
-    s.body_contact.penetration = loads.penetration;
   }
 }
 
@@ -546,6 +553,7 @@ RunSummary Simulation::summary() {
   s.active_set_s = d.active_set_seconds;
   s.tools_s = d.tools_seconds;
   s.solve_s = d.solve_seconds;
+  s.contact_s = d.contact_seconds;
   if (lod_) lod_->fill(s.lod);
   s.tool = tool_summary();
   s.tool_name = tool_name_;
@@ -558,7 +566,7 @@ RunSummary Simulation::summary() {
           .emplace_back(t.name, ToolSummary{true, kind, t.position, load.force, load.torque, load.contacts,
                                             load.penetration, load.friction});
     }
-  if (model.n_bodies() > 1) body_summaries(model, state, sim.body_contact(), s);
+  body_summaries(model, state, sim.body_contact(), sim.body_sleep(), s);
   if (d.cuts > 0 || !scripted_cuts_.empty()) {
     // the object's cut (with levels of detail every cut of an active set reaches it)
     const Model& object = lod_ ? lod_->settled_object_model() : model;

@@ -116,8 +116,9 @@ class Simulation {
   /// The name the probe or held tool is reported under (summary().tool_name): its [[tool]]'s; "probe" by default.
   void set_tool_name(std::string name) { tool_name_ = std::move(name); }
   /// Contact between the model's bodies (Model::body_start) on their surfaces (`surface`, with its bodies'
-  /// vertices and triangles): contact/body_contact.hpp. Explicit steps lower its penalty to E x spacing per point,
-  /// as a held tool's. Throws Error with one body, with levels of detail, or when it is already on.
+  /// vertices and triangles), and between the pieces cuts make of one, on the surface split along the cuts once
+  /// they stop: contact/body_contact.hpp. One body touches nothing until a cut parts it. Explicit steps lower its
+  /// penalty to E x spacing per point, as a held tool's. Throws Error with levels of detail, or when it is already on.
   void add_body_contact(const ObjectSurface& surface, const BodyContactParams& params = {});
   /// The contact between the bodies (nullptr without one).
   BodyContact* body_contact();

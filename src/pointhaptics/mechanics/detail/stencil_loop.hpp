@@ -176,14 +176,25 @@ void stencil_sum(const Model& model, const Points& u, Workspace& ws, Points& y, 
       model.stencil_end();  // passive points: gradients (their neighbours read them), no stencil
   // every gradient is needed before any stencil's hourglass term (it reads its neighbours' G_j), and
   // every padded u before any gradient
+  // (the points that sleep, ws.asleep: neither their gradients nor their stencils, only ws.awake's; their sum is
+  // 0. No neighbour list leaves a body, and a body sleeps whole)
+  const auto over_awake = [&](index_t first, index_t last, auto&& pass) {
+    if (ws.asleep.empty()) return pass(first, last);
+    for (const std::array<index_t, 2>& range : ws.awake)
+      if (std::max(first, range[0]) < std::min(last, range[1]))
+        pass(std::max(first, range[0]), std::min(last, range[1]));
+  };
   ws.for_each_chunk([&](int c) { pad_points(u, ws.chunk_begin(c), ws.chunk_end(c), ws.padded_u); });
-  ws.for_each_chunk(
-      [&](int c) { gradient_pass(model, ws.padded_u, ws.chunk_begin(c), ws.chunk_end(c), ws.gradients); });
+  ws.for_each_chunk([&](int c) {
+    over_awake(ws.chunk_begin(c), ws.chunk_end(c),
+               [&](index_t first, index_t last) { gradient_pass(model, ws.padded_u, first, last, ws.gradients); });
+  });
   ws.for_each_chunk([&](int c) {
     PaddedPoints& buffer = ws.chunk_forces[c];
     const index_t lo = ws.scatter_begin(c), hi = ws.scatter_end(c);
     buffer.middleCols(lo, hi - lo).setZero();
-    run(ws.chunk_begin(c), std::min(ws.chunk_end(c), stencil_end), buffer);
+    over_awake(ws.chunk_begin(c), std::min(ws.chunk_end(c), stencil_end),
+               [&](index_t first, index_t last) { run(first, last, buffer); });
   });
   ws.for_each_chunk([&](int c) {
     const index_t first = ws.chunk_begin(c), last = ws.chunk_end(c);
