@@ -672,6 +672,8 @@ names the problem.)doc")
               block["contact_force"] = vec(b.contact_force);
               block["mean_displacement"] = vec(b.mean_displacement);
               block["max_displacement"] = b.max_displacement;
+              block["asleep"] = b.asleep;
+              block["slept_steps"] = b.slept_steps;
               block["reference"] = view(m.X, self, first, b.points);
               block["displacement"] = view(p.sim->state().u, self, first, b.points);
               block["velocity"] = view(p.sim->state().velocity, self, first, b.points);
@@ -681,8 +683,9 @@ names the problem.)doc")
           },
           "With several [[object]] tables, each body by name, a dict: first_point and points (its rows in the "
           "object's arrays), mass (kg), contact_force (what the other bodies exert on it now, N), mean_displacement "
-          "(its centre of mass's, m), max_displacement (m), and its rows of reference, displacement and velocity as "
-          "read-only (points, 3) views. Empty with one object.")
+          "(its centre of mass's, m), max_displacement (m), asleep and slept_steps (explicit steps: a body at rest that "
+          "nothing touches sleeps), and its rows of reference, displacement and velocity as read-only (points, 3) "
+          "views. Empty with one object.")
       .def(
           "summary",
           [](PySimulation& p) {

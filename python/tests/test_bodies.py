@@ -29,3 +29,39 @@ def test_the_layers_are_bodies_with_views_of_their_rows():
 def test_one_object_has_no_bodies():
     sim = ph.Simulation.from_scene(os.path.join(SCENES, "block_on_table.toml"), threads=1)
     assert sim.bodies == {}
+
+
+def test_a_body_at_rest_sleeps():
+    # two blocks standing apart on a table, explicit: once settled, both sleep (their material forces are skipped)
+    text = """
+[material]
+young = 1e5
+poisson = 0.3
+density = 1000.0
+damping = 20.0
+[[object]]
+name = "a"
+shape = "box"
+size = [0.02, 0.01, 0.02]
+spacing = 0.005
+[[object]]
+name = "b"
+shape = "box"
+origin = [0.03, 0.0, 0.0]
+size = [0.02, 0.01, 0.02]
+spacing = 0.005
+[[load]]
+kind = "gravity"
+[[obstacle]]
+name = "table"
+plane = { point = [0.0, 0.0, 0.0], normal = [0.0, 1.0, 0.0] }
+[solver]
+kind = "explicit"
+dt = 1e-3
+"""
+    sim = ph.Simulation.from_scene_text(text, threads=1)
+    assert not sim.bodies["a"]["asleep"]
+    sim.run(0.8)
+    for name in ("a", "b"):
+        assert sim.bodies[name]["asleep"], name
+        assert sim.bodies[name]["slept_steps"] > 0, name

@@ -171,6 +171,47 @@ TEST(SurfaceContact, ForcesAreTheEnergyGradientAndTheTangentTheirDerivative) {
   }
 }
 
+// An obstacle's or posed tool's contact carries only the vertices that can touch it
+// (SurfaceContactParams::cull_far_vertices): its energy, forces, tangent, load and multipliers are those of the
+// contact that carries every vertex, for every shape, with friction, over displacements large and small
+TEST(SurfaceContact, CarryingOnlyTheVerticesThatCanTouchChangesNothing) {
+  const Block b = block();
+  for (const ToolCase& t : tools()) {
+    for (const double scale : {1e-4, 3e-3}) {
+      SCOPED_TRACE(std::string(t.name) + " at " + std::to_string(scale) + " m");
+      SurfaceContactParams all, near;
+      all.friction = near.friction = 0.3;
+      near.cull_far_vertices = true;
+      SurfaceContact every(b.model, b.surface, build_surface_map(b.model, b.surface.V), t.shape, all);
+      SurfaceContact culled(b.model, b.surface, build_surface_map(b.model, b.surface.V), t.shape, near);
+      every.set_pose(t.pose);
+      culled.set_pose(t.pose);
+      const Points u = random_field(b.model.n_points, scale, 11);
+      every.anchor_pressing(u);
+      culled.anchor_pressing(u);
+      EXPECT_EQ(every.update_multipliers(b.model, u), culled.update_multipliers(b.model, u));
+      const Points v = random_field(b.model.n_points, scale, 13);
+      EXPECT_NEAR(every.energy(b.model, v), culled.energy(b.model, v), 1e-12 * std::abs(every.energy(b.model, v)));
+      Points f_every = Points::Zero(3, b.model.n_points), f_culled = f_every;
+      every.add_forces(b.model, v, f_every);
+      culled.add_forces(b.model, v, f_culled);
+      ASSERT_GT(f_every.norm(), 0);
+      EXPECT_LT((f_every - f_culled).norm(), 1e-12 * f_every.norm());
+      every.linearise(b.model, v, TangentMode::EXACT);
+      culled.linearise(b.model, v, TangentMode::EXACT);
+      const Points du = random_field(b.model.n_points, 1e-4, 17);
+      Points k_every = Points::Zero(3, b.model.n_points), k_culled = k_every;
+      every.add_tangent_product(du, k_every);
+      culled.add_tangent_product(du, k_culled);
+      EXPECT_LT((k_every - k_culled).norm(), 1e-12 * k_every.norm());
+      const ToolLoad a = every.load(b.model, v), c = culled.load(b.model, v);
+      EXPECT_EQ(a.contacts, c.contacts);
+      EXPECT_LT((a.force - c.force).norm(), 1e-12 * a.force.norm());
+      EXPECT_NEAR(a.penetration, c.penetration, 1e-15);
+    }
+  }
+}
+
 // What the Cholesky preconditioner's factor takes of the contact (EnergyTerm::add_to_matrix): the projected
 // tangent with its coupling between the points that carry a vertex. Where a pair of them lies outside the
 // material tangent's pattern it is lumped onto their diagonal blocks, which keeps the matrix at or above the

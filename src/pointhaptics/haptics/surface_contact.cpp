@@ -79,6 +79,19 @@ SurfaceContact::SurfaceContact(const Model& model, const TriangleMesh& surface, 
     per_area_penalty_ *= scale;
     max_point_stiffness_ = params.max_point_stiffness;
   }
+  cull_ = params.cull_far_vertices;
+  if (cull_) {
+    // how far a vertex can be from where the displacement's largest point moved it, per unit of that: sum |w|
+    weight_l1_.assign(static_cast<std::size_t>(m), 0.0);
+    for (index_t v = 0; v < n_surface_; ++v)
+      for (index_t e = map_.points.begin(v); e < map_.points.end(v); ++e)
+        weight_l1_[static_cast<std::size_t>(v)] += std::abs(map_.weight[static_cast<std::size_t>(e)]);
+    for (std::size_t k = 0; k < samples_.size(); ++k)
+      for (int b = 0; b < 3; ++b)
+        weight_l1_[static_cast<std::size_t>(n_surface_) + k] +=
+            std::abs(samples_[k].weight[b]) * weight_l1_[static_cast<std::size_t>(samples_[k].vertex[b])];
+    carried_.assign(static_cast<std::size_t>(m), 1);
+  }
 }
 
 template <class Fn>
@@ -133,12 +146,55 @@ void SurfaceContact::limit_point_stiffness(std::span<const double> limit, double
 }
 
 void SurfaceContact::evaluate(const Points& u) {
+  if (cull_) return evaluate_near(u);
   // the surface's vertices by the map, then each sample as its combination of them
   carry_surface_into(map_, Y_, u, y_.leftCols(n_surface_));
   for (std::size_t k = 0; k < samples_.size(); ++k) {
     const ContactSample& s = samples_[k];
     y_.col(n_surface_ + static_cast<index_t>(k)) =
         s.weight[0] * y_.col(s.vertex[0]) + s.weight[1] * y_.col(s.vertex[1]) + s.weight[2] * y_.col(s.vertex[2]);
+  }
+}
+
+void SurfaceContact::evaluate_near(const Points& u) {
+  // the largest point displacement bounds how far each vertex moved: |y_v - Y_v| <= sum |w| max_j |u_j|
+  double largest = 0;
+  for (Eigen::Index j = 0; j < u.cols(); ++j) largest = std::max(largest, u.col(j).squaredNorm());
+  largest = std::sqrt(largest);
+  const bool plane = shape_.kind == ToolKind::PLANE;
+  const Vec3 normal = pose_.orientation * Vec3::UnitZ();
+  const double reach = tool_reach(shape_);
+  const index_t m = static_cast<index_t>(Y_.cols());
+  for (index_t v = 0; v < m; ++v) {
+    const auto i = static_cast<std::size_t>(v);
+    const double slack = weight_l1_[i] * largest + tolerance_;
+    const Vec3 from_tool = Y_.col(v) - pose_.position;
+    carried_[i] = lambda_[i] != 0 || (!anchors_.empty() && anchors_[i].held) ||
+                  (plane ? normal.dot(from_tool) <= slack : from_tool.norm() <= reach + slack);
+  }
+  // a sample carried needs its vertices
+  for (std::size_t k = 0; k < samples_.size(); ++k)
+    if (carried_[static_cast<std::size_t>(n_surface_) + k])
+      for (int b = 0; b < 3; ++b) carried_[static_cast<std::size_t>(samples_[k].vertex[b])] = 1;
+  // the others far outside the tool (beyond its reach, above a plane), where every evaluation skips them
+  const Vec3 outside = pose_.position + 1e6 * (plane ? normal : Vec3::UnitX()) + (plane ? 0.0 : reach) * Vec3::UnitX();
+  for (index_t v = 0; v < n_surface_; ++v) {
+    if (!carried_[static_cast<std::size_t>(v)]) {
+      y_.col(v) = outside;
+      continue;
+    }
+    Vec3 y = Y_.col(v);
+    for (index_t e = map_.points.begin(v); e < map_.points.end(v); ++e)
+      y += map_.weight[static_cast<std::size_t>(e)] * u.col(map_.points.index[static_cast<std::size_t>(e)]);
+    y_.col(v) = y;
+  }
+  for (std::size_t k = 0; k < samples_.size(); ++k) {
+    const ContactSample& s = samples_[k];
+    y_.col(n_surface_ + static_cast<index_t>(k)) =
+        carried_[static_cast<std::size_t>(n_surface_) + k]
+            ? Vec3(s.weight[0] * y_.col(s.vertex[0]) + s.weight[1] * y_.col(s.vertex[1]) +
+                   s.weight[2] * y_.col(s.vertex[2]))
+            : outside;
   }
 }
 

@@ -72,6 +72,13 @@ struct SurfaceContactParams {
   /// times the tool's radius). Longer edges get samples at their midpoints (haptics/contact_samples.hpp), so
   /// that the tool cannot pass between the surface's vertices. Negative: the vertices only.
   double sample_spacing = 0;
+  /// Carry only the vertices that can touch the tool: those within its reach of it by a bound on how far the
+  /// displacement moved them (or, for a plane, not above it by that bound), and those whose multiplier or
+  /// friction is in force; the others are put far outside it, where every evaluation skips them. For obstacles
+  /// and posed tools, which read no vertex but those: carrying every vertex of every body at every explicit
+  /// sub-step was a seventh of a three-body run. Not for a device's probe, whose god-object reads every
+  /// triangle (enters()).
+  bool cull_far_vertices = false;
 };
 
 /// A sphere fits through a triangle whose circumradius exceeds its radius, touching none of its vertices. At
@@ -221,6 +228,8 @@ class SurfaceContact final : public EnergyTerm {
   void advance_anchor(index_t v, const ToolDistance& d);
   /// y = Y + W u, the vertices that can touch the tool, and their contact values.
   void evaluate(const Points& u);
+  /// evaluate() of the vertices that can touch the tool (SurfaceContactParams::cull_far_vertices)
+  void evaluate_near(const Points& u);
   /// The load of the vertices pressing on the tool at y_, calling pressing(v, distance, pressure) for each.
   template <class Pressing>
   ToolLoad for_each_pressing(const Pressing& pressing) const;
@@ -247,6 +256,9 @@ class SurfaceContact final : public EnergyTerm {
   std::vector<std::array<index_t, 2>> parents_;    // each sample's two ends (ContactSamples::parents)
   std::vector<std::uint64_t> keys_;                // each vertex's and sample's name on the whole surface
   index_t n_surface_ = 0;
+  bool cull_ = false;              ///< SurfaceContactParams::cull_far_vertices
+  std::vector<double> weight_l1_;  ///< per vertex and sample, sum |w| of its map's row (samples: their parents')
+  std::vector<char> carried_;      ///< evaluate()'s scratch: which vertices and samples it carries
   int sample_levels_ = 0;
   SurfaceMap map_;
   ToolShape shape_;

@@ -267,6 +267,7 @@ void Simulation::add_posed_body(PosedBody::Role role, std::string name, const To
     for (const PosedBody& o : sim.posed_bodies())
       if (o.role == role && o.name == name) throw Error(fmt::format("\"{}\" is already the name of a {}", name, what));
   SurfaceContactParams contact = params;
+  contact.cull_far_vertices = true;  // (an obstacle or a posed tool reads only the vertices that can touch it)
   // explicit steps: as a held tool's (hold_tool())
   if (sim.solver().kind == SolverKind::EXPLICIT && contact.max_point_stiffness <= 0)
     contact.max_point_stiffness = sim.model().material.young * sim.model().spacing;
