@@ -126,8 +126,7 @@ void BodyContact::refresh(const Model& model, const Points& u) {
   centroid_.resize(3, nf);
   face_normal_.resize(3, nf);
   vertex_normal_.setZero(3, nv);
-  for (Eigen::AlignedBox3d& box : piece_box_)
-    box.setEmpty();  // (sized by the pieces: no allocation once they are known)
+  for (Eigen::AlignedBox3d& box : piece_box_) box.setEmpty();  // (one per piece, sized with them by the constructor)
   max_circumradius_ = 0;
   for (index_t t = 0; t < nf; ++t) {
     const auto& f = mesh_.F[static_cast<std::size_t>(t)];
@@ -140,7 +139,6 @@ void BodyContact::refresh(const Model& model, const Points& u) {
     for (index_t v : f) vertex_normal_.col(v) += twice_area;
     const index_t piece = face_piece_[static_cast<std::size_t>(t)];
     if (piece < 0) continue;
-    if (static_cast<std::size_t>(piece) >= piece_box_.size()) piece_box_.resize(static_cast<std::size_t>(piece) + 1);
     for (const Vec3& corner : {a, b, c}) piece_box_[static_cast<std::size_t>(piece)].extend(corner);
   }
   grid_.rebuild(centroid_);

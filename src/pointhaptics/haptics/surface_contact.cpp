@@ -177,7 +177,7 @@ void SurfaceContact::evaluate_near(const Points& u) {
     if (carried_[static_cast<std::size_t>(n_surface_) + k])
       for (int b = 0; b < 3; ++b) carried_[static_cast<std::size_t>(samples_[k].vertex[b])] = 1;
   // the others far outside the tool (beyond its reach, above a plane), where every evaluation skips them
-  const Vec3 outside = pose_.position + 1e6 * (plane ? normal : Vec3::UnitX()) + (plane ? 0.0 : reach) * Vec3::UnitX();
+  const Vec3 outside = pose_.position + (plane ? Vec3(1e6 * normal) : Vec3((reach + 1e6) * Vec3::UnitX()));
   for (index_t v = 0; v < n_surface_; ++v) {
     if (!carried_[static_cast<std::size_t>(v)]) {
       y_.col(v) = outside;
