@@ -41,6 +41,15 @@ void plot(const char* label, const RollingSeries& series, std::vector<float>& sc
                    ImVec2(0, 60));
 }
 
+// with several device-driven tools and the mouse: which one the cursor drives (Tab: the next)
+void hands_panel(const Prepared& p, PanelState& state) {
+  if (p.mice.size() < 2) return;
+  int k = static_cast<int>(p.driven);
+  std::vector<const char*> names;
+  for (const std::string& n : p.hand_names) names.push_back(n.c_str());
+  if (ImGui::Combo("mouse drives (Tab)", &k, names.data(), static_cast<int>(names.size()))) state.drive = k;
+}
+
 void scene_panel(const ViewerSession* session, const Prepared& p, const DisplayFrame& f) {
   ImGui::TextWrapped("%s", p.scene.path.c_str());
   ImGui::Text("%ld points, %ld simulated, %d in contact", static_cast<long>(p.reference.cols()),
@@ -175,6 +184,7 @@ void controls_panel() {
       "left button: grab (held)\n"
       "right drag: orbit   middle drag: pan\n"
       "space: probe stops following the mouse\n"
+      "Tab: the mouse drives the next tool (the others stay)\n"
       "R: reset view   S: screenshot   Q/Esc: quit");
 }
 
@@ -188,6 +198,7 @@ void draw_panels(const ViewerSession* session, const Prepared& p, const DisplayF
                ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
   ImGui::PushItemWidth(150);
   scene_panel(session, p, f);
+  hands_panel(p, state);
   ImGui::Separator();
   const bool edited = parameter_panels(state.edit);
   (void)edited;

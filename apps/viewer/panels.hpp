@@ -24,6 +24,7 @@ struct PanelState {
   Scene edit;
   bool apply = false;  ///< set by the panel when the user applies the edits; the caller rebuilds and clears it
   std::string screenshot_message;
+  int drive = -1;  ///< set by the panel to the hand the cursor should drive; the caller switches and clears it
 };
 
 /// Draw the panels for a window of `width` x `height` (between ImGui::NewFrame and Render). `session` may

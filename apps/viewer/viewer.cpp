@@ -73,7 +73,8 @@ struct ImGuiContextGuard {
 // The mouse drives the probe: the cursor moves it in the plane facing the camera through it, the wheel in
 // depth, the left button grabs.
 struct MouseProbe {
-  Vec3 target = Vec3::Constant(NAN);  ///< scene position the hand aims at
+  Vec3 target = Vec3::Constant(NAN);  ///< scene position the hand the cursor drives aims at
+  std::vector<Vec3> targets;          ///< every hand's, where the cursor left it (the driven one's is `target`)
   CursorAnchor anchor;                ///< moves it with the cursor's motion (from the first motion on)
   bool follow = true;
   double scroll = 0;      ///< wheel clicks since the last frame (from the GLFW callback)
@@ -171,7 +172,25 @@ int run_window(const ViewerOptions& o) {
   PanelState state{session.current().scene, false, {}};
   LiveStats live;
   session.start();
-  mouse.target = session.current().options.mapping.origin;
+
+  // every hand aims at its workspace's origin until the cursor drives it
+  const auto aim_at_origins = [&] {
+    const Prepared& p = session.current();
+    mouse.targets.clear();
+    for (std::size_t k = 0; k < p.hand_names.size(); ++k) mouse.targets.push_back(hand_origin(p, k));
+    mouse.target = hand_origin(p, p.driven);
+    mouse.anchor.reset();
+  };
+  aim_at_origins();
+  // the cursor passes to hand k; the one it drove stays where it left it
+  const auto drive = [&](std::size_t k) {
+    Prepared& p = session.current();
+    if (p.mice.empty() || k == p.driven || k >= p.mice.size()) return;
+    mouse.targets[p.driven] = mouse.target;
+    drive_hand(p, k);
+    mouse.target = mouse.targets[k];
+    mouse.anchor.reset();
+  };
 
   const auto start = std::chrono::steady_clock::now();
   const auto wall = [&start] {
@@ -186,8 +205,7 @@ int run_window(const ViewerOptions& o) {
     if (session.poll()) {  // a rebuild took over
       view.camera.frame(session.current().lo, session.current().hi);
       state.edit = session.current().scene;
-      mouse.target = session.current().options.mapping.origin;
-      mouse.anchor.reset();
+      aim_at_origins();
     }
     Prepared& p = session.current();
     const DisplayFrame& frame = session.frame();
@@ -241,7 +259,10 @@ int run_window(const ViewerOptions& o) {
       }
       if (key == GLFW_KEY_Q || key == GLFW_KEY_ESCAPE) glfwSetWindowShouldClose(window.handle(), 1);
       if (key == GLFW_KEY_S) save_key = true;
+      if (key == GLFW_KEY_TAB && !p.mice.empty()) drive((p.driven + 1) % p.mice.size());
     }
+    if (state.drive >= 0) drive(static_cast<std::size_t>(state.drive));
+    state.drive = -1;
     mouse.keys.clear();
     // the probe follows the cursor in the plane through the hand's target
     if (p.mouse) {

@@ -117,7 +117,20 @@ std::unique_ptr<Prepared> prepare(const Scene& scene_in, ProbeSource source, int
   DeviceSpecs mouse_specs = known_device_specs(scene.device.specs == "custom" ? "touch" : scene.device.specs);
   mouse_specs.name = "mouse";
   p->device = make_device(scene, source, mouse_specs, p->mouse, p->device_name);
-  p->other_devices = make_other_hand_devices(scene, p->options);
+  p->hand_names.push_back(scene.probe_name.empty() ? "probe" : scene.probe_name);
+  for (const SceneHand& h : scene.other_hands) p->hand_names.push_back(h.name);
+  if (p->mouse) {
+    // every hand a mouse of its own, starting at its workspace's origin: the cursor drives one at a time
+    p->mice.push_back(p->mouse);
+    for (HandOptions& hand : p->options.other_hands) {
+      auto mouse = std::make_unique<MouseDevice>(mouse_specs);
+      p->mice.push_back(mouse.get());
+      hand.device = mouse.get();
+      p->other_devices.push_back(std::move(mouse));
+    }
+  } else {
+    p->other_devices = make_other_hand_devices(scene, p->options);
+  }
   DisplayFrame initial;
   initial.u = Points::Zero(3, p->reference.cols());
   initial.probe = p->options.mapping.origin;
@@ -125,6 +138,23 @@ std::unique_ptr<Prepared> prepare(const Scene& scene_in, ProbeSource source, int
   initial.simulated = p->simulation->simulated_model().n_points;
   p->display = std::make_unique<TripleBuffer<DisplayFrame>>(initial);
   return p;
+}
+
+void drive_hand(Prepared& p, std::size_t hand) {
+  if (p.mice.empty()) throw Error("view: the hands are not the mouse's (--probe script or device)");
+  if (hand >= p.mice.size())
+    throw Error(fmt::format("view: hand {} of {}: the scene has no such device-driven tool", hand + 1, p.mice.size()));
+  p.driven = hand;
+  p.mouse = p.mice[hand];
+}
+
+Vec3 hand_origin(const Prepared& p, std::size_t hand) {
+  return hand == 0 ? p.options.mapping.origin : p.options.other_hands.at(hand - 1).mapping.origin;
+}
+
+Vec3 device_of_scene(const Prepared& p, const Vec3& scene, std::size_t hand) {
+  const WorkspaceMapping& m = hand == 0 ? p.options.mapping : p.options.other_hands.at(hand - 1).mapping;
+  return (scene - m.origin) / m.scale;
 }
 
 std::vector<index_t> heaviest_points(const SurfaceMap& map) {
@@ -247,8 +277,7 @@ void ViewerSession::poll_cut_surface() {
 }
 
 Vec3 ViewerSession::device_of_scene(const Vec3& scene) const {
-  const WorkspaceMapping& m = prepared_->options.mapping;
-  return (scene - m.origin) / m.scale;
+  return viewer::device_of_scene(*prepared_, scene, prepared_->driven);
 }
 
 }  // namespace pointhaptics::viewer

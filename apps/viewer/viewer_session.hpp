@@ -27,10 +27,15 @@ struct Prepared {
   Scene scene;
   std::unique_ptr<Simulation> simulation;
   std::unique_ptr<Device> device;
-  MouseDevice* mouse = nullptr;  ///< the device, when the mouse drives it
+  MouseDevice* mouse = nullptr;  ///< the device the cursor drives now (mice[driven]), when the mouse drives
   std::string device_name;       ///< what drives the probe, for the panel
-  /// The scene's other device-driven tools' devices (two hands): the mouse drives the first tool, these the others
+  /// The scene's other device-driven tools' devices (two hands). With the mouse, each is a mouse device of its own
+  /// (mice), of which the cursor drives one at a time (drive_hand()) and the others stay where it left them; with a
+  /// script or a device, the scene's devices.
   std::vector<std::unique_ptr<Device>> other_devices;
+  std::vector<MouseDevice*> mice;  ///< with the mouse: every hand's, in the hands' order (0: `device`'s); else empty
+  std::size_t driven = 0;          ///< the hand the cursor drives (mice's index)
+  std::vector<std::string> hand_names;  ///< every device-driven tool's name, in the hands' order
   InteractiveOptions options;
   Points reference;  ///< the object's points, m
   std::vector<unsigned char> fixed;
@@ -63,6 +68,14 @@ std::vector<index_t> visible_shell(const Csr& neighbours);
 /// Build a scene for viewing; throws Error for a scene that cannot be built.
 std::unique_ptr<Prepared> prepare(const Scene& scene, ProbeSource source, int threads);
 
+/// With the mouse: the cursor drives hand `hand` from now on (prepared.mouse is its device); the hand it drove
+/// stays where it left it. Throws Error for a hand that is not there or without the mouse.
+void drive_hand(Prepared& prepared, std::size_t hand);
+/// Device frame of a scene point for hand `hand` (the inverse of its workspace mapping), for the mouse.
+Vec3 device_of_scene(const Prepared& prepared, const Vec3& scene, std::size_t hand);
+/// Scene position of hand `hand`'s workspace origin, m: where its mouse starts.
+Vec3 hand_origin(const Prepared& prepared, std::size_t hand);
+
 /// Each vertex's point of largest weight in `map`.
 std::vector<index_t> heaviest_points(const SurfaceMap& map);
 
@@ -93,7 +106,7 @@ class ViewerSession {
   /// The run or the last rebuild failed: the message (the old run goes on after a failed rebuild).
   const std::string& error() const { return error_; }
   bool running() const { return thread_.joinable() && !finished_.load(std::memory_order_acquire); }
-  /// Device frame of a scene point (the inverse of the workspace mapping), for the mouse.
+  /// Device frame of a scene point for the hand the cursor drives (the inverse of its workspace mapping).
   Vec3 device_of_scene(const Vec3& scene) const;
 
  private:

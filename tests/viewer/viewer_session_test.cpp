@@ -119,6 +119,36 @@ TEST(ViewerSession, AToolHeldAtAPositionBecomesTheMousesProbe) {
   EXPECT_NEAR(simulate_frame(*p, 0.05).time, 0.05, 1e-9);
 }
 
+// two device-driven tools (scenes/two_hands_two_layers.toml, coarser): with the mouse each has a mouse device of
+// its own, the cursor drives one at a time, and the one it left stays where it was; a script drives both instead
+TEST(ViewerSession, TheMouseDrivesOneToolAtATimeAndTheOtherStaysWhereItLeftIt) {
+  Scene scene = read_scene_file(PH_SCENES_DIR "/two_hands_two_layers.toml");
+  for (BodySpec& b : scene.bodies) b.object.spacing = 0.005;
+  auto p = prepare(scene, ProbeSource::MOUSE, 1);
+  ASSERT_EQ(p->mice.size(), 2u);
+  EXPECT_EQ(p->hand_names, (std::vector<std::string>{"finger", "probe"}));
+  EXPECT_EQ(p->mouse, p->mice[0]);
+  EXPECT_EQ(p->options.other_hands[0].device, p->mice[1]) << "not the scene's scripted device";
+  drive_hand(*p, 1);
+  EXPECT_EQ(p->driven, 1u);
+  EXPECT_EQ(p->mouse, p->mice[1]);
+  EXPECT_THROW(drive_hand(*p, 2), Error);
+  // the cursor aims the second tool 6 mm to the side of its origin, in the air above the lower layer
+  const Vec3 aim = hand_origin(*p, 1) + Vec3(0.006, 0.0, 0.0);
+  p->mouse->set_target(device_of_scene(*p, aim, 1), 0u);
+  const DisplayFrame f = simulate_frame(*p, 0.4);
+  EXPECT_LT((f.probe - hand_origin(*p, 0)).norm(), 2e-4) << "the first tool stays at its origin";
+  const auto second = std::find_if(f.rigid.begin(), f.rigid.end(), [](const auto& r) { return r.hand; });
+  ASSERT_NE(second, f.rigid.end());
+  EXPECT_LT((second->pose.position - aim).norm(), 1e-3) << second->pose.position.transpose();
+  EXPECT_GT((second->pose.position - hand_origin(*p, 1)).norm(), 5e-3);
+
+  auto scripted = prepare(scene, ProbeSource::SCRIPT, 1);
+  EXPECT_TRUE(scripted->mice.empty());
+  EXPECT_EQ(scripted->hand_names.size(), 2u);
+  EXPECT_THROW(drive_hand(*scripted, 1), Error);
+}
+
 TEST(ViewerSession, TheMouseDrivesARealTimeRunAndEditsRebuildIt) {
   const Scene scene = beam_scene();
   ViewerSession session(prepare(scene, ProbeSource::MOUSE, 1), ProbeSource::MOUSE, 1);
