@@ -411,6 +411,80 @@ dt = 2e-3
   EXPECT_GE(summary.cut.surface_splits, 1);
 }
 
+// the same slab and block, cut by a device's blade (a capsule 4 cm long, its edge along z) that the hand draws down
+// with its button held through the slab and 8 mm into the block, then lifts: a scalpel cuts what it passes through,
+// so the slab comes apart and the block is cut but stays one piece; the slab's free piece falls onto the block
+TEST(Bodies, ADevicesBladeCutsEveryBodyItPassesThrough) {
+  const std::string text = R"(
+[material]
+young = 1e6
+poisson = 0.3
+density = 1000.0
+damping = 20.0
+[[object]]
+name = "block"
+shape = "box"
+origin = [0.01, 0.0, 0.0]
+size = [0.05, 0.02, 0.02]
+spacing = 0.005
+[[object]]
+name = "slab"
+shape = "box"
+origin = [0.0, 0.03, 0.0]
+size = [0.06, 0.01, 0.02]
+spacing = 0.005
+[[fixed]]
+object = "block"
+box = { min = [-1.0, -1.0, -1.0], max = [1.0, 0.001, 1.0] }
+[[fixed]]
+object = "slab"
+box = { min = [-1.0, -1.0, -1.0], max = [0.006, 1.0, 1.0] }
+[[load]]
+kind = "gravity"
+[solver]
+kind = "implicit"
+dt = 2e-3
+duration = 1.0
+[[device]]
+name = "hand"
+[[tool]]
+name = "scalpel"
+device = "hand"
+mode = "cut"
+shape = "capsule"
+radius = 0.001
+length = 0.04
+origin = [0.0175, 0.05, 0.01]
+keyframes = [[0.0, 0.0, 0.0, 0.0, 1], [0.15, 0.0, -0.038, 0.0, 1], [0.2, 0.0, -0.038, 0.0, 0], [0.4, 0.0, 0.0, 0.0, 0]]
+)";
+  SceneSession s = open_scene(parse_scene(text, "scene.toml"), two_threads());
+  Simulation& sim = *s.simulation;
+  const Model& model = sim.model();
+  double falling = 0;
+  for (index_t i = model.body_start[1]; i < model.body_start[2]; ++i)
+    if (model.X(0, i) > 0.0175) falling += model.mass[i] * 9.81;
+  InteractiveOptions o = s.interactive;
+  o.real_time = false;
+  o.log = false;
+  const InteractiveResult r = run_interactive(sim, *s.device, o);
+  RunSummary summary = sim.summary();
+  add_interactive_summary(summary, r);
+  ASSERT_TRUE(summary.converged) << summary.failure;
+  EXPECT_GT(summary.cut.sweeps, 0);
+  EXPECT_GE(summary.cut.surface_splits, 1);
+  // the slab in two, the block cut 8 mm deep but whole: three pieces
+  std::vector<index_t> piece_of;
+  EXPECT_EQ(piece_sizes(sim.model(), piece_of).size(), 3u);
+  index_t block_severed = 0;
+  for (index_t i = model.body_start[0]; i < model.body_start[1]; ++i)
+    for (index_t e = model.neighbours.begin(i); e < model.neighbours.end(i); ++e)
+      block_severed += !sim.model().severed.empty() && sim.model().severed[e];
+  EXPECT_GT(block_severed, 0) << "the blade passed into the block too";
+  // the slab's free piece fell onto the block, which carries its weight
+  EXPECT_NEAR(body(summary, "block").contact_force.y(), -falling, 0.02 * falling);
+  EXPECT_LT(summary.body_contact.penetration, 0.01 * 0.005);
+}
+
 }  // namespace
 
 namespace {

@@ -1051,9 +1051,6 @@ void check_body_names(const Scene& scene) {
   refuse(scene.lod.present, scene.lod.line, "lod", "an active set is one object's");
   refuse(!scene.refine.empty(), scene.refine.empty() ? 0 : scene.refine.front().line, "refine",
          "a refinement resamples one object");
-  const std::string_view blade = "a device's blade cuts one object; a [[cut]] names the one it cuts";
-  refuse(scene.probe.cut, scene.probe.line, "probe.mode", blade);
-  for (const SceneHand& other : scene.other_hands) refuse(other.probe.cut, other.probe.line, "tool.mode", blade);
   refuse(!scene.regions.empty(), scene.regions.empty() ? 0 : scene.regions.front().line, "region",
          "give each [[object]] its own material = { ... }");
 }
