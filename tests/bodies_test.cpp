@@ -109,6 +109,87 @@ TEST(Bodies, TablesAreReadAndTheirMistakesNamed) {
   fails(coloured, "object[1].material.colour: unknown key");
 }
 
+// [[region]] and [[refine]] tables name their body: each body gets its own stiff region and its own finer points
+// (the two refinements touch in space at y = 0.02, which two tables of one body may not), and a table naming no
+// body, an unknown one, or a spacing not finer than its own body's is a named error
+TEST(Bodies, EachBodyHasItsOwnRegionsAndRefinements) {
+  const std::string tables = R"(
+[[region]]
+object = "lower"
+box = { min = [-1.0, -1.0, -1.0], max = [0.01, 1.0, 1.0] }
+young = 1e6
+[[refine]]
+object = "lower"
+box = { min = [0.01, 0.01, 0.01], max = [0.03, 0.02, 0.03] }
+spacing = 0.0025
+[[refine]]
+object = "upper"
+box = { min = [0.01, 0.02, 0.01], max = [0.03, 0.03, 0.03] }
+spacing = 0.0025
+)";
+  const Scene plain = parse_scene(two_blocks(0.0, "kind = \"static\""), "scene.toml");
+  const Scene scene = parse_scene(two_blocks(0.0, "kind = \"static\"", tables), "scene.toml");
+  ASSERT_EQ(scene.refine.size(), 2u);
+  EXPECT_EQ(scene.refine[1].object, "upper");
+  EXPECT_EQ(scene.regions[0].object, "lower");
+  const Model uniform = build_scene_model(plain), model = build_scene_model(scene);
+  ASSERT_EQ(model.n_bodies(), 2);
+  for (int b = 0; b < 2; ++b)
+    EXPECT_GT(model.body_start[b + 1] - model.body_start[b], uniform.body_start[b + 1] - uniform.body_start[b])
+        << "body " << b << " gained fine points";
+  ASSERT_EQ(model.support.size(), model.n_points);
+  const auto young = [&](index_t i) {
+    return model.point_materials[model.material_of[static_cast<std::size_t>(i)]].young;
+  };
+  for (int b = 0; b < 2; ++b) {
+    const double lo = b == 0 ? 0.0 : 0.02, hi = b == 0 ? 0.02 : 0.04;
+    index_t fine = 0;
+    for (index_t i = model.body_start[b]; i < model.body_start[b + 1]; ++i) {
+      ASSERT_TRUE(model.X(1, i) >= lo - 1e-12 && model.X(1, i) <= hi + 1e-12) << "a point left its body";
+      fine += model.support[i] < 0.75 * model.h;
+      const double expected = b == 1 ? 2e5 : model.X(0, i) <= 0.01 + 1e-9 ? 1e6 : 1e5;
+      ASSERT_EQ(young(i), expected) << "point " << i << " of body " << b;
+    }
+    EXPECT_GT(fine, 0) << "body " << b << " has points of the fine support";
+  }
+  // pressed together (the lower held at its base, the upper's top moved down 0.5 mm), statically: the refined
+  // bodies touch, equal and opposite, and the lower's support carries what the upper pushes
+  {
+    const std::string held =
+        "[[fixed]]\nobject = \"lower\"\nbox = { min = [-1.0, -1.0, -1.0], max = [1.0, 0.001, 1.0] }\n"
+        "[[fixed]]\nobject = \"upper\"\nbox = { min = [-1.0, 0.039, -1.0], max = [1.0, 1.0, 1.0] }\n"
+        "displacement = [0.0, -0.0005, 0.0]\n";
+    SceneSession s =
+        open_scene(parse_scene(two_blocks(0.0, "kind = \"static\"", tables + held), "scene.toml"), two_threads());
+    s.simulation->step();
+    const RunSummary r = s.simulation->summary();
+    ASSERT_TRUE(r.converged) << r.failure;
+    const Vec3 on_lower = body(r, "lower").contact_force, on_upper = body(r, "upper").contact_force;
+    EXPECT_LT(on_lower.y(), -0.05) << "pressed";
+    EXPECT_LT((on_lower + on_upper).norm(), 1e-9 * on_lower.norm());
+    EXPECT_NEAR(r.reactions.at(0).y(), -on_lower.y(), 1e-3 * -on_lower.y());
+  }
+  const std::string unnamed = "[[refine]]\nbox = { min = [0.0, 0.0, 0.0], max = [0.01, 0.01, 0.01] }\nspacing = 0.0025";
+  EXPECT_NE(error_of(two_blocks(0.0, "kind = \"static\"", unnamed), false).find("refine[0].object: missing"),
+            std::string::npos);
+  EXPECT_NE(error_of(two_blocks(0.0, "kind = \"static\"",
+                                "[[region]]\nobject = \"middle\"\nbox = { min = [0.0, 0.0, 0.0], max = [0.01, 0.01, "
+                                "0.01] }\nyoung = 1e6"),
+                     false)
+                .find("region[0].object: no [[object]] is named \"middle\""),
+            std::string::npos);
+  // upper at 4 mm: 4.5 mm is finer than the lower's 5 mm, not than its own
+  std::string coarse = two_blocks(0.0, "kind = \"static\"",
+                                  "[[refine]]\nobject = \"upper\"\nbox = { min = [0.01, 0.02, 0.01], max = [0.03, "
+                                  "0.03, 0.03] }\nspacing = 0.0045");
+  coarse.replace(coarse.rfind("spacing = 0.005"), 15, "spacing = 0.004");
+  EXPECT_NE(
+      error_of(coarse, false)
+          .find("refine[0].spacing: 0.0045 is out of range: must be finer than object \"upper\"'s spacing (0.004 m)"),
+      std::string::npos)
+      << error_of(coarse, false);
+}
+
 // each body is built alone: its own spacing, material and held points; no neighbour pair crosses; the point load
 // indexes its own body's points
 TEST(Bodies, TheModelJoinsThemWithoutANeighbourAcross) {

@@ -93,6 +93,7 @@ struct FixedSpec : PointSelector {
 /// [[region]]: a part of the object with its own material (a stiff nodule in soft tissue); the keys it
 /// omits are the object's [material]'s. Later tables win where regions overlap.
 struct RegionSpec : PointSelector {
+  std::string object;  ///< the [[object]] it belongs to, by name (empty: the scene's only object)
   std::optional<MaterialModel> model;
   std::optional<double> young, poisson, density;  ///< Pa, -, kg/m^3
   int line = 0;
@@ -101,6 +102,7 @@ struct RegionSpec : PointSelector {
 /// A [[refine]] table: the object's points in the region resampled at a finer spacing (resolution where a tool
 /// presses; geometry/refine_sampling.hpp).
 struct RefineSpec : PointSelector {
+  std::string object;  ///< the [[object]] it resamples, by name (empty: the scene's only object)
   double spacing = 0;  ///< m, finer than the object's
   int line = 0;
 };

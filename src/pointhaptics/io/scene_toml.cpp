@@ -548,6 +548,7 @@ FixedSpec read_fixed(TableReader& r) {
 RegionSpec read_region(TableReader& r) {
   RegionSpec g;
   g.line = r.line();
+  g.object = r.string("object", "");
   read_selector(r, g);
   if (r.find("model")) g.model = r.enumeration("model", MaterialModel::SVK);
   if (r.find("young")) g.young = read_young(r, 0);
@@ -556,14 +557,20 @@ RegionSpec read_region(TableReader& r) {
   return g;
 }
 
-RefineSpec read_refine(TableReader& r, const ObjectSpec& object) {
+// `scene`'s [object], or the [[object]] the table names (an unknown name is check_body_names()'s to report)
+RefineSpec read_refine(TableReader& r, const Scene& scene) {
   RefineSpec f;
   f.line = r.line();
+  f.object = r.string("object", "");
+  const auto named = std::find_if(scene.bodies.begin(), scene.bodies.end(),
+                                  [&](const BodySpec& b) { return !f.object.empty() && b.name == f.object; });
+  const ObjectSpec& object = named != scene.bodies.end() ? named->object : scene.object;
   read_selector(r, f);
   if (!r.find("spacing")) r.fail_table("spacing", "a [[refine]] table needs spacing = s (m), finer than the object's");
   f.spacing = r.number(
       "spacing", 0.0, [&](double s) { return s > 0 && s < object.spacing && s >= 0.05 * object.spacing; },
-      "must be finer than the object's spacing, and at least a twentieth of it (m)");
+      fmt::format("must be finer than {}'s spacing ({} m), and at least a twentieth of it (m)",
+                  f.object.empty() ? std::string("the object") : "object \"" + f.object + "\"", object.spacing));
   if (object.shape == ShapeKind::FILE)
     r.fail_table("spacing", "[[refine]] is for box, sphere and half_sphere objects (not files)");
   return f;
@@ -1029,6 +1036,10 @@ void check_body_names(const Scene& scene) {
   for (std::size_t k = 0; k < scene.loads.size(); ++k)
     check(scene.loads[k].object, "load", k, scene.loads[k].line, scene.loads[k].kind == LoadKind::GRAVITY);
   for (std::size_t k = 0; k < scene.cuts.size(); ++k) check(scene.cuts[k].object, "cut", k, scene.cuts[k].line, false);
+  for (std::size_t k = 0; k < scene.regions.size(); ++k)
+    check(scene.regions[k].object, "region", k, scene.regions[k].line, false);
+  for (std::size_t k = 0; k < scene.refine.size(); ++k)
+    check(scene.refine[k].object, "refine", k, scene.refine[k].line, false);
   for (std::size_t k = 0; k < scene.contact.pairs.size(); ++k)
     for (const std::string& name : scene.contact.pairs[k].bodies)
       if (!known(name))
@@ -1042,17 +1053,10 @@ void check_body_names(const Scene& scene) {
                       scene.path, scene.contact.line));
     return;
   }
-  // not yet: each carries one object's points (a level of detail's active set, a refinement's sampling, a cut's
-  // surface, a region's material)
-  const auto refuse = [&](bool present, int line, std::string_view key, std::string_view why) {
-    if (present)
-      throw Error(fmt::format("{}:{}: {}: not yet with several [[object]] tables ({})", scene.path, line, key, why));
-  };
-  refuse(scene.lod.present, scene.lod.line, "lod", "an active set is one object's");
-  refuse(!scene.refine.empty(), scene.refine.empty() ? 0 : scene.refine.front().line, "refine",
-         "a refinement resamples one object");
-  refuse(!scene.regions.empty(), scene.regions.empty() ? 0 : scene.regions.front().line, "region",
-         "give each [[object]] its own material = { ... }");
+  // not yet: an active set is one object's points
+  if (scene.lod.present)
+    throw Error(fmt::format("{}:{}: lod: not yet with several [[object]] tables (an active set is one object's)",
+                            scene.path, scene.lod.line));
 }
 
 // [[name]] arrays of tables
@@ -1185,7 +1189,7 @@ Scene parse_scene(std::string_view text, const std::string& name, const std::str
   if (scene.probe.cut && scene.probe.held())
     throw Error(fmt::format("{}:{}: probe.mode: a blade cuts as the device moves it, not held at a position", name,
                             scene.probe.line));
-  read_array_of_tables(top, "refine", [&](TableReader& r) { scene.refine.push_back(read_refine(r, scene.object)); });
+  read_array_of_tables(top, "refine", [&](TableReader& r) { scene.refine.push_back(read_refine(r, scene)); });
   if (!scene.refine.empty() && scene.lod.present)
     throw Error(fmt::format("{}:{}: refine: not yet with levels of detail ([lod] thins a uniform sampling)", name,
                             scene.refine.front().line));

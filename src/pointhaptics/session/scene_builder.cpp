@@ -26,6 +26,18 @@
 namespace pointhaptics {
 
 namespace {
+
+// the object a message speaks of
+std::string the_object(const Scene& scene) {
+  return scene.bodies.empty() ? std::string("the object") : fmt::format("object \"{}\"", scene.bodies.front().name);
+}
+
+// Whether a [[fixed]], [[load]], [[region]] or [[refine]] naming `object` (empty: none) applies to the scene's
+// object: with [[object]] tables, the build sees one body at a time (body_scene)
+bool applies(const Scene& scene, const std::string& object) {
+  return object.empty() || scene.bodies.empty() || object == scene.bodies.front().name;
+}
+
 // the set-up's seconds: per point (sampling, surface, stable step, active set: the 104k-point half-sphere of
 // scenes/half_sphere_100k_lod.toml took 7.7 s) and per point per neighbour^1.5 (a pair's work grows with the
 // neighbourhood's size: the stencil fits and the tangent products), measured on the 2-core development machine:
@@ -67,6 +79,7 @@ double estimated_points(const Scene& scene) {
   }
   // [[refine]] regions add their fine points: the part of their bounds within the object's, at their spacing
   for (const RefineSpec& r : scene.refine) {
+    if (!applies(scene, r.object)) continue;
     const Vec3 extent = (r.bounds().max.cwiseMin(hi) - r.bounds().min.cwiseMax(lo)).cwiseMax(0.0);
     n += (extent.array() / r.spacing + 1).prod();
   }
@@ -157,6 +170,7 @@ void check_refine_regions_apart(const Scene& scene) {
   for (std::size_t a = 0; a < scene.refine.size(); ++a)
     for (std::size_t b = a + 1; b < scene.refine.size(); ++b) {
       const RefineSpec &ra = scene.refine[a], &rb = scene.refine[b];
+      if (!applies(scene, ra.object) || !applies(scene, rb.object)) continue;
       const Vec3 lo = ra.bounds().min.cwiseMax(rb.bounds().min), hi = ra.bounds().max.cwiseMin(rb.bounds().max);
       if (!(lo.array() <= hi.array()).all()) continue;
       const double step = std::max(std::min(ra.spacing, rb.spacing), (hi - lo).maxCoeff() / 100);
@@ -180,6 +194,7 @@ PointCloud sample_object(const Scene& scene) {
   // [[refine]]: finer points where a tool presses, each with its own support
   const double support = scene.kernel.support > 0 ? scene.kernel.support : scene.kernel.support_factor * o.spacing;
   for (const RefineSpec& r : scene.refine) {
+    if (!applies(scene, r.object)) continue;
     const double tol = 1e-9 * o.spacing;
     Aabb bounds = r.bounds();
     bounds.min.array() -= tol;
@@ -220,15 +235,18 @@ std::vector<index_t> points_in(const Model& model, const Aabb& box) {
 // otherwise; none without regions
 void assign_region_materials(const Scene& scene, const Points& X, std::vector<MaterialParams>& materials,
                              std::vector<std::uint8_t>& material_of) {
-  if (scene.regions.empty()) return;
-  if (scene.regions.size() + 1 > max_point_materials)
-    throw Error(fmt::format("{}:{}: region: {} [[region]] tables; at most {}", scene.path, scene.regions.back().line,
-                            scene.regions.size(), max_point_materials - 1));
+  const auto own = [&](const RegionSpec& r) { return applies(scene, r.object); };
+  const std::size_t regions = static_cast<std::size_t>(std::count_if(scene.regions.begin(), scene.regions.end(), own));
+  if (regions == 0) return;
+  if (regions + 1 > max_point_materials)
+    throw Error(fmt::format("{}:{}: region: {} [[region]] tables in {}; at most {}", scene.path,
+                            scene.regions.back().line, regions, the_object(scene), max_point_materials - 1));
   materials = {scene.material};
   material_of.assign(static_cast<std::size_t>(X.cols()), 0);
   const double tol = region_tolerance(scene.object.spacing);
   for (std::size_t k = 0; k < scene.regions.size(); ++k) {
     const RegionSpec& r = scene.regions[k];
+    if (!own(r)) continue;
     MaterialParams m = scene.material;
     if (r.model) m.model = *r.model;
     if (r.young) m.young = *r.young;
@@ -237,8 +255,10 @@ void assign_region_materials(const Scene& scene, const Points& X, std::vector<Ma
     materials.push_back(m);
     const std::vector<index_t> inside = points_in(X, r, tol);
     if (inside.empty())
-      throw Error(fmt::format("{}:{}: region[{}].{}: holds no point of the object", scene.path, r.line, k, r.key()));
-    for (const index_t i : inside) material_of[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(k + 1);
+      throw Error(
+          fmt::format("{}:{}: region[{}].{}: holds no point of {}", scene.path, r.line, k, r.key(), the_object(scene)));
+    for (const index_t i : inside)
+      material_of[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(materials.size() - 1);
   }
 }
 
@@ -269,24 +289,14 @@ void apply_stiffness_map(const Scene& scene, PointCloud& cloud) {
 
 namespace {
 
-// The scene with body k as its one object (its own object, material, held points and loads; the rest as given).
+// The scene with body k as its one object (its own object and material; the tables that name another body are
+// skipped where they are read: applies()).
 Scene body_scene(const Scene& scene, std::size_t k) {
   Scene body = scene;
   body.bodies = {scene.bodies[k]};
   body.object = scene.bodies[k].object;
   body.material = scene.bodies[k].material;
   return body;
-}
-
-// Whether a [[fixed]] or [[load]] naming `object` (empty: none) applies to the scene's object: with [[object]]
-// tables, the build sees one body at a time (body_scene)
-bool applies(const Scene& scene, const std::string& object) {
-  return object.empty() || scene.bodies.empty() || object == scene.bodies.front().name;
-}
-
-// the object a message speaks of
-std::string the_object(const Scene& scene) {
-  return scene.bodies.empty() ? std::string("the object") : fmt::format("object \"{}\"", scene.bodies.front().name);
 }
 
 }  // namespace
