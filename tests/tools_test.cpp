@@ -4,6 +4,7 @@
 // pinch is below the weight over 2 mu; two keyframed tools lift a block off a table in implicit dynamics.
 #include <pointhaptics/io/result_json.hpp>
 #include <pointhaptics/io/scene_toml.hpp>
+#include <pointhaptics/session/interactive.hpp>
 #include <pointhaptics/session/scene_session.hpp>
 #include <pointhaptics/world/simulation.hpp>
 
@@ -273,7 +274,14 @@ TEST(Tools, AGrasperIsReadAndItsMistakesNamed) {
        "a grasper needs length > 0"},
       {"[[tool]]\nname = \"g\"\nposition = [0.0, 0.03, 0.0]\nopening = 0.01", "only a grasper has an opening"},
       {"[probe]\nshape = \"grasper\"\nlength = 0.01\nkeyframes = [[0.0, 0.0, 0.0, 0.0]]",
-       "a grasper driven by a device (closed by its button) is not available yet"},
+       "a grasper driven by a device needs opening = <m> (its jaws' gap, the button up) and grip = <m>"},
+      {"[probe]\nshape = \"grasper\"\nlength = 0.01\nopening = 0.02\ngrip = 0.03\nkeyframes = [[0.0, 0.0, 0.0, "
+       "0.0]]",
+       "grip: 0.03 is out of range: must lie in [0, opening)"},
+      {"[probe]\nshape = \"grasper\"\nlength = 0.01\nopening = 0.02\ngrip = 0.01\nmode = \"grab\"\nkeyframes = "
+       "[[0.0, 0.0, 0.0, 0.0]]",
+       "a grasper has no mode"},
+      {"[probe]\nradius = 0.005\ngrip = 0.01\nkeyframes = [[0.0, 0.0, 0.0, 0.0]]", "grip: only a grasper has it"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.text);
@@ -314,6 +322,68 @@ TEST(Tools, AGrasperLiftsCarriesAndLetsGo) {
   EXPECT_LT(sim.state().u.row(1).mean(), 0.002) << "back on the table";
   EXPECT_NEAR(sim.state().u.row(0).mean(), 0.02, 0.003) << "where it was let go";
   EXPECT_EQ(tool(dropped, "grasper").contacts, 0) << "the jaws hold nothing";
+  EXPECT_GT(dropped.obstacles.at(0).second.contacts, 0);
+}
+
+// a device's grasper (a virtual hand's script: [t, x, y, z, button], device frame, from the origin between the jaws
+// at the sample's mid-height): its button closes the jaws from 2.1 to 1.8 cm over 0.1 s, the hand lifts 1 cm and
+// carries 2 cm sideways, and lets the button go; the hand feels the sample's weight while it carries it
+std::string device_grasper() {
+  return R"(
+[[obstacle]]
+name = "table"
+plane = { point = [0.0, 0.0, 0.0], normal = [0.0, 1.0, 0.0] }
+friction = 0.5
+[[device]]
+name = "hand"
+[[tool]]
+name = "grasper"
+device = "hand"
+shape = "grasper"
+radius = 0.005
+length = 0.016
+orientation = [0.7071067811865476, -0.7071067811865476, 0.0, 0.0]
+friction = 0.5
+opening = 0.021
+grip = 0.018
+grip_time = 0.1
+origin = [0.01, 0.0125, 0.01]
+keyframes = [[0.0, 0.0, 0.0, 0.0, 1], [0.1, 0.0, 0.0, 0.0, 1], [0.3, 0.0, 0.01, 0.0, 1], [0.5, 0.02, 0.01, 0.0, 1], [0.55, 0.02, 0.01, 0.0, 0]]
+)";
+}
+
+TEST(Tools, ADevicesGrasperClosesByItsButtonLiftsCarriesAndLetsGo) {
+  const auto run = [](double duration) {
+    SceneSession s = open_scene(
+        parse_scene(sample(fmt::format("kind = \"implicit\"\ndt = 0.002\nduration = {}", duration), device_grasper()),
+                    "scene.toml"),
+        two_threads());
+    InteractiveOptions o = s.interactive;
+    o.real_time = false;
+    o.log = false;
+    EXPECT_EQ(o.probe.mode, ProbeMode::GRASP);
+    const InteractiveResult r = run_interactive(*s.simulation, *s.device, o);
+    RunSummary summary = s.simulation->summary();
+    add_interactive_summary(summary, r);
+    EXPECT_TRUE(s.simulation->posed_tool_loads().empty()) << "its jaws are reported as the hand, not besides it";
+    return std::tuple(summary, Points(s.simulation->state().u), summary.tool);
+  };
+  const auto [carried, u, held] = run(0.5);
+  ASSERT_TRUE(carried.converged) << carried.failure;
+  // the hand follows its script with a lag (a mass on a spring); the sample goes with the grasper
+  EXPECT_GT(u.row(0).mean(), 0.016) << "carried sideways";
+  EXPECT_NEAR(u.row(0).mean(), held.position.x() - 0.01, 0.0015) << "with the grasper";
+  EXPECT_NEAR(u.row(1).mean(), held.position.y() - 0.0125, 0.0015) << "and up with it";
+  EXPECT_GT(u.row(1).mean(), 0.008);
+  EXPECT_EQ(carried.obstacles.at(0).second.contacts, 0) << "off the table";
+  EXPECT_EQ(held.kind, "grasper");
+  EXPECT_NEAR(held.force.y(), -weight, 0.1 * weight) << "the hand feels the sample's weight";
+  EXPECT_GT(held.contacts, 0);
+  const auto [dropped, v, open] = run(0.85);
+  ASSERT_TRUE(dropped.converged) << dropped.failure;
+  EXPECT_LT(v.row(1).mean(), 0.002) << "let go: back on the table";
+  EXPECT_GT(v.row(0).mean(), 0.016) << "where it was let go";
+  EXPECT_EQ(open.contacts, 0) << "the jaws hold nothing";
   EXPECT_GT(dropped.obstacles.at(0).second.contacts, 0);
 }
 

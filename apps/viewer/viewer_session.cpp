@@ -106,9 +106,9 @@ std::unique_ptr<Prepared> prepare(const Scene& scene_in, ProbeSource source, int
     p->note += std::string(p->note.empty() ? "" : "; ") + "no surface: " + e.what();
   }
   if (p->surface) p->surface_point = heaviest_points(p->surface->map);
-  // the mouse pushes, and grabs while its button is held; a scene's grab mode grabs only, its blade cuts while
-  // the button is held
-  if (!scene.probe.grab && !scene.probe.cut) p->options.probe.mode = ProbeMode::PUSH_GRAB;
+  // the mouse pushes, and grabs while its button is held; a scene's grab mode grabs only, its blade cuts and its
+  // grasper closes while the button is held
+  if (!scene.probe.grab && !scene.probe.cut && !scene.probe.grasper) p->options.probe.mode = ProbeMode::PUSH_GRAB;
   p->options.duration = std::numeric_limits<double>::infinity();
   p->options.log = false;
   p->options.real_time = true;

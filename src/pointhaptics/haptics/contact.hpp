@@ -14,7 +14,10 @@ namespace pointhaptics {
 /// CUT: the tool is a blade, its capsule axis the cutting edge: while the button is held it passes through the
 /// object and cuts where its edge sweeps (mechanics/cut.hpp), and the hand feels the cutting resistance; while
 /// it is up it pushes.
-enum class ProbeMode { PUSH, GRAB, PUSH_GRAB, CUT };
+/// PUSH: the probe pushes; GRAB: holds the points under it while button 1 is down; PUSH_GRAB: pushes, and grabs
+/// while the button is down; CUT: a blade that cuts while the button is down; GRASP: a grasper, two capsule jaws
+/// that close while the button is down (ProbeParams::opening, grip) and hold what they squeeze by friction.
+enum class ProbeMode { PUSH, GRAB, PUSH_GRAB, CUT, GRASP };
 
 struct ProbeParams {
   double radius = 0.005;  ///< probe sphere, m
@@ -40,6 +43,9 @@ struct ProbeParams {
   /// CUT: the work of cutting per unit of new cut area, J/m^2 (N/m): the hand feels it as a force against the
   /// edge's motion, this times the new area over the distance moved (0: the blade cuts freely)
   double cut_resistance = 0;
+  /// GRASP: the gap between the jaws' surfaces with the button up (opening) and held (grip), m, and the time the
+  /// jaws take from one to the other, s (they move at a constant speed)
+  double opening = 0, grip = 0, grip_time = 0.2;
 };
 
 /// The force the object exerts on the probe near p0, linearised: F(p) = f0 + K (p - p0).

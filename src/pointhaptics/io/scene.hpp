@@ -149,6 +149,9 @@ struct ProbeSpec {
   /// shape = "grasper" ([[tool]] posed by the scene): two capsule jaws (radius, length) either side of the tool's
   /// position along its local x, their axes along its local z, `opening` apart (the gap between their surfaces)
   bool grasper = false;
+  /// A grasper driven by a device: its jaws' gap with the button up (opening) and held (grip), m, and the time they
+  /// take from one to the other, s
+  double opening = 0, grip = 0, grip_time = 0.2;
   double length = 0;              ///< capsule: its axis segment, m, along the tool's local z
   double friction = 0;            ///< Coulomb's coefficient on the surface
   bool object_stiffness = false;  ///< local_stiffness = "object" (else "contact"): ProbeParams::object_stiffness

@@ -751,14 +751,36 @@ void read_tool_shape(TableReader& r, ProbeSpec& p) {
                               "must lie in (0, 1] (m: the contact's samples along the surface's edges)");
 }
 
+// a grasper driven by a device: its jaws' gap with the button up and held, and the time between (ProbeParams)
+void read_device_grasper(TableReader& r, ProbeSpec& p) {
+  if (!p.grasper) {
+    for (const char* key : {"opening", "grip", "grip_time"})
+      if (const toml::node* node = r.find(key)) r.fail_at(*node, key, "only a grasper has it (shape = \"grasper\")");
+    return;
+  }
+  if (const toml::node* node = r.find("mode"))
+    r.fail_at(*node, "mode", "a grasper has no mode: the device's button closes its jaws");
+  if (const toml::node* node = r.find("position"))
+    r.fail_at(*node, "position",
+              "a grasper held by the scene is a [[tool]] without a device (position and opening, or keyframes = "
+              "[[t, x, y, z, opening], ...])");
+  for (const char* key : {"opening", "grip"})
+    if (!r.find(key))
+      r.fail_table(key,
+                   "a grasper driven by a device needs opening = <m> (its jaws' gap, the button up) and grip = <m> "
+                   "(the gap it closes to while the button is held)");
+  p.opening = r.number("opening", 0.0, positive_up_to(1), "must lie in (0, 1] (m)");
+  p.grip = r.number(
+      "grip", 0.0, [&](double g) { return g >= 0 && g < p.opening; },
+      "must lie in [0, opening) (m): the jaws' gap while the button is held");
+  p.grip_time = r.number("grip_time", p.grip_time, positive_up_to(10), "must lie in (0, 10] (s)");
+}
+
 void read_probe(TableReader& r, ProbeSpec& p, const Context& ctx) {
   p.present = true;
   p.line = r.line();
   read_tool_shape(r, p);
-  if (p.grasper)
-    r.fail_at(*r.find("shape"), "shape",
-              "a grasper driven by a device (closed by its button) is not available yet: make it a [[tool]] posed by "
-              "the scene, with position and opening or keyframes = [[t, x, y, z, opening], ...]");
+  read_device_grasper(r, p);
   const std::string mode = r.choice("mode", "push", {"push", "grab", "cut"});
   p.grab = mode == "grab";
   p.cut = mode == "cut";

@@ -259,7 +259,10 @@ namespace {
 // centre of the object's top)
 void hand_options(const ProbeSpec& p, const Model& model, ProbeParams& probe, WorkspaceMapping& mapping) {
   probe.radius = p.radius;
-  probe.mode = p.grab ? ProbeMode::GRAB : p.cut ? ProbeMode::CUT : ProbeMode::PUSH;
+  probe.mode = p.grasper ? ProbeMode::GRASP : p.grab ? ProbeMode::GRAB : p.cut ? ProbeMode::CUT : ProbeMode::PUSH;
+  probe.opening = p.opening;
+  probe.grip = p.grip;
+  probe.grip_time = p.grip_time;
   probe.cut_resistance = p.cut_resistance;
   probe.stiffness = p.stiffness;
   probe.object_stiffness = p.object_stiffness;

@@ -16,6 +16,13 @@ ProbeTool::ProbeTool(const Model& model, const ProbeParams& params, double coupl
       scratch_(Points::Zero(3, model.n_points)),
       compliance_solver_(model) {
   trail_.reserve(blade_trail_steps);
+  gap_ = params.opening;
+}
+
+void ProbeTool::set_grasp_load(const ToolLoad& load, double time) {
+  grasp_load_ = load;
+  last_ = ContactModel{time, probe_, load.force, Mat3::Zero(), load.contacts, false, load.torque};
+  held_K_ = load.stiffness;
 }
 
 bool ProbeTool::pushing_surface() const {
@@ -145,6 +152,18 @@ void ProbeTool::place(const Model& model, const State& state, const Vec3& device
     cut_force_.setZero();
     cut_points_.clear();
   }
+  if (grasper()) {
+    // the jaws close while the button is held and open when it is let go, at a constant speed; a device that is
+    // lost lets go
+    const ProbeParams& p = contact_.params();
+    const bool closing = device.allFinite() && button;
+    const double dt = std::max(0.0, state.time - grasp_time_);
+    const double speed = (p.opening - p.grip) / std::max(p.grip_time, 1e-9);
+    gap_ = closing ? std::max(p.grip, gap_ - speed * dt) : std::min(p.opening, gap_ + speed * dt);
+    grasp_time_ = state.time;
+    if (device.allFinite()) probe_ = device;
+    return;
+  }
   if (!device.allFinite() || (contact_.params().mode == ProbeMode::CUT && button)) {
     // a blade cutting goes where the hand takes it (the resistance is what it feels)
     probe_ = device;
@@ -172,6 +191,7 @@ void ProbeTool::place(const Model& model, const State& state, const Vec3& device
 }
 
 void ProbeTool::add(const Model& model, const State& state, Points& f) {
+  if (grasper()) return;  // its jaws push (posed tools of the simulation's); last_ is set_grasp_load()'s
   if (cutting()) {
     // the blade pushes the points it parts along its move as hard as they resist it
     for (const index_t p : cut_points_) f.col(p) -= cut_force_ / static_cast<double>(cut_points_.size());
@@ -189,6 +209,7 @@ void ProbeTool::add(const Model& model, const State& state, Points& f) {
 }
 
 void ProbeTool::after_step(const Model& model, const State& state, Workspace& ws) {
+  if (grasper()) return;
   if (!pushing_surface() || !probe_.allFinite()) {
     if (surface_) surface_->reset_multipliers();
     surface_touched_.clear();
@@ -262,6 +283,7 @@ Mat3 ProbeTool::compliance_stiffness(const Model& model, const State& state, con
 // where vertices cross the probe's centre and their normals flip.
 bool ProbeTool::add_stiffness(const Model& model, const State& state,
                               Eigen::Matrix<double, 9, Eigen::Dynamic>& springs) {
+  if (grasper()) return false;
   if (pushing_surface() && probe_.allFinite()) {
     surface_->linearise(model, state.u, TangentMode::PROJECTED);
     surface_->add_diagonal_blocks(springs);

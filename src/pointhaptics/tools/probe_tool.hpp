@@ -43,6 +43,22 @@ class ProbeTool final : public DynamicForces {
 
   /// A blade (ProbeMode::CUT).
   bool blade() const { return contact_.params().mode == ProbeMode::CUT; }
+  /// A grasper (ProbeMode::GRASP): the tool is two capsule jaws that the simulation poses either side of the
+  /// probe along the tool's local x, jaw_gap() apart (ModelSimulation), each a posed tool's contact; the probe
+  /// goes where the device is (the jaws are the hand's, as a real grasper's are), and the hand feels what the
+  /// bodies exert on the jaws (set_grasp_load()). The tool itself touches nothing.
+  bool grasper() const { return contact_.params().mode == ProbeMode::GRASP; }
+  /// A grasper: the gap between its jaws' surfaces at this step, m: from the opening it closes toward the grip
+  /// while the button is held, and opens again when it is let go, at (opening - grip) / grip_time m/s.
+  double jaw_gap() const { return gap_; }
+  /// The tool's orientation at the last placement: the params' turned by the device's.
+  const Eigen::Quaterniond& orientation() const { return orientation_; }
+  /// A grasper, at the step's end: the bodies' load on its jaws (summed; the torque about the probe) is the hand's
+  /// local model, held between updates without a stiffness (the jaws' contact, stuck to a body it carries, is
+  /// stiffer than anything a hand moves against, and a model with it would hold the hand still).
+  void set_grasp_load(const ToolLoad& load, double time);
+  /// A grasper: the load set_grasp_load() was given last.
+  const ToolLoad& grasp_load() const { return grasp_load_; }
   /// A blade with the button held: this step it cuts instead of touching.
   bool cutting() const { return blade() && button_ && probe_.allFinite(); }
   /// The blade's edge at the probe's pose (its capsule axis).
@@ -146,6 +162,9 @@ class ProbeTool final : public DynamicForces {
   double step_start_ = 0;  // the time at which the step being taken began (place())
   Vec3 probe_ = Vec3::Constant(NAN);
   bool button_ = false;
+  double gap_ = 0;         ///< a grasper's jaw gap, m (jaw_gap())
+  double grasp_time_ = 0;  ///< the time its gap was last moved to, s
+  ToolLoad grasp_load_;    ///< grasp_load()
   int contacts_before_ = 0;
   ContactModel last_;
   Mat3 held_K_ = Mat3::Zero();

@@ -47,6 +47,17 @@ SurfaceContact probe_surface_contact(ActiveSurface part, const SurfaceContactPar
   return contact;
 }
 
+ToolLoad grasper_load(const ToolLoad& a, const Vec3& at_a, const ToolLoad& b, const Vec3& at_b, const Vec3& centre) {
+  ToolLoad g = a;
+  g.torque = (at_a - centre).cross(a.force) + a.torque + (at_b - centre).cross(b.force) + b.torque;
+  g.force += b.force;
+  g.friction += b.friction;
+  g.contacts += b.contacts;
+  g.penetration = std::max(a.penetration, b.penetration);
+  g.stiffness += b.stiffness;
+  return g;
+}
+
 ToolPose PosedBody::pose_at(double t) const {
   ToolPose pose = start;
   if (!path.keyframes().empty()) pose.position += path.position(t);
@@ -256,7 +267,35 @@ void ModelSimulation::solve() {
   report_ = solver_impl_->step(model_, state_, ws_, tools);
   dynamic_forces_ = tools != nullptr;
   if (tools && report_.status != StepStatus::FAILED) tools->after_step(model_, state_, ws_);
+  feel_grasper_jaws();
   diagnostics_.contact_seconds += forces_.take_seconds();
+}
+
+void ModelSimulation::pose_grasper_jaws() {
+  for (PosedBody& jaw : posed_bodies_) {
+    if (jaw.hand < 0) continue;
+    const ProbeTool& tool = hands_.at(static_cast<std::size_t>(jaw.hand)).tool;
+    if (!tool.probe().allFinite()) continue;  // no device point yet: where they were
+    const ToolPose pose{tool.probe(), tool.orientation()};
+    const double side = 0.5 * tool.jaw_gap() + jaw.contact.shape().radius;
+    jaw.contact.set_pose(
+        ToolPose{pose.position + jaw.jaw * side * (pose.orientation * Vec3::UnitX()), pose.orientation});
+  }
+}
+
+void ModelSimulation::feel_grasper_jaws() {
+  for (std::size_t k = 0; k < hands_.size(); ++k) {
+    ProbeTool& tool = hands_[k].tool;
+    if (!tool.grasper()) continue;
+    PosedBody* jaws[2] = {nullptr, nullptr};
+    for (PosedBody& o : posed_bodies_)
+      if (o.hand == static_cast<int>(k)) jaws[o.jaw > 0] = &o;
+    if (!jaws[0] || !jaws[1]) continue;
+    const ToolLoad a = jaws[0]->contact.load(model_, state_.u), b = jaws[1]->contact.load(model_, state_.u);
+    tool.set_grasp_load(grasper_load(a, jaws[0]->contact.pose().position, b, jaws[1]->contact.pose().position,
+                                     tool.probe().allFinite() ? tool.probe() : Vec3::Zero()),
+                        state_.time);
+  }
 }
 
 namespace {
@@ -356,6 +395,7 @@ void ModelSimulation::place_tools() {
   }
   bool cutting = false;
   for (std::size_t k = 0; k < hands_.size(); ++k) cutting = place_hand(hands_[k], inputs_[k]) || cutting;
+  pose_grasper_jaws();
   // once the cuts stop (no blade cuts, and a step added no sheet: a scripted cut adds a strip every step it runs),
   // the hands push on the surface split along them, and the bodies touch by it: one split per stroke or cut. (A
   // second hand re-split while the other cut took 25 ms a step on 3k points, and a hand re-split at every step of

@@ -120,9 +120,16 @@ struct PosedBody {
   /// `opening` gives the gap between their surfaces over time (x of its keyframes, m).
   int jaw = 0;
   Trajectory opening;
+  /// A device's grasper's jaw (ProbeTool::grasper()): driven by hand `hand`, posed at its probe, turned as its tool,
+  /// `jaw` side, the tool's jaw_gap() apart (ModelSimulation::place_tools); -1: posed by the scene
+  int hand = -1;
   /// Where it is at time t (s): start moved along path, and a jaw half the opening and its radius to its side.
   ToolPose pose_at(double t) const;
 };
+
+/// Two jaws' loads as one tool's: forces, friction, contacts and stiffness summed, the deepest penetration, the torque
+/// about `centre` (each jaw's own about its position `at`, and its force's moment).
+ToolLoad grasper_load(const ToolLoad& a, const Vec3& at_a, const ToolLoad& b, const Vec3& at_b, const Vec3& centre);
 
 class ModelSimulation {
  public:
@@ -221,6 +228,10 @@ class ModelSimulation {
   /// places the hand's probe; a blade with its button held cuts (returns true)
   bool place_hand(ProbeAttachment& hand, const StepInputs& inputs);
   void refresh_probe_surface(ProbeAttachment& hand);
+  /// a device's grasper's jaws where its hand is, their gap the hand's (before the solve)
+  void pose_grasper_jaws();
+  /// a device's grasper's hand feels what the bodies exert on its jaws (after the solve)
+  void feel_grasper_jaws();
   /// the bodies' contact over their surface split along the cuts, each vertex the split kept carrying its
   /// multiplier over
   void refresh_body_surface();

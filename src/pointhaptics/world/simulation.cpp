@@ -171,6 +171,11 @@ void Simulation::attach_probe(const ProbeParams& params, double coupling_stiffne
   if (params.mode == ProbeMode::CUT && !(params.length > 0))
     throw Error("probe: a blade is a capsule whose axis is its edge: give it a length");
   if (sim.held_tool()) throw Error("probe: the simulation already holds a tool (one tool at a time)");
+  const bool grasper = params.mode == ProbeMode::GRASP;
+  if (grasper && (!(params.length > 0) || !surface || lod_ || !(params.grip < params.opening)))
+    throw Error(
+        "probe: a grasper's jaws are capsules (give a length) that press on the bodies' surface (not with levels of "
+        "detail), and its grip is narrower than its opening");
   SurfaceContactParams contact;
   // the contact no stiffer on a point than the point spheres' springs were (E x spacing): explicit steps keep
   // their stable sub-step, implicit ones their linearly implicit springs. The probe's multipliers, advanced
@@ -196,9 +201,23 @@ void Simulation::attach_probe(const ProbeParams& params, double coupling_stiffne
         std::make_shared<const std::vector<double>>(whole.point_stiffness(lod_->object_model().n_points));
   }
   std::optional<SurfaceContact> on_surface;
-  if (surface)
+  if (surface && grasper) {
+    // its jaws: posed tools the simulation moves with the hand (ModelSimulation::pose_grasper_jaws), far away until
+    // the device's first point; their contact a posed tool's (friction with its multipliers in implicit steps)
+    SurfaceContactParams jaw_contact;
+    jaw_contact.friction = params.friction;
+    jaw_contact.non_negative_weights = params.non_negative_surface_map;
+    jaw_contact.sample_spacing = params.sample_spacing;
+    const ToolPose away{Vec3::Constant(1e3), params.orientation};
+    const int hand = static_cast<int>(sim.hands().size());
+    for (const int side : {-1, +1})
+      add_posed_body(PosedBody::Role::TOOL, name.empty() ? tool_name_ : name, probe_shape(params), away, surface->mesh,
+                     surface->map, jaw_contact, {}, side, {}, hand);
+    surface = nullptr;  // the tool itself touches nothing
+  } else if (surface) {
     on_surface.emplace(probe_surface_contact(*surface, contact, probe_shape(params), sim.model(),
                                              lod_ ? &lod_->active_set() : nullptr));
+  }
   sim.add_hand(ProbeAttachment{ProbeTool(sim.model(), params, coupling_stiffness, max_force, std::move(on_surface)),
                                asynchronous_lod,
                                std::move(surface),
@@ -256,14 +275,14 @@ void Simulation::add_grasper(std::string name, const ToolShape& jaw, const ToolP
 
 void Simulation::add_posed_body(PosedBody::Role role, std::string name, const ToolShape& shape, const ToolPose& pose,
                                 const TriangleMesh& mesh, SurfaceMap map, const SurfaceContactParams& params,
-                                const Trajectory& path, int jaw, const Trajectory& opening) {
+                                const Trajectory& path, int jaw, const Trajectory& opening, int hand) {
   const bool obstacle = role == PosedBody::Role::OBSTACLE;
   const char* what = obstacle ? "obstacle" : "tool";
   if (lod_)
     throw Error(
         fmt::format("{}: not yet with levels of detail (an active set carries only part of the surface)", what));
   ModelSimulation& sim = core();
-  if (jaw <= 0)  // (a grasper's second jaw shares its first's name)
+  if (jaw <= 0 && hand < 0)  // (a grasper's second jaw shares its first's name; a hand's jaws are named as the hand)
     for (const PosedBody& o : sim.posed_bodies())
       if (o.role == role && o.name == name) throw Error(fmt::format("\"{}\" is already the name of a {}", name, what));
   SurfaceContactParams contact = params;
@@ -279,7 +298,7 @@ void Simulation::add_posed_body(PosedBody::Role role, std::string name, const To
   // sliding up its sides, stalled an implicit step's Newton (its residual at 3e-3 after 300 iterations; the
   // same with the table frictionless converged), not yet understood
   held.update_after_step(!obstacle && sim.solver().kind == SolverKind::IMPLICIT);
-  PosedBody body{std::move(name), role, std::move(held), path, pose, jaw, opening};
+  PosedBody body{std::move(name), role, std::move(held), path, pose, jaw, opening, hand};
   body.contact.set_pose(body.pose_at(sim.state().time));
   // an obstacle may not start inside the object: its surface's vertices (the reference ones) stay out of it (a
   // tool may: an indentation)
@@ -304,18 +323,13 @@ struct PosedToolLoad {
 std::vector<PosedToolLoad> posed_tool_loads_of(ModelSimulation& sim, PosedBody::Role role) {
   std::vector<PosedToolLoad> loads;
   for (PosedBody& o : sim.posed_bodies()) {
-    if (o.role != role) continue;
+    if (o.role != role || o.hand >= 0) continue;  // (a device's grasper is reported as its hand)
     const ToolLoad load = o.contact.load(sim.model(), sim.state().u);
     const Vec3 at = o.contact.pose().position;
     if (o.jaw > 0 && !loads.empty() && loads.back().name == o.name) {  // the grasper's second jaw
       PosedToolLoad& g = loads.back();
       const Vec3 first = g.position, centre = 0.5 * (first + at);
-      g.load.torque += (first - centre).cross(g.load.force) + load.torque + (at - centre).cross(load.force);
-      g.load.force += load.force;
-      g.load.friction += load.friction;
-      g.load.contacts += load.contacts;
-      g.load.penetration = std::max(g.load.penetration, load.penetration);
-      g.load.stiffness += load.stiffness;
+      g.load = grasper_load(g.load, first, load, at, centre);
       g.position = centre;
       continue;
     }
@@ -454,6 +468,10 @@ ToolSummary Simulation::tool_summary(std::size_t hand) {
     // the probe's local model at the last step's end: the force the object exerts on it there; on the surface
     // its load there, with the torque, the friction and the deepest vertex
     const ContactModel& c = probe->contact_model();
+    if (probe->grasper()) {  // its jaws' load, summed
+      const ToolLoad& load = probe->grasp_load();
+      return {true, "grasper", probe->probe(), load.force, load.torque, load.contacts, load.penetration, load.friction};
+    }
     if (const SurfaceContact* surface = probe->surface_contact()) {
       const ToolLoad& load = surface->last_load();
       return {true,

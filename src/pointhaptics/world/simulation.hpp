@@ -170,7 +170,7 @@ class Simulation {
  private:
   void add_posed_body(PosedBody::Role role, std::string name, const ToolShape& shape, const ToolPose& pose,
                       const TriangleMesh& mesh, SurfaceMap map, const SurfaceContactParams& params,
-                      const Trajectory& path, int jaw = 0, const Trajectory& opening = {});
+                      const Trajectory& path, int jaw = 0, const Trajectory& opening = {}, int hand = -1);
   ModelSimulation& core() { return lod_ ? lod_->active() : *object_; }
   const ModelSimulation& core() const { return lod_ ? lod_->active() : *object_; }
 
