@@ -80,6 +80,7 @@ SurfaceContact::SurfaceContact(const Model& model, const TriangleMesh& surface, 
     max_point_stiffness_ = params.max_point_stiffness;
   }
   cull_ = params.cull_far_vertices;
+  cull_margin_ = std::max(0.0, params.cull_margin);
   if (cull_) {
     // how far a vertex can be from where the displacement's largest point moved it, per unit of that: sum |w|
     weight_l1_.assign(static_cast<std::size_t>(m), 0.0);
@@ -91,6 +92,12 @@ SurfaceContact::SurfaceContact(const Model& model, const TriangleMesh& surface, 
         weight_l1_[static_cast<std::size_t>(n_surface_) + k] +=
             std::abs(samples_[k].weight[b]) * weight_l1_[static_cast<std::size_t>(samples_[k].vertex[b])];
     carried_.assign(static_cast<std::size_t>(m), 1);
+    max_weight_l1_ = weight_l1_.empty() ? 0.0 : *std::max_element(weight_l1_.begin(), weight_l1_.end());
+    // a skin of half the tool's reach (a plane's: a spacing): the candidates chosen again once the tool, or the
+    // displacement's bound, has moved that far
+    candidate_skin_ = shape.kind == ToolKind::PLANE ? model.spacing : 0.5 * tool_reach(shape);
+    candidates_.reserve(static_cast<std::size_t>(m));
+    near_triangles_.reserve(triangles_.size());
   }
 }
 
@@ -161,13 +168,33 @@ void SurfaceContact::evaluate_near(const Points& u) {
   double largest = 0;
   for (Eigen::Index j = 0; j < u.cols(); ++j) largest = std::max(largest, u.col(j).squaredNorm());
   largest = std::sqrt(largest);
+  // the candidates stand while neither the tool nor that bound has moved by more than their skin (a Verlet list)
+  const double moved =
+      (pose_.position - candidate_position_).norm() + max_weight_l1_ * std::max(0.0, largest - candidate_largest_);
+  if (!(moved <= candidate_skin_)) select_candidates(largest);
+  for (const index_t v : candidates_) {
+    if (v >= n_surface_) continue;
+    Vec3 y = Y_.col(v);
+    for (index_t e = map_.points.begin(v); e < map_.points.end(v); ++e)
+      y += map_.weight[static_cast<std::size_t>(e)] * u.col(map_.points.index[static_cast<std::size_t>(e)]);
+    y_.col(v) = y;
+  }
+  for (const index_t v : candidates_) {
+    if (v < n_surface_) continue;
+    const ContactSample& s = samples_[static_cast<std::size_t>(v - n_surface_)];
+    y_.col(v) =
+        s.weight[0] * y_.col(s.vertex[0]) + s.weight[1] * y_.col(s.vertex[1]) + s.weight[2] * y_.col(s.vertex[2]);
+  }
+}
+
+void SurfaceContact::select_candidates(double largest) {
   const bool plane = shape_.kind == ToolKind::PLANE;
   const Vec3 normal = pose_.orientation * Vec3::UnitZ();
-  const double reach = tool_reach(shape_);
+  const double reach = tool_reach(shape_) + cull_margin_ + candidate_skin_;
   const index_t m = static_cast<index_t>(Y_.cols());
   for (index_t v = 0; v < m; ++v) {
     const auto i = static_cast<std::size_t>(v);
-    const double slack = weight_l1_[i] * largest + tolerance_;
+    const double slack = weight_l1_[i] * largest + tolerance_ + candidate_skin_;
     const Vec3 from_tool = Y_.col(v) - pose_.position;
     carried_[i] = lambda_[i] != 0 || (!anchors_.empty() && anchors_[i].held) ||
                   (plane ? normal.dot(from_tool) <= slack : from_tool.norm() <= reach + slack);
@@ -176,26 +203,22 @@ void SurfaceContact::evaluate_near(const Points& u) {
   for (std::size_t k = 0; k < samples_.size(); ++k)
     if (carried_[static_cast<std::size_t>(n_surface_) + k])
       for (int b = 0; b < 3; ++b) carried_[static_cast<std::size_t>(samples_[k].vertex[b])] = 1;
-  // the others far outside the tool (beyond its reach, above a plane), where every evaluation skips them
-  const Vec3 outside = pose_.position + (plane ? Vec3(1e6 * normal) : Vec3((reach + 1e6) * Vec3::UnitX()));
-  for (index_t v = 0; v < n_surface_; ++v) {
-    if (!carried_[static_cast<std::size_t>(v)]) {
-      y_.col(v) = outside;
-      continue;
-    }
-    Vec3 y = Y_.col(v);
-    for (index_t e = map_.points.begin(v); e < map_.points.end(v); ++e)
-      y += map_.weight[static_cast<std::size_t>(e)] * u.col(map_.points.index[static_cast<std::size_t>(e)]);
-    y_.col(v) = y;
+  // the others far outside the tool (beyond its reach, above a plane), where every evaluation skips them; the
+  // candidates in order, vertices first (a sample is carried after its vertices)
+  const Vec3 at = pose_.position.allFinite() ? pose_.position : Vec3::Zero();
+  const Vec3 outside = at + (plane ? Vec3(1e6 * normal) : Vec3((reach + 1e6) * Vec3::UnitX()));
+  candidates_.clear();  // (their capacities kept: no allocation after the constructor's)
+  for (index_t v = 0; v < m; ++v) {
+    if (carried_[static_cast<std::size_t>(v)]) candidates_.push_back(v);
+    else y_.col(v) = outside;
   }
-  for (std::size_t k = 0; k < samples_.size(); ++k) {
-    const ContactSample& s = samples_[k];
-    y_.col(n_surface_ + static_cast<index_t>(k)) =
-        carried_[static_cast<std::size_t>(n_surface_) + k]
-            ? Vec3(s.weight[0] * y_.col(s.vertex[0]) + s.weight[1] * y_.col(s.vertex[1]) +
-                   s.weight[2] * y_.col(s.vertex[2]))
-            : outside;
-  }
+  near_triangles_.clear();
+  for (const auto& t : triangles_)
+    if (carried_[static_cast<std::size_t>(t[0])] && carried_[static_cast<std::size_t>(t[1])] &&
+        carried_[static_cast<std::size_t>(t[2])])
+      near_triangles_.push_back(t);
+  candidate_position_ = pose_.position;
+  candidate_largest_ = largest;
 }
 
 void SurfaceContact::set_vertex_ids(const std::vector<index_t>& ids) {
@@ -207,20 +230,21 @@ double SurfaceContact::energy(const Model&, const Points& u) {
   evaluate(u);
   double e = 0;
   const double far = tool_reach(shape_);
-  for (index_t v = 0; v < y_.cols(); ++v) {
+  for_each_candidate([&](index_t v) {
     const double lambda = lambda_[static_cast<std::size_t>(v)], k = penalty_[static_cast<std::size_t>(v)];
-    if (lambda == 0 && (y_.col(v) - pose_.position).squaredNorm() > far * far) continue;
+    if (lambda == 0 && (y_.col(v) - pose_.position).squaredNorm() > far * far) return;
     const double t = std::max(lambda + k * tool_distance(shape_, pose_, y_.col(v)).penetration, 0.0);
     e += (t * t - lambda * lambda) / (2 * k);
-  }
+  });
   // friction: quadratic in the trial force inside the cone, linear beyond it (so a slide is one minimisation,
   // not one multiplier update per penalty's worth of slip)
-  for (index_t v = 0; v < static_cast<index_t>(anchors_.size()); ++v) {
-    const Anchor& a = anchors_[static_cast<std::size_t>(v)];
-    if (!a.held) continue;
-    const double k = tangential_penalty(v), cone = friction_cone(v), t = friction_trial(v).norm();
-    e += (t <= cone ? t * t : 2 * cone * t - cone * cone) / (2 * k) - a.tau.squaredNorm() / (2 * k);
-  }
+  if (!anchors_.empty())
+    for_each_candidate([&](index_t v) {
+      const Anchor& a = anchors_[static_cast<std::size_t>(v)];
+      if (!a.held) return;
+      const double k = tangential_penalty(v), cone = friction_cone(v), t = friction_trial(v).norm();
+      e += (t <= cone ? t * t : 2 * cone * t - cone * cone) / (2 * k) - a.tau.squaredNorm() / (2 * k);
+    });
   return e;
 }
 
@@ -272,29 +296,30 @@ template <class Pressing>
 ToolLoad SurfaceContact::for_each_pressing(const Pressing& pressing) const {
   ToolLoad out;
   const double far = tool_reach(shape_);
-  for (index_t v = 0; v < y_.cols(); ++v) {
+  for_each_candidate([&](index_t v) {
     const double lambda = lambda_[static_cast<std::size_t>(v)], k = penalty_[static_cast<std::size_t>(v)];
-    if (lambda == 0 && (y_.col(v) - pose_.position).squaredNorm() > far * far) continue;
+    if (lambda == 0 && (y_.col(v) - pose_.position).squaredNorm() > far * far) return;
     const ToolDistance d = tool_distance(shape_, pose_, y_.col(v));
     out.penetration = std::max(out.penetration, d.penetration);
     const double pressure = lambda + k * d.penetration;
-    if (!(pressure > 0)) continue;
+    if (!(pressure > 0)) return;
     const Vec3 on_tool = -pressure * d.normal;
     out.force += on_tool;
     out.torque += (d.core - pose_.position).cross(on_tool);  // the force acts along the normal through the core
     out.stiffness -= k * d.normal * d.normal.transpose();
     ++out.contacts;
     pressing(v, d, pressure);
-  }
+  });
   // friction: the anchored vertices drag the tool (acting where they are)
-  for (index_t v = 0; v < static_cast<index_t>(anchors_.size()); ++v) {
-    if (!anchors_[static_cast<std::size_t>(v)].held) continue;
-    const Vec3 on_tool = friction_force(v);
-    out.force += on_tool;
-    out.friction += on_tool;
-    out.torque += (y_.col(v) - pose_.position).cross(on_tool);
-    out.stiffness -= friction_hessian(v);  // the anchor moves with the tool: its slip by minus the tool's motion
-  }
+  if (!anchors_.empty())
+    for_each_candidate([&](index_t v) {
+      if (!anchors_[static_cast<std::size_t>(v)].held) return;
+      const Vec3 on_tool = friction_force(v);
+      out.force += on_tool;
+      out.friction += on_tool;
+      out.torque += (y_.col(v) - pose_.position).cross(on_tool);
+      out.stiffness -= friction_hessian(v);  // the anchor moves with the tool: its slip by minus the tool's motion
+    });
   return out;
 }
 
@@ -304,11 +329,12 @@ void SurfaceContact::add_forces(const Model&, const Points& u, Points& f) {
     const Vec3 force = pressure * d.normal;  // on the vertex, out of the tool
     for_each_weight(v, [&](index_t j, double w) { f.col(j) += w * force; });
   });
-  for (index_t v = 0; v < static_cast<index_t>(anchors_.size()); ++v) {
-    if (!anchors_[static_cast<std::size_t>(v)].held) continue;
-    const Vec3 force = -friction_force(v);  // on the vertex, toward its anchor
-    for_each_weight(v, [&](index_t j, double w) { f.col(j) += w * force; });
-  }
+  if (!anchors_.empty())
+    for_each_candidate([&](index_t v) {
+      if (!anchors_[static_cast<std::size_t>(v)].held) return;
+      const Vec3 force = -friction_force(v);  // on the vertex, toward its anchor
+      for_each_weight(v, [&](index_t j, double w) { f.col(j) += w * force; });
+    });
 }
 
 void SurfaceContact::linearise(const Model&, const Points& u, TangentMode mode) {
@@ -325,11 +351,12 @@ void SurfaceContact::linearise(const Model&, const Points& u, TangentMode mode) 
     active_.push_back(
         {v, d.normal, pressure, hessian, penalty_[static_cast<std::size_t>(v)] * d.normal * d.normal.transpose()});
   });
-  for (index_t v = 0; v < static_cast<index_t>(anchors_.size()); ++v) {
-    if (!anchors_[static_cast<std::size_t>(v)].held) continue;
-    const Mat3 hessian = friction_hessian(v);
-    active_.push_back({v, Vec3::Zero(), 0.0, hessian, hessian});
-  }
+  if (!anchors_.empty())
+    for_each_candidate([&](index_t v) {
+      if (!anchors_[static_cast<std::size_t>(v)].held) return;
+      const Mat3 hessian = friction_hessian(v);
+      active_.push_back({v, Vec3::Zero(), 0.0, hessian, hessian});
+    });
 }
 
 void SurfaceContact::add_tangent_product(const Points& dx, Points& out) const {
@@ -445,7 +472,7 @@ void SurfaceContact::advance_anchor(index_t v, const ToolDistance& d) {
 
 bool SurfaceContact::enters(const Vec3& from, const Vec3& to) const {
   const Vec3 low = from.cwiseMin(to), high = from.cwiseMax(to);
-  for (const auto& t : triangles_) {
+  for (const auto& t : cull_ ? near_triangles_ : triangles_) {
     const Vec3 a = y_.col(t[0]), b = y_.col(t[1]), c = y_.col(t[2]);
     // most triangles are far from a move of a fraction of the tool's radius: their boxes miss the move's
     if ((a.cwiseMax(b).cwiseMax(c).array() < low.array()).any() ||
@@ -478,20 +505,21 @@ ToolLoad SurfaceContact::load(const Model&, const Points& u, bool same_u) {
 ToolLoad SurfaceContact::advance_multipliers(double rate, double max_force) {
   const double far = tool_reach(shape_);
   Vec3 pressing = Vec3::Zero();
-  for (index_t v = 0; v < y_.cols(); ++v) {
+  for_each_candidate([&](index_t v) {
     double& lambda = lambda_[static_cast<std::size_t>(v)];
-    if (lambda == 0 && (y_.col(v) - pose_.position).squaredNorm() > far * far) continue;
+    if (lambda == 0 && (y_.col(v) - pose_.position).squaredNorm() > far * far) return;
     const ToolDistance d = tool_distance(shape_, pose_, y_.col(v));
     lambda = std::max(lambda + rate * penalty_[static_cast<std::size_t>(v)] * d.penetration, 0.0);
     pressing += lambda * d.normal;
-  }
+  });
   if (pressing.norm() > max_force)
     for (double& lambda : lambda_) lambda *= max_force / pressing.norm();
   // the friction's anchors and forces, on the multipliers just made
   if (!anchors_.empty())
-    for (index_t v = 0; v < y_.cols(); ++v)
+    for_each_candidate([&](index_t v) {
       if (lambda_[static_cast<std::size_t>(v)] > 0 || anchors_[static_cast<std::size_t>(v)].held)
         advance_anchor(v, tool_distance(shape_, pose_, y_.col(v)));
+    });
   return for_each_pressing([](index_t, const ToolDistance&, double) {});
 }
 

@@ -76,9 +76,13 @@ struct SurfaceContactParams {
   /// displacement moved them (or, for a plane, not above it by that bound), and those whose multiplier or
   /// friction is in force; the others are put far outside it, where every evaluation skips them. For obstacles
   /// and posed tools, which read no vertex but those: carrying every vertex of every body at every explicit
-  /// sub-step was a seventh of a three-body run. Not for a device's probe, whose god-object reads every
-  /// triangle (enters()).
+  /// sub-step was a seventh of a three-body run. A device's probe culls too, with a margin (cull_margin) that covers
+  /// the moves its god-object tries within a step (enters(), side_of(): they read the triangles whose vertices are
+  /// all carried).
   bool cull_far_vertices = false;
+  /// With cull_far_vertices: how much farther than the tool's reach a vertex is still carried, m (a probe's
+  /// placement tries positions up to two radii from where the step found it).
+  double cull_margin = 0;
 };
 
 /// A sphere fits through a triangle whose circumradius exceeds its radius, touching none of its vertices. At
@@ -189,7 +193,7 @@ class SurfaceContact final : public EnergyTerm {
   bool enters(const Vec3& from, const Vec3& to) const;
   /// Where p is seen from the surface as the last evaluation carried it (nearest_surface_within()).
   std::optional<SurfaceSide> side_of(const Vec3& p, double radius) const {
-    return nearest_surface_within(p, y_, triangles_, radius);
+    return nearest_surface_within(p, y_, cull_ ? near_triangles_ : triangles_, radius);
   }
   /// The contact's map of the surface's vertices: the surface's, or without its negative weights
   /// (SurfaceContactParams::non_negative_weights). The samples are carried through it by their vertices.
@@ -228,8 +232,21 @@ class SurfaceContact final : public EnergyTerm {
   void advance_anchor(index_t v, const ToolDistance& d);
   /// y = Y + W u, the vertices that can touch the tool, and their contact values.
   void evaluate(const Points& u);
-  /// evaluate() of the vertices that can touch the tool (SurfaceContactParams::cull_far_vertices)
+  /// evaluate() of the vertices that can touch the tool (SurfaceContactParams::cull_far_vertices): the candidates
+  /// select_candidates() chose, chosen again when the tool or the displacement's bound has moved past their skin
   void evaluate_near(const Points& u);
+  /// The vertices and samples within the tool's reach, the margin and the skin by the displacement's bound `largest`
+  /// (and those with a multiplier or friction in force), the triangles among them; the rest put far outside.
+  void select_candidates(double largest);
+  /// Each vertex or sample a loop over the contact must visit: the candidates when culling (the rest are far
+  /// outside, with no multiplier or friction), else all.
+  template <class Fn>
+  void for_each_candidate(const Fn& fn) const {
+    if (cull_)
+      for (const index_t v : candidates_) fn(v);
+    else
+      for (index_t v = 0; v < y_.cols(); ++v) fn(v);
+  }
   /// The load of the vertices pressing on the tool at y_, calling pressing(v, distance, pressure) for each.
   template <class Pressing>
   ToolLoad for_each_pressing(const Pressing& pressing) const;
@@ -256,7 +273,15 @@ class SurfaceContact final : public EnergyTerm {
   std::vector<std::array<index_t, 2>> parents_;    // each sample's two ends (ContactSamples::parents)
   std::vector<std::uint64_t> keys_;                // each vertex's and sample's name on the whole surface
   index_t n_surface_ = 0;
-  bool cull_ = false;              ///< SurfaceContactParams::cull_far_vertices
+  bool cull_ = false;       ///< SurfaceContactParams::cull_far_vertices
+  double cull_margin_ = 0;  ///< SurfaceContactParams::cull_margin
+  /// culling: the vertices and samples carried (select_candidates()), in order, and the triangles whose vertices are
+  /// all among them (the rest reach far outside); where the tool was and the displacement's bound when they were
+  /// chosen, their skin, and the largest sum |w| of a vertex
+  std::vector<index_t> candidates_;
+  std::vector<std::array<index_t, 3>> near_triangles_;
+  Vec3 candidate_position_ = Vec3::Constant(NAN);
+  double candidate_largest_ = 0, candidate_skin_ = 0, max_weight_l1_ = 0;
   std::vector<double> weight_l1_;  ///< per vertex and sample, sum |w| of its map's row (samples: their parents')
   std::vector<char> carried_;      ///< evaluate()'s scratch: which vertices and samples it carries
   int sample_levels_ = 0;

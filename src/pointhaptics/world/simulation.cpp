@@ -188,6 +188,11 @@ void Simulation::attach_probe(const ProbeParams& params, double coupling_stiffne
   // friction then measured 0.288 of the pressure for mu = 0.3 (0.286 with a hundredth, where new contacts
   // stuck for tens of steps; the full penalty made explicit steps chatter: 0.217)
   contact.tangential_share = 0.1;
+  // the probe carries only the vertices it can reach within a step: its placement tries positions up to two radii
+  // from where the step found it (ProbeTool::place), and reads the triangles there (carrying every vertex of
+  // three 10k-point bodies for two hands at every sub-step was a fifth of the step)
+  contact.cull_far_vertices = true;
+  contact.cull_margin = 2.5 * params.radius + params.length;
   if (surface && lod_) {
     // every active set's part of the surface presses as the whole surface does on the object's points (after a
     // cut, as the unsplit one did: the split adds vertices only along the cut, the one place this is approximate)
