@@ -49,6 +49,9 @@ BodyContact::BodyContact(const Model& model, TriangleMesh mesh, SurfaceMap map, 
   tolerance_ = params.tolerance > 0 ? params.tolerance : 1e-3 * spacing;
   reach_ = params.reach > 0 ? params.reach : spacing;
   rate_ = params.multiplier_rate;
+  friction_rate_ = params.friction_rate;
+  if (!(rate_ > 0 && rate_ <= 1) || !(friction_rate_ > 0 && friction_rate_ <= 1))
+    throw Error("body contact: the multipliers' rates must lie in (0, 1]");
   const std::size_t bodies = vertex_start_.size() - 1;
   if (!(params.friction >= 0) || !(params.tangential_share > 0 && params.tangential_share <= 1) ||
       (!params.pair_friction.empty() && params.pair_friction.size() != bodies * bodies))
@@ -383,7 +386,7 @@ bool BodyContact::friction_met(const Points& u) const {
   return true;
 }
 
-void BodyContact::update_friction(const Points& u) {
+void BodyContact::update_friction(const Points& u, double rate) {
   for (const Pair& p : pairs_) {
     if (p.friction <= 0) continue;
     Anchor& a = anchors_[static_cast<std::size_t>(p.vertex)];
@@ -400,7 +403,7 @@ void BodyContact::update_friction(const Points& u) {
     const double c = cone(p);
     const Vec3 t = trial(p, slip(p, u));
     if (t.norm() <= c) {
-      a.tau = t;
+      a.tau += rate * (t - a.tau);
     } else {
       a.tau = c / t.norm() * t;  // on the cone; the anchor moves to where the vertex is at the next refresh
       a.afresh = true;
@@ -432,7 +435,7 @@ bool BodyContact::update_multipliers(const Model& model, const Points& u) {
     }
     return deepest() <= tolerance_ && change <= 1e-3 * scale;
   }
-  update_friction(u);
+  update_friction(u, 1.0);
   for (Pair& p : pairs_) p.multiplier = pressing(p, gap(p, u));
   refresh(model, u);
   return false;
@@ -444,7 +447,7 @@ void BodyContact::after_step(const Model& model, const State& state, Workspace&)
   if (!update_after_step_) return;
   // Uzawa's update spread over the steps: each multiplier moves by a share of the way to its pair's force, and
   // the friction takes its trial force (on the cone)
-  update_friction(state.u);
+  update_friction(state.u, friction_rate_);
   for (Pair& p : pairs_) p.multiplier += rate_ * (pressing(p, gap(p, state.u)) - p.multiplier);
   refresh(model, state.u);
 }

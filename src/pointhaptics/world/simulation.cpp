@@ -359,6 +359,12 @@ void Simulation::add_body_contact(const ObjectSurface& surface, const BodyContac
   BodyContactParams contact = params;
   if (sim.solver().kind == SolverKind::EXPLICIT && contact.max_point_stiffness <= 0)
     contact.max_point_stiffness = sim.model().material.young * sim.model().spacing;
+  // explicit steps: multipliers that move slowly, or they pump the contact's ringing (BodyContactParams::friction_rate)
+  if (sim.solver().kind == SolverKind::EXPLICIT) {
+    const BodyContactParams defaults;
+    if (contact.multiplier_rate == defaults.multiplier_rate) contact.multiplier_rate = explicit_contact_rate;
+    if (contact.friction_rate == defaults.friction_rate) contact.friction_rate = explicit_contact_rate;
+  }
   contact.update_after_step = sim.solver().kind != SolverKind::STATIC;
   sim.set_body_contact(std::make_shared<const ObjectSurface>(surface), contact);
 }
