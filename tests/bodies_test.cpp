@@ -468,11 +468,10 @@ TEST(Bodies, ContactTablesAreReadAndTheirMistakesNamed) {
 
 namespace {
 
-// a slab held at its left end 1 cm above a block held at its base; a scripted blade drawn down through both near the
-// slab's root cuts the slab alone (the one it names): its free piece falls onto the block and comes to rest there,
-// the block carrying its weight; the bodies' contact then goes on over the slab's surface split along the cut
-TEST(Bodies, AScriptedCutCutsTheBodyItNamesAndItsPieceFallsOntoTheOther) {
-  const std::string text = R"(
+// a slab (6 x 1 x 2 cm) held at its left end 1 cm above a block (5 x 2 x 2 cm) held at its base, both E = 1 MPa,
+// under gravity; `more` adds the solver and what cuts them
+std::string slab_over_block(const std::string& more) {
+  return R"(
 [material]
 young = 1e6
 poisson = 0.3
@@ -498,6 +497,14 @@ object = "slab"
 box = { min = [-1.0, -1.0, -1.0], max = [0.006, 1.0, 1.0] }
 [[load]]
 kind = "gravity"
+)" + more;
+}
+
+// a slab held at its left end 1 cm above a block held at its base; a scripted blade drawn down through both near the
+// slab's root cuts the slab alone (the one it names): its free piece falls onto the block and comes to rest there,
+// the block carrying its weight; the bodies' contact then goes on over the slab's surface split along the cut
+TEST(Bodies, AScriptedCutCutsTheBodyItNamesAndItsPieceFallsOntoTheOther) {
+  const std::string text = slab_over_block(R"(
 [[cut]]
 object = "slab"
 edge = [[0.0175, 0.05, -0.01], [0.0175, 0.05, 0.03]]
@@ -507,7 +514,7 @@ duration = 0.02
 [solver]
 kind = "implicit"
 dt = 2e-3
-)";
+)");
   SceneSession s = open_scene(parse_scene(text, "scene.toml"), two_threads());
   Simulation& sim = *s.simulation;
   const Model& model = sim.model();
@@ -550,32 +557,7 @@ dt = 2e-3
 // with its button held through the slab and 8 mm into the block, then lifts: a scalpel cuts what it passes through,
 // so the slab comes apart and the block is cut but stays one piece; the slab's free piece falls onto the block
 TEST(Bodies, ADevicesBladeCutsEveryBodyItPassesThrough) {
-  const std::string text = R"(
-[material]
-young = 1e6
-poisson = 0.3
-density = 1000.0
-damping = 20.0
-[[object]]
-name = "block"
-shape = "box"
-origin = [0.01, 0.0, 0.0]
-size = [0.05, 0.02, 0.02]
-spacing = 0.005
-[[object]]
-name = "slab"
-shape = "box"
-origin = [0.0, 0.03, 0.0]
-size = [0.06, 0.01, 0.02]
-spacing = 0.005
-[[fixed]]
-object = "block"
-box = { min = [-1.0, -1.0, -1.0], max = [1.0, 0.001, 1.0] }
-[[fixed]]
-object = "slab"
-box = { min = [-1.0, -1.0, -1.0], max = [0.006, 1.0, 1.0] }
-[[load]]
-kind = "gravity"
+  const std::string text = slab_over_block(R"(
 [solver]
 kind = "implicit"
 dt = 2e-3
@@ -591,7 +573,7 @@ radius = 0.001
 length = 0.04
 origin = [0.0175, 0.05, 0.01]
 keyframes = [[0.0, 0.0, 0.0, 0.0, 1], [0.15, 0.0, -0.038, 0.0, 1], [0.2, 0.0, -0.038, 0.0, 0], [0.4, 0.0, 0.0, 0.0, 0]]
-)";
+)");
   SceneSession s = open_scene(parse_scene(text, "scene.toml"), two_threads());
   Simulation& sim = *s.simulation;
   const Model& model = sim.model();
