@@ -70,7 +70,7 @@ struct Model {
   /// which completes the neighbourhoods (M_i, d_ij) of the held points next to the simulated ones.
   index_t n_passive = 0;
 
-  /// Several deformable bodies in one model (issue 47; mechanics/join_models.hpp): body k's points are
+  /// Several deformable bodies in one model (issue 47; bodies/join_models.hpp): body k's points are
   /// [body_start[k], body_start[k + 1]) and no neighbour list leaves a body. Both empty: one body.
   std::vector<index_t> body_start;
   std::vector<std::string> body_names;

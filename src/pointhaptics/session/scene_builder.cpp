@@ -1,6 +1,6 @@
 #include <pointhaptics/session/scene_builder.hpp>
 
-#include <pointhaptics/mechanics/join_models.hpp>
+#include <pointhaptics/bodies/join_models.hpp>
 
 #include <pointhaptics/core/error.hpp>
 #include <pointhaptics/core/memory_limit.hpp>

@@ -298,77 +298,22 @@ void ModelSimulation::feel_grasper_jaws() {
   }
 }
 
-namespace {
-
-// A body sleeps once every point of it has been slower than this for sleep_time with nothing touching it, and wakes
-// when the contacts' force on it moves from what it was by more than wake_share of its weight and that force (a
-// body resting on a table: the table's support steady to 1e-4 of the weight; a hand or a tool that arrives, a body
-// that lands on it or one under it that moves change it by far more)
-constexpr double sleep_speed = 1e-4;  // m/s
-constexpr double sleep_time = 0.1;    // s
-constexpr double wake_share = 0.02;
-
-}  // namespace
-
 void ModelSimulation::update_sleep() {
-  const index_t n_bodies = model_.n_bodies();
-  if (!solver_.sleep || solver_.kind != SolverKind::EXPLICIT || n_bodies < 2 || !model_.material.prony.empty() ||
-      report_.status == StepStatus::FAILED)
+  if (!solver_.sleep || solver_.kind != SolverKind::EXPLICIT || model_.n_bodies() < 2 ||
+      !model_.material.prony.empty() || report_.status == StepStatus::FAILED)
     return;
-  if (sleep_.size() != static_cast<std::size_t>(n_bodies)) sleep_.assign(static_cast<std::size_t>(n_bodies), {});
-  // a cut wakes every body (it changes what holds them); a hand wakes the bodies whose points it touches
-  const bool cut = cut_sheets_.revision != sleep_cuts_revision_;
+  SleepInputs inputs;
+  inputs.contact_forces = dynamic_forces_ ? &ws_.acceleration : nullptr;
+  inputs.cut = cut_sheets_.revision != sleep_cuts_revision_;
   sleep_cuts_revision_ = cut_sheets_.revision;
-  bool changed = false;
-  for (index_t k = 0; k < n_bodies; ++k) {
-    BodySleep& body = sleep_[static_cast<std::size_t>(k)];
-    const index_t first = model_.body_start[static_cast<std::size_t>(k)],
-                  last = model_.body_start[static_cast<std::size_t>(k) + 1];
-    const auto in_body = [&](index_t i) { return i >= first && i < last; };
-    const bool touched = std::any_of(hands_.begin(), hands_.end(), [&](const ProbeAttachment& hand) {
-      return std::any_of(hand.tool.touched().begin(), hand.tool.touched().end(), in_body);
+  inputs.touched = [this](index_t first, index_t last) {
+    return std::any_of(hands_.begin(), hands_.end(), [&](const ProbeAttachment& hand) {
+      return std::any_of(hand.tool.touched().begin(), hand.tool.touched().end(),
+                         [&](index_t i) { return i >= first && i < last; });
     });
-    Vec3 force = Vec3::Zero(), weight = Vec3::Zero();
-    for (index_t i = first; i < last; ++i) {
-      if (dynamic_forces_) force += ws_.acceleration.col(i);
-      weight += model_.f_ext.col(i);
-    }
-    if (body.asleep) {
-      ++body.slept_steps;
-      ++diagnostics_.sleeping_body_steps;
-      if (cut || touched ||
-          (force - body.dynamic_force).norm() > wake_share * (weight.norm() + body.dynamic_force.norm()) + 1e-12) {
-        body.asleep = false;
-        body.quiet = 0;
-        changed = true;
-      }
-      continue;
-    }
-    double fastest = 0;
-    for (index_t i = first; i < last; ++i) fastest = std::max(fastest, state_.velocity.col(i).squaredNorm());
-    body.quiet = fastest < sleep_speed * sleep_speed && !touched && !cut ? body.quiet + solver_.dt : 0.0;
-    if (body.quiet >= sleep_time) {
-      body.asleep = true;
-      body.dynamic_force = force;
-      state_.velocity.middleCols(first, last - first).setZero();
-      changed = true;
-    }
-  }
-  if (!changed) return;
-  // the workspace's view: which points sleep, and the ranges that do not (none sleeping: both empty)
-  const bool any = std::any_of(sleep_.begin(), sleep_.end(), [](const BodySleep& b) { return b.asleep; });
-  ws_.asleep.clear();
-  ws_.awake.clear();
-  if (!any) return;
-  ws_.asleep.assign(static_cast<std::size_t>(model_.n_points), 0);
-  for (index_t k = 0; k < n_bodies; ++k) {
-    const index_t first = model_.body_start[static_cast<std::size_t>(k)],
-                  last = model_.body_start[static_cast<std::size_t>(k) + 1];
-    if (sleep_[static_cast<std::size_t>(k)].asleep)
-      std::fill(ws_.asleep.begin() + first, ws_.asleep.begin() + last, char{1});
-    else if (!ws_.awake.empty() && ws_.awake.back()[1] == first) ws_.awake.back()[1] = last;
-    else ws_.awake.push_back({first, last});
-  }
+  };
+  inputs.dt = solver_.dt;
+  update_body_sleep(model_, state_, inputs, sleep_, diagnostics_.sleeping_body_steps, ws_);
 }
 
 DynamicForces* ModelSimulation::forces_this_step() {

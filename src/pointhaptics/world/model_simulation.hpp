@@ -2,6 +2,7 @@
 /// @file An ordinary simulation of one model: its State, the solver's Workspace and the Solver, the tools
 /// that act on it, and the step pipeline. It knows nothing of levels of detail: the layer above
 /// (levels_of_detail.hpp) drives one of these over the active model. Most users want Simulation.
+#include <pointhaptics/bodies/body_sleep.hpp>
 #include <pointhaptics/core/state.hpp>
 #include <pointhaptics/core/workspace.hpp>
 #include <pointhaptics/contact/body_contact.hpp>
@@ -196,13 +197,7 @@ class ModelSimulation {
   const std::vector<PosedBody>& posed_bodies() const { return posed_bodies_; }
   /// Contact between the model's bodies (several [[object]] tables); nullptr with one body.
   BodyContact* body_contact() { return body_contact_.get(); }
-  /// Body k's sleep (SolverSpec::sleep): whether it sleeps now, and the steps it slept.
-  struct BodySleep {
-    bool asleep = false;
-    long long slept_steps = 0;
-    double quiet = 0;                   ///< s its points have been slower than the sleeping speed, nothing touching it
-    Vec3 dynamic_force = Vec3::Zero();  ///< the contacts' force on it when it fell asleep, N
-  };
+  /// Each body's sleep (SolverSpec::sleep; bodies/body_sleep.hpp): whether it sleeps now, and the steps it slept.
   const std::vector<BodySleep>& body_sleep() const { return sleep_; }
   /// Contact between the model's bodies over `surface` (every body's, ObjectSurface::body_vertex_start), from now
   /// on. Once the cuts stop (a step that adds no sheet), it takes the surface split along them

@@ -504,7 +504,7 @@ namespace {
 // each body's block: its points, mass, motion, held groups and what the others do to it
 // each body's block (with several) and the contact between them and between the pieces of a cut one
 void body_summaries(const Model& model, const State& state, const BodyContact* contact,
-                    const std::vector<ModelSimulation::BodySleep>& sleep, RunSummary& s) {
+                    const std::vector<BodySleep>& sleep, RunSummary& s) {
   const BodyLoads loads = contact ? contact->loads(model, state.u) : BodyLoads{};
   if (contact) {
     s.body_contact.present = true;

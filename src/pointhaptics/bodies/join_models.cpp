@@ -1,4 +1,4 @@
-#include <pointhaptics/mechanics/join_models.hpp>
+#include <pointhaptics/bodies/join_models.hpp>
 
 #include <pointhaptics/core/error.hpp>
 
