@@ -343,18 +343,15 @@ TEST(Bodies, TheShippedLayersSceneOpensWithTwoBodiesInContact) {
 }  // namespace
 namespace {
 
-// a block resting on another whose base is held, under gravity tilted by atan(0.2): a static solve by contact
-// alone converges when the friction between them (0.5) can hold it, friction carrying the sideways weight, and
-// finds no equilibrium when it cannot (0.1: the block slides off)
-TEST(Bodies, FrictionHoldsABlockOnATiltedBlockInAStaticSolveOrLetsItSlide) {
-  // (15 Newton iterations a solve: the held block needs fewer; the sliding one fails the same way as with the
-  // default 50, in a third of the time)
-  const auto scene = [](double friction) {
-    return fmt::format(R"(
+// a 2 cm block resting on a 4 x 2 x 4 cm one whose base is held (E = 100 kPa, mass-proportional `damping`), under
+// gravity tilted by atan(0.2); `more` adds the contact and the solver
+std::string block_on_held_block_on_a_slope(double damping, const std::string& more) {
+  return fmt::format(R"(
 [material]
 young = 1e5
 poisson = 0.3
 density = 1000.0
+damping = {}
 [[object]]
 name = "lower"
 size = [0.04, 0.02, 0.04]
@@ -367,17 +364,25 @@ spacing = 0.005
 [[fixed]]
 object = "lower"
 box = {{ min = [-1.0, -1.0, -1.0], max = [1.0, 0.0, 1.0] }}
-[contact]
-friction = 0.1
-pairs = [{{ bodies = ["lower", "upper"], friction = {} }}]
-[solver]
-kind = "static"
-max_iterations = 15
 [[load]]
 kind = "gravity"
 g = [1.962, -9.81, 0.0]
 )",
-                       friction);
+                     damping) +
+         more;
+}
+
+// a block resting on another whose base is held, under gravity tilted by atan(0.2): a static solve by contact
+// alone converges when the friction between them (0.5) can hold it, friction carrying the sideways weight, and
+// finds no equilibrium when it cannot (0.1: the block slides off)
+TEST(Bodies, FrictionHoldsABlockOnATiltedBlockInAStaticSolveOrLetsItSlide) {
+  // (15 Newton iterations a solve: the held block needs fewer; the sliding one fails the same way as with the
+  // default 50, in a third of the time)
+  const auto scene = [](double friction) {
+    return block_on_held_block_on_a_slope(
+        0.0, fmt::format("[contact]\nfriction = 0.1\npairs = [{{ bodies = [\"lower\", \"upper\"], friction = {} }}]\n"
+                         "[solver]\nkind = \"static\"\nmax_iterations = 15\n",
+                         friction));
   };
   const double mass = 0.02 * 0.02 * 0.02 * 1000.0;
   SceneSession held = open_scene(parse_scene(scene(0.5), "scene.toml"), two_threads());
@@ -401,33 +406,8 @@ g = [1.962, -9.81, 0.0]
 // steps, the ringing went on for good (the pressure between 0.13 and 2.3 times the weight) and the block crept
 // 7-10 mm/s down the slope
 TEST(Bodies, ABlockOnASlopeSettlesAndHoldsInExplicitSteps) {
-  const std::string text = R"(
-[material]
-young = 1e5
-poisson = 0.3
-density = 1000.0
-damping = 20.0
-[[object]]
-name = "lower"
-size = [0.04, 0.02, 0.04]
-spacing = 0.005
-[[object]]
-name = "upper"
-origin = [0.01, 0.02, 0.01]
-size = [0.02, 0.02, 0.02]
-spacing = 0.005
-[[fixed]]
-object = "lower"
-box = { min = [-1.0, -1.0, -1.0], max = [1.0, 0.0, 1.0] }
-[contact]
-friction = 0.5
-[solver]
-kind = "explicit"
-dt = 0.001
-[[load]]
-kind = "gravity"
-g = [1.962, -9.81, 0.0]
-)";
+  const std::string text =
+      block_on_held_block_on_a_slope(20.0, "[contact]\nfriction = 0.5\n[solver]\nkind = \"explicit\"\ndt = 0.001\n");
   SceneSession s = open_scene(parse_scene(text, "scene.toml"), two_threads());
   Simulation& sim = *s.simulation;
   const Model& model = sim.model();
