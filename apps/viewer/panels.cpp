@@ -115,6 +115,20 @@ bool parameter_panels(Scene& s) {
       s.probe.radius = r_mm * 1e-3;
       changed = true;
     }
+    if (s.probe.grasper) {  // the button closes its jaws from the opening to the grip
+      ImGui::TextWrapped("grasper: the button closes its jaws");
+      double opening_mm = s.probe.opening * 1e3, grip_mm = s.probe.grip * 1e3;
+      if (slider("opening (mm)", opening_mm, 1.0, 100.0, "%.3g", true)) {
+        s.probe.opening = opening_mm * 1e-3;
+        s.probe.grip = std::min(s.probe.grip, 0.99 * s.probe.opening);
+        changed = true;
+      }
+      if (slider("grip (mm)", grip_mm, 0.0, opening_mm, "%.3g")) {
+        s.probe.grip = std::min(grip_mm * 1e-3, 0.99 * s.probe.opening);
+        changed = true;
+      }
+      return changed;
+    }
     int mode = s.probe.cut ? 2 : s.probe.grab ? 1 : 0;
     if (ImGui::Combo("mode", &mode, "push (button grabs)\0grab only\0blade (button cuts)\0")) {
       s.probe.grab = mode == 1;
