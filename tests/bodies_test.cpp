@@ -400,6 +400,49 @@ TEST(Bodies, FrictionHoldsABlockOnATiltedBlockInAStaticSolveOrLetsItSlide) {
   EXPECT_FALSE(slides.simulation->summary().converged);
 }
 
+// two elastic spheres (R = 1 cm, neo-Hookean), each held at its far cap and refined to R/8 where they meet, pressed
+// together statically by moving the upper one's cap 0.6 mm: the solve converges (a vertex kept the triangle it was
+// paired with while that covered it; choosing afresh at each update, the pairing flipped between two sets of
+// triangles of the faceted spheres, the force by 0.6% and 4% by turns, and the solve failed after 50 updates), the
+// caps' reactions are equal and opposite and along the line of centres, and neither sphere is inside the other
+TEST(Bodies, TwoElasticSpheresPressedTogetherStaticallyConverge) {
+  const auto sphere = [](const char* name, double centre_y, double cap_from, double cap_to, const char* more) {
+    return fmt::format(R"(
+[[object]]
+name = "{0}"
+shape = "sphere"
+radius = 0.01
+origin = [0.0, {1}, 0.0]
+spacing = 0.0025
+surface_edge = 0.000625
+[[fixed]]
+object = "{0}"
+box = {{ min = [-0.02, {2}, -0.02], max = [0.02, {3}, 0.02] }}
+{4}
+[[refine]]
+object = "{0}"
+sphere = {{ centre = [0.0, 0.01005, 0.0], radius = 0.004 }}
+spacing = 0.00125
+)",
+                       name, centre_y, cap_from, cap_to, more);
+  };
+  const std::string text =
+      "[material]\nmodel = \"neo_hookean\"\nyoung = 1e5\npoisson = 0.3\n[solver]\nkind = \"static\"\n" +
+      sphere("lower", 0.0, -0.02, -0.007, "") +
+      sphere("upper", 0.0201, 0.0271, 0.05, "displacement = [0.0, -0.0006, 0.0]");
+  SceneSession s = open_scene(parse_scene(text, "scene.toml"), two_threads());
+  s.simulation->run(0);
+  const RunSummary summary = s.simulation->summary();
+  ASSERT_TRUE(summary.converged) << summary.failure;
+  ASSERT_EQ(summary.reactions.size(), 2u);
+  const Vec3 lower = summary.reactions[0], upper = summary.reactions[1];
+  EXPECT_GT(lower.y(), 0.02) << "pressed together (Hertz: 0.05 N at this approach)";
+  EXPECT_LT((lower + upper).norm(), 1e-6 * lower.norm()) << "equal and opposite";
+  EXPECT_LT(std::hypot(lower.x(), lower.z()), 1e-3 * lower.y()) << "along the line of centres";
+  EXPECT_GT(summary.body_contact.contacts, 3);
+  EXPECT_LT(summary.body_contact.penetration, 0.01 * 0.00125);
+}
+
 // a block resting on a held one under gravity tilted to a slope of 0.2, friction 0.5, in explicit steps: once it has
 // settled (its drop onto the contact's give rings at first) it stays where it is, pressed with its weight and held
 // by friction carrying the slope's pull. With the multipliers taking a fifth of the way each step, as in implicit

@@ -189,6 +189,68 @@ void cut_piece_falls(std::vector<Check>& checks, int threads) {
                        r.kinetic_energy < 1e-9 && named(r.obstacles, "table").contacts > 0));
 }
 
+/// Two elastic spheres pressed together, against Hertz's two-body law.
+struct HertzRow {
+  int refine = 0;       ///< the contact's spacing is R / refine (the rest of each sphere R / 4)
+  double approach = 0;  ///< the centres' approach, m
+  double force = 0;     ///< N
+  double hertz = 0;     ///< N
+  int contacts = 0;
+  double solve_s = 0;
+  bool converged = false;
+};
+
+// two neo-Hookean spheres (R = 1 cm, E = 100 kPa, nu = 0.3), 0.1 mm apart, each held at its far cap (3 mm high) and
+// refined where they meet; the upper cap is moved down by `travel`, statically. Hertz's two-body law:
+// F = 4/3 E* sqrt(R*) d^(3/2) with R* = R / 2, 1 / E* = 2 (1 - nu^2) / E, and d the approach of the centres (the
+// spheres' bulk compression between the centres and the contact is in d too: a few percent of it at these
+// approaches)
+HertzRow press_spheres(int refine, double travel, std::vector<Check>& checks, int threads) {
+  constexpr double R = 0.01, young = 1e5, poisson = 0.3, gap = 1e-4;
+  const double fine = R / refine;
+  const auto sphere = [&](const char* name, double centre_y, double cap_from, double cap_to, const std::string& more) {
+    return fmt::format(
+        "[[object]]\nname = \"{0}\"\nshape = \"sphere\"\nradius = {1}\norigin = [0.0, {2}, 0.0]\nspacing = "
+        "{3}\nsurface_edge = {4}\n[[fixed]]\nobject = \"{0}\"\nbox = {{ min = [-0.02, {5}, -0.02], max = [0.02, {6}, "
+        "0.02] }}\n{7}\n[[refine]]\nobject = \"{0}\"\nsphere = {{ centre = [0.0, {8}, 0.0], radius = {9} }}\nspacing = "
+        "{10}\n",
+        name, R, centre_y, R / 4, fine / 2, cap_from, cap_to, more, R + gap / 2, 0.4 * R, fine);
+  };
+  const std::string text =
+      fmt::format("[material]\nmodel = \"neo_hookean\"\nyoung = {}\npoisson = {}\n[solver]\nkind = \"static\"\n", young,
+                  poisson) +
+      sphere("lower", 0.0, -2 * R, -0.7 * R, "") +
+      sphere("upper", 2 * R + gap, 2.7 * R + gap, 5 * R, fmt::format("displacement = [0.0, {}, 0.0]", -travel));
+  SceneSession s = open(text, "two-spheres", threads);
+  s.simulation->step();
+  const RunSummary r = s.simulation->summary();
+  const Model& model = s.simulation->model();
+  const Points& u = s.simulation->state().u;
+  // the centres' points (each sphere's lattice has one there)
+  const auto centre = [&](const Vec3& c) {
+    index_t nearest = 0;
+    for (index_t i = 1; i < model.n_points; ++i)
+      if ((model.X.col(i) - c).squaredNorm() < (model.X.col(nearest) - c).squaredNorm()) nearest = i;
+    return nearest;
+  };
+  const index_t lower = centre(Vec3::Zero()), upper = centre(Vec3(0, 2 * R + gap, 0));
+  HertzRow row;
+  row.refine = refine;
+  row.approach = u(1, lower) - u(1, upper) - gap;
+  row.force = r.reactions.size() == 2 ? r.reactions[0].y() : 0.0;
+  const double effective_young = young / (2 * (1 - poisson * poisson)), effective_radius = R / 2;
+  row.hertz = 4.0 / 3.0 * effective_young * std::sqrt(effective_radius) * std::pow(std::max(row.approach, 0.0), 1.5);
+  row.contacts = r.body_contact.contacts;
+  row.solve_s = r.solve_s;
+  row.converged = r.converged;
+  const std::string label = fmt::format("spheres R/{}, approach {:.3f} R", refine, row.approach / R);
+  checks.push_back(yes("body-body", label + ": static solve converged", r.converged));
+  if (r.reactions.size() == 2)
+    checks.push_back(within("body-body", label + ": upper cap's reaction / the lower's (opposite)", -r.reactions[1].y(),
+                            r.reactions[0].y(), 1e-6));
+  return row;
+}
+
 }  // namespace
 
 int run_contact_pairs_experiment(const ContactPairsOptions& options) {
@@ -201,6 +263,15 @@ int run_contact_pairs_experiment(const ContactPairsOptions& options) {
   pinch(checks, options.threads);
   lift(checks, options.threads);
   cut_piece_falls(checks, options.threads);
+  std::vector<HertzRow> hertz;
+  for (int refine : {8, 16})
+    for (double travel : {0.0006, 0.0011}) hertz.push_back(press_spheres(refine, travel, checks, options.threads));
+  auto hertz_csv = fmt::output_file((out / "two-spheres.csv").string());
+  hertz_csv.print("refine,approach_m,approach_over_r,force_n,hertz_n,ratio,contacts,solve_s,converged\n");
+  for (const HertzRow& h : hertz)
+    hertz_csv.print("{},{:.6g},{:.4f},{:.6g},{:.6g},{:.4f},{},{:.2f},{}\n", h.refine, h.approach, h.approach / 0.01,
+                    h.force, h.hertz, h.force / h.hertz, h.contacts, h.solve_s, h.converged ? 1 : 0);
+  hertz_csv.close();
   auto csv = fmt::output_file((out / "contact-pairs.csv").string());
   csv.print("pair,quantity,measured,expected,relative_error,tolerance,holds\n");
   for (const Check& c : checks)
@@ -219,10 +290,20 @@ int run_contact_pairs_experiment(const ContactPairsOptions& options) {
              c.tolerance > 0 ? fmt::format("{:.2e}", c.relative_error()) : "-",
              c.tolerance > 0 ? fmt::format("{:.1e}", c.tolerance) : "-", c.holds ? "yes" : "**no**");
   md.print(
-      "\nNot yet here: two elastic spheres pressed together against Hertz's two-body law (the body contact's "
-      "pairs are vertex to triangle on each body's own surface, and at the spacings a test affords, 1 mm on a 1 cm "
-      "sphere, the contact patch at small approach spans one or two spacings; refinement, which resolves it for a "
-      "tool, is not yet available with several bodies).\n");
+      "\n## Two elastic spheres against Hertz's two-body law (measured, not yet a check)\n\n"
+      "Two neo-Hookean spheres (R = 1 cm, E = 100 kPa, nu = 0.3), each held at its far cap, spacing R/4 refined "
+      "where they meet, pressed together statically (`two-spheres.csv`). Hertz: F = 4/3 E* sqrt(R*) d^(3/2), "
+      "R* = R/2, E* = E / (2 (1 - nu^2)), d the centres' approach.\n\n"
+      "| contact spacing | approach / R | force (N) | Hertz (N) | / Hertz | within 5% | vertices pressing | solve (s) |\n"
+      "|---|---|---|---|---|---|---|---|\n");
+  for (const HertzRow& h : hertz)
+    md.print("| R/{} | {:.3f} | {:.4f} | {:.4f} | {:.3f} | {} | {} | {:.1f} |\n", h.refine, h.approach / 0.01, h.force,
+             h.hertz, h.force / h.hertz, std::abs(h.force / h.hertz - 1) <= 0.05 ? "yes" : "no", h.contacts, h.solve_s);
+  md.print(
+      "\nThe goal (within 5% at small approach) is not a check yet: between R/8 and R/16 at the contact the force "
+      "still moves by tens of percent (the contact's radius, sqrt(R* d), is 1.5-2 mm: one or two R/8 spacings), so "
+      "the point model is not converged there, and Hertz's law for two whole spheres held at their caps carries a "
+      "finite-size error of a few percent that only an FEM model of the same spheres would give.\n");
   md.close();
   bool all = plots == 0;
   for (const Check& c : checks) {

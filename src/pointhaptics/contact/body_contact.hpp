@@ -205,6 +205,8 @@ class BodyContact final : public DynamicForces, public EnergyTerm {
   std::vector<Eigen::AlignedBox3d> piece_box_;  ///< each piece's deformed faces' box
   SpatialGrid grid_;
   std::vector<double> previous_multiplier_;  ///< per vertex, across a refresh
+  /// per vertex, across a refresh: the triangle it was paired with (-1: none), kept while it still covers it
+  std::vector<index_t> previous_triangle_;
 };
 
 }  // namespace pointhaptics

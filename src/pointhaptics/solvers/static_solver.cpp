@@ -69,8 +69,8 @@ StaticStats solve_static(const Model& model, State& state, Workspace& ws, Newton
     if (++stats.multiplier_updates > max_updates) {
       stats.converged = false;
       stats.failure = fmt::format(
-          "static solver: the tool's contact constraint is still not met after {} updates of its "
-          "multipliers",
+          "static solver: the contact constraints (a tool's, an obstacle's, between bodies) are still not met "
+          "after {} updates of their multipliers",
           max_updates);
       break;
     }
