@@ -283,6 +283,32 @@ TEST(Bodies, ABlockOnABlockOnATableEachCarriesWhatIsAboveIt) {
   EXPECT_GT(doc["body_contact"]["contacts"].get<int>(), 0);
 }
 
+// the same two blocks, both free, in one static solve: the table carries both, the lower one the upper, by contact
+// and friction alone (nothing held). The table's vertices touch it exactly at the start, with no multiplier: the
+// solve's first tangent counts them as pressing (SurfaceContact's kink tangent); without it the stack had no
+// vertical stiffness in the first Newton iteration, its CG diverged and the solve found no equilibrium at all
+TEST(Bodies, TwoFreeBlocksStackedOnATableSolveStatically) {
+  SceneSession s =
+      open_scene(parse_scene(two_blocks(0.0, "kind = \"static\"",
+                                        "[contact]\nfriction = 0.5\n[[load]]\nkind = \"gravity\"\n"
+                                        "[[obstacle]]\nname = \"table\"\nfriction = 0.5\nplane = { normal = "
+                                        "[0.0, 1.0, 0.0] }"),
+                             "scene.toml"),
+                 two_threads());
+  s.simulation->run(0);
+  const RunSummary summary = s.simulation->summary();
+  ASSERT_TRUE(summary.converged) << summary.failure;
+  EXPECT_NEAR(body(summary, "upper").contact_force.y(), upper_weight, 1e-6 * upper_weight);
+  EXPECT_NEAR(body(summary, "lower").contact_force.y(), -upper_weight, 1e-6 * upper_weight);
+  ASSERT_EQ(summary.obstacles.size(), 1u);
+  EXPECT_NEAR(summary.obstacles[0].second.force.y(), -(lower_weight + upper_weight),
+              1e-6 * (lower_weight + upper_weight));
+  EXPECT_LT(summary.body_contact.penetration, 0.01 * spacing);
+  EXPECT_LT(summary.obstacles[0].second.penetration, 0.01 * spacing);
+  const Vec3 mean = s.simulation->state().u.rowwise().mean();
+  EXPECT_LT(std::hypot(mean.x(), mean.z()), 0.01 * spacing) << "friction holds them where they stood";
+}
+
 }  // namespace
 
 namespace {

@@ -264,6 +264,7 @@ double SurfaceContact::friction_cone(index_t v) const {
 }
 
 void SurfaceContact::anchor_pressing(const Points& u) {
+  kink_tangent_ = true;
   if (anchors_.empty()) return;
   evaluate(u);
   for (index_t v = 0; v < y_.cols(); ++v) {
@@ -293,7 +294,7 @@ Vec3 SurfaceContact::friction_force(index_t v) const {
 }
 
 template <class Pressing>
-ToolLoad SurfaceContact::for_each_pressing(const Pressing& pressing) const {
+ToolLoad SurfaceContact::for_each_pressing(const Pressing& pressing, bool touching) const {
   ToolLoad out;
   const double far = tool_reach(shape_);
   for_each_candidate([&](index_t v) {
@@ -302,7 +303,7 @@ ToolLoad SurfaceContact::for_each_pressing(const Pressing& pressing) const {
     const ToolDistance d = tool_distance(shape_, pose_, y_.col(v));
     out.penetration = std::max(out.penetration, d.penetration);
     const double pressure = lambda + k * d.penetration;
-    if (!(pressure > 0)) return;
+    if (!(pressure > 0 || (touching && lambda == 0 && d.penetration > -1e-3 * tolerance_))) return;
     const Vec3 on_tool = -pressure * d.normal;
     out.force += on_tool;
     out.torque += (d.core - pose_.position).cross(on_tool);  // the force acts along the normal through the core
@@ -340,17 +341,20 @@ void SurfaceContact::add_forces(const Model&, const Points& u, Points& f) {
 void SurfaceContact::linearise(const Model&, const Points& u, TangentMode mode) {
   evaluate(u);
   active_.clear();
-  for_each_pressing([&](index_t v, const ToolDistance& d, double pressure) {
-    // d2E/dy2 = k n n^T - p dn/dy: the second part (the tool's curvature, negative) only in the exact tangent
-    Mat3 hessian = penalty_[static_cast<std::size_t>(v)] * d.normal * d.normal.transpose();
-    if (mode == TangentMode::EXACT && d.curvature > 0) {
-      const Mat3 off_normal = Mat3::Identity() - d.normal * d.normal.transpose();
-      const Mat3 along = Mat3::Identity() - d.axis * d.axis.transpose();
-      hessian -= (pressure * d.curvature) * off_normal * along;
-    }
-    active_.push_back(
-        {v, d.normal, pressure, hessian, penalty_[static_cast<std::size_t>(v)] * d.normal * d.normal.transpose()});
-  });
+  for_each_pressing(
+      [&](index_t v, const ToolDistance& d, double pressure) {
+        // d2E/dy2 = k n n^T - p dn/dy: the second part (the tool's curvature, negative) only in the exact tangent
+        Mat3 hessian = penalty_[static_cast<std::size_t>(v)] * d.normal * d.normal.transpose();
+        if (mode == TangentMode::EXACT && d.curvature > 0) {
+          const Mat3 off_normal = Mat3::Identity() - d.normal * d.normal.transpose();
+          const Mat3 along = Mat3::Identity() - d.axis * d.axis.transpose();
+          hessian -= (pressure * d.curvature) * off_normal * along;
+        }
+        active_.push_back(
+            {v, d.normal, pressure, hessian, penalty_[static_cast<std::size_t>(v)] * d.normal * d.normal.transpose()});
+      },
+      kink_tangent_);
+  kink_tangent_ = false;
   if (!anchors_.empty())
     for_each_candidate([&](index_t v) {
       if (!anchors_[static_cast<std::size_t>(v)].held) return;

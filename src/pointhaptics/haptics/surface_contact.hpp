@@ -249,7 +249,7 @@ class SurfaceContact final : public EnergyTerm {
   }
   /// The load of the vertices pressing on the tool at y_, calling pressing(v, distance, pressure) for each.
   template <class Pressing>
-  ToolLoad for_each_pressing(const Pressing& pressing) const;
+  ToolLoad for_each_pressing(const Pressing& pressing, bool touching = false) const;
 
   SurfaceContact(const Model& model, const TriangleMesh& surface, SurfaceMap map, ContactSamples samples,
                  const ToolShape& shape, const SurfaceContactParams& params);
@@ -273,7 +273,12 @@ class SurfaceContact final : public EnergyTerm {
   std::vector<std::array<index_t, 2>> parents_;    // each sample's two ends (ContactSamples::parents)
   std::vector<std::uint64_t> keys_;                // each vertex's and sample's name on the whole surface
   index_t n_surface_ = 0;
-  bool cull_ = false;       ///< SurfaceContactParams::cull_far_vertices
+  bool cull_ = false;  ///< SurfaceContactParams::cull_far_vertices
+  /// The next linearise() counts a vertex touching with no multiplier (at the kink) as pressing: the first of a
+  /// static solve (anchor_pressing()), where a body resting exactly on an obstacle has no stiffness under it
+  /// otherwise (two blocks stacked on a table: the first iteration's CG diverged). Only the first: at every
+  /// linearisation it made the shipped block on a table stall at 0.91 of its load
+  bool kink_tangent_ = false;
   double cull_margin_ = 0;  ///< SurfaceContactParams::cull_margin
   /// culling: the vertices and samples carried (select_candidates()), in order, and the triangles whose vertices are
   /// all among them (the rest reach far outside); where the tool was and the displacement's bound when they were
