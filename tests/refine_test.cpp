@@ -56,6 +56,54 @@ TEST(Refine, KeepsTheVolumeAndPutsFinePointsInTheRegion) {
   EXPECT_DOUBLE_EQ(cloud.volume[0], uniform.volume[0]);
 }
 
+// a graded refinement: R/16 at the contact inside R/8 around it, in either order in the file (made coarsest first).
+// The volume is kept, the inner region holds the finest lattice only, the shell between the two the middle one,
+// an affine field is still exact everywhere; two regions that only partly overlap are still an error
+TEST(Refine, ARegionInsideAnotherRefinesItFurther) {
+  for (const bool finest_first : {false, true}) {
+    Scene s = block(true);
+    s.refine.resize(2);
+    s.refine[1].box = {Vec3(-0.006, 0.034, -0.006), Vec3(0.006, 0.05, 0.006)};
+    s.refine[1].spacing = 0.000625;
+    if (finest_first) std::swap(s.refine[0], s.refine[1]);
+    const RefineSpec &middle = s.refine[finest_first ? 1 : 0], &inner = s.refine[finest_first ? 0 : 1];
+    const PointCloud cloud = sample_object(s);
+    EXPECT_NEAR(cloud.volume.sum(), 0.08 * 0.04 * 0.08, 1e-9 * 0.08 * 0.04 * 0.08);
+    int finest = 0, between = 0;
+    for (index_t i = 0; i < cloud.size(); ++i) {
+      const Vec3 x = cloud.X.col(i);
+      if (inner.contains(x, 0)) {
+        ++finest;
+        EXPECT_LT(cloud.volume[i], 3 * std::pow(0.000625, 3));
+      } else if (middle.contains(x, 1e-12)) {
+        ++between;
+        EXPECT_NEAR(std::remainder(x.x(), 0.00125), 0.0, 1e-12) << "the shell keeps the middle lattice";
+      }
+    }
+    // 19 x 10 x 19 fine points (x, z in [-5.625, 5.625] mm, y in [34.375, 40] mm)
+    EXPECT_EQ(finest, 19 * 10 * 19);
+    EXPECT_GT(between, 1000);
+    const Model model = build_scene_model(s);
+    Mat3 A;
+    A << 0.01, 0.02, -0.005, 0.003, -0.02, 0.004, 0.0, 0.01, 0.015;
+    const Points u = A * model.X;
+    double worst = 0;
+    for (index_t i = 0; i < model.n_points; ++i)
+      worst = std::max(worst, (displacement_gradient(model, u, i) - A).norm());
+    EXPECT_LT(worst, 1e-10);
+  }
+  Scene partly = block(true);
+  partly.refine.resize(2);
+  partly.refine[1].box = {Vec3(0.0, 0.034, -0.006), Vec3(0.02, 0.05, 0.006)};  // out of the first along x
+  partly.refine[1].spacing = 0.000625;
+  try {
+    sample_object(partly);
+    ADD_FAILURE() << "a region partly outside another was taken";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("unless one lies wholly inside the other"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Refine, AffineFieldsGiveTheExactDeformationGradientEverywhere) {
   const Model model = build_scene_model(block(true));
   Mat3 A;

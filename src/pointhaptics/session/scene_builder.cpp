@@ -78,7 +78,12 @@ double estimated_points(const Scene& scene) {
     hi.array() += o.radius;
   }
   // [[refine]] regions add their fine points: the part of their bounds within the object's, at their spacing
-  for (const RefineSpec& r : scene.refine) {
+  // coarsest first: a region nested in another refines what that one made
+  std::vector<const RefineSpec*> order;
+  for (const RefineSpec& r : scene.refine) order.push_back(&r);
+  std::stable_sort(order.begin(), order.end(), [](auto a, auto b) { return a->spacing > b->spacing; });
+  for (const RefineSpec* refine : order) {
+    const RefineSpec& r = *refine;
     if (!applies(scene, r.object)) continue;
     const Vec3 extent = (r.bounds().max.cwiseMin(hi) - r.bounds().min.cwiseMax(lo)).cwiseMax(0.0);
     n += (extent.array() / r.spacing + 1).prod();
@@ -164,8 +169,22 @@ PointCloud sample_shape(const Scene& scene) {
 
 namespace {
 
-// [[refine]] regions must not overlap (each refines the coarse sampling it finds): a point of a lattice over the
-// two regions' common bounds, at the finer spacing (at most 100 per axis), in both is an overlap (issue 52)
+// [[refine]] regions must not overlap (each refines the sampling it finds), unless one lies wholly inside the other
+// with a finer spacing: a graded refinement (R/16 at the contact inside R/8 around it), which sample_object() makes
+// coarsest first. A point of a lattice over the two regions' common bounds, at the finer spacing (at most 100 per
+// axis), in both is an overlap (issue 52); the nesting is checked on a lattice over the finer region's bounds
+bool lies_inside(const RefineSpec& inner, const RefineSpec& outer) {
+  const Vec3 lo = inner.bounds().min, hi = inner.bounds().max;
+  const double step = std::max(inner.spacing, (hi - lo).maxCoeff() / 100);
+  for (double x = lo.x(); x <= hi.x() + 0.5 * step; x += step)
+    for (double y = lo.y(); y <= hi.y() + 0.5 * step; y += step)
+      for (double z = lo.z(); z <= hi.z() + 0.5 * step; z += step) {
+        const Vec3 p = Vec3(x, y, z).cwiseMin(hi);
+        if (inner.contains(p, 0) && !outer.contains(p, 0)) return false;
+      }
+  return true;
+}
+
 void check_refine_regions_apart(const Scene& scene) {
   for (std::size_t a = 0; a < scene.refine.size(); ++a)
     for (std::size_t b = a + 1; b < scene.refine.size(); ++b) {
@@ -177,11 +196,16 @@ void check_refine_regions_apart(const Scene& scene) {
       for (double x = lo.x(); x <= hi.x(); x += step)
         for (double y = lo.y(); y <= hi.y(); y += step)
           for (double z = lo.z(); z <= hi.z(); z += step)
-            if (ra.contains(Vec3(x, y, z), 0) && rb.contains(Vec3(x, y, z), 0))
-              throw Error(
-                  fmt::format("{}:{}: refine[{}] overlaps refine[{}] (line {}) at ({:.4g}, {:.4g}, {:.4g}): "
-                              "[[refine]] regions must not overlap (join them into one)",
-                              scene.path, rb.line, b, a, ra.line, x, y, z));
+            if (ra.contains(Vec3(x, y, z), 0) && rb.contains(Vec3(x, y, z), 0)) {
+              const bool nested =
+                  (rb.spacing < ra.spacing && lies_inside(rb, ra)) || (ra.spacing < rb.spacing && lies_inside(ra, rb));
+              if (nested) goto next_pair;
+              throw Error(fmt::format(
+                  "{}:{}: refine[{}] overlaps refine[{}] (line {}) at ({:.4g}, {:.4g}, {:.4g}): [[refine]] regions "
+                  "must not overlap unless one lies wholly inside the other with a finer spacing (join them into one)",
+                  scene.path, rb.line, b, a, ra.line, x, y, z));
+            }
+    next_pair:;
     }
 }
 
@@ -193,7 +217,12 @@ PointCloud sample_object(const Scene& scene) {
   PointCloud cloud = sample_shape(scene);
   // [[refine]]: finer points where a tool presses, each with its own support
   const double support = scene.kernel.support > 0 ? scene.kernel.support : scene.kernel.support_factor * o.spacing;
-  for (const RefineSpec& r : scene.refine) {
+  // coarsest first: a region nested in another refines what that one made
+  std::vector<const RefineSpec*> order;
+  for (const RefineSpec& r : scene.refine) order.push_back(&r);
+  std::stable_sort(order.begin(), order.end(), [](auto a, auto b) { return a->spacing > b->spacing; });
+  for (const RefineSpec* refine : order) {
+    const RefineSpec& r = *refine;
     if (!applies(scene, r.object)) continue;
     const double tol = 1e-9 * o.spacing;
     Aabb bounds = r.bounds();
