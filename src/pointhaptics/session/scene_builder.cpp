@@ -77,13 +77,9 @@ double estimated_points(const Scene& scene) {
     lo.array() -= o.radius;
     hi.array() += o.radius;
   }
-  // [[refine]] regions add their fine points: the part of their bounds within the object's, at their spacing
-  // coarsest first: a region nested in another refines what that one made
-  std::vector<const RefineSpec*> order;
-  for (const RefineSpec& r : scene.refine) order.push_back(&r);
-  std::stable_sort(order.begin(), order.end(), [](auto a, auto b) { return a->spacing > b->spacing; });
-  for (const RefineSpec* refine : order) {
-    const RefineSpec& r = *refine;
+  // [[refine]] regions add their fine points: the part of their bounds within the object's, at their spacing (a
+  // nested region's counted as if added: an estimate's bound)
+  for (const RefineSpec& r : scene.refine) {
     if (!applies(scene, r.object)) continue;
     const Vec3 extent = (r.bounds().max.cwiseMin(hi) - r.bounds().min.cwiseMax(lo)).cwiseMax(0.0);
     n += (extent.array() / r.spacing + 1).prod();
