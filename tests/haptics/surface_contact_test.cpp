@@ -187,8 +187,8 @@ TEST(SurfaceContact, CarryingOnlyTheVerticesThatCanTouchChangesNothing) {
       every.set_pose(t.pose);
       culled.set_pose(t.pose);
       const Points u = random_field(b.model.n_points, scale, 11);
-      every.anchor_pressing(u);
-      culled.anchor_pressing(u);
+      every.begin_static_solve(u);
+      culled.begin_static_solve(u);
       EXPECT_EQ(every.update_multipliers(b.model, u), culled.update_multipliers(b.model, u));
       const Points v = random_field(b.model.n_points, scale, 13);
       EXPECT_NEAR(every.energy(b.model, v), culled.energy(b.model, v), 1e-12 * std::abs(every.energy(b.model, v)));

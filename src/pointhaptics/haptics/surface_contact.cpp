@@ -263,7 +263,7 @@ double SurfaceContact::friction_cone(index_t v) const {
   return friction_ * lambda_[static_cast<std::size_t>(v)];
 }
 
-void SurfaceContact::anchor_pressing(const Points& u) {
+void SurfaceContact::begin_static_solve(const Points& u) {
   kink_tangent_ = true;
   if (anchors_.empty()) return;
   evaluate(u);

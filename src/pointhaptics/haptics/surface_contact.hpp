@@ -141,11 +141,13 @@ class SurfaceContact final : public EnergyTerm {
   Vec3 tool_response(const Points& x) const;
   /// Uzawa's update at u: true (multipliers kept) when no vertex is deeper in the tool than the tolerance.
   bool update_multipliers(const Model& model, const Points& u) override;
-  /// With friction: anchor every vertex pressing into the tool at u that has no anchor yet, sticking without a
-  /// bound until the next update_multipliers() (which puts it on its cone). A static solve's first minimisation,
-  /// before any multiplier, then holds a body that only this tool's friction holds (two tools pinching it under
-  /// gravity), where a cone of friction x 0 would let it fall without end (the body contact's fresh pairs alike).
-  void anchor_pressing(const Points& u);
+  /// Before a static solve's first minimisation, which has no multiplier yet:
+  /// - with friction, anchor every vertex pressing into the tool at u that has no anchor yet, sticking without a
+  ///   bound until the next update_multipliers() (which puts it on its cone). It then holds a body that only this
+  ///   tool's friction holds (two tools pinching it under gravity), where a cone of friction x 0 would let it fall
+  ///   without end (the body contact's fresh pairs alike);
+  /// - the next linearise() counts the vertices touching the tool as pressing (kink_tangent_).
+  void begin_static_solve(const Points& u);
 
   /// The load on the tool at u (its multipliers and penalty as they are); same_u: u is the last evaluation's,
   /// whose carried surface is reused (the probe's placement tries several positions on one state).
@@ -214,7 +216,7 @@ class SurfaceContact final : public EnergyTerm {
     Mat3 tangent = Mat3::Zero();
     Vec3 tau = Vec3::Zero();
     bool held = false;
-    bool fresh = false;  ///< anchor_pressing()'s, before its first update: its cone has no bound
+    bool fresh = false;  ///< begin_static_solve()'s, before its first update: its cone has no bound
   };
   /// The friction's trial force on the tool from an anchored vertex v at y_: tau + k s.
   Vec3 friction_trial(index_t v) const;
@@ -275,7 +277,7 @@ class SurfaceContact final : public EnergyTerm {
   index_t n_surface_ = 0;
   bool cull_ = false;  ///< SurfaceContactParams::cull_far_vertices
   /// The next linearise() counts a vertex touching with no multiplier (at the kink) as pressing: the first of a
-  /// static solve (anchor_pressing()), where a body resting exactly on an obstacle has no stiffness under it
+  /// static solve (begin_static_solve()), where a body resting exactly on an obstacle has no stiffness under it
   /// otherwise (two blocks stacked on a table: the first iteration's CG diverged). Only the first: at every
   /// linearisation it made the shipped block on a table stall at 0.91 of its load
   bool kink_tangent_ = false;

@@ -22,6 +22,7 @@
 #include <fstream>
 #include <limits>
 #include <numbers>
+#include <optional>
 
 namespace pointhaptics {
 
@@ -167,8 +168,7 @@ namespace {
 
 // [[refine]] regions must not overlap (each refines the sampling it finds), unless one lies wholly inside the other
 // with a finer spacing: a graded refinement (R/16 at the contact inside R/8 around it), which sample_object() makes
-// coarsest first. A point of a lattice over the two regions' common bounds, at the finer spacing (at most 100 per
-// axis), in both is an overlap (issue 52); the nesting is checked on a lattice over the finer region's bounds
+// coarsest first (issue 52). The nesting is checked on a lattice over the finer region's bounds
 bool lies_inside(const RefineSpec& inner, const RefineSpec& outer) {
   const Vec3 lo = inner.bounds().min, hi = inner.bounds().max;
   const double step = std::max(inner.spacing, (hi - lo).maxCoeff() / 100);
@@ -181,27 +181,32 @@ bool lies_inside(const RefineSpec& inner, const RefineSpec& outer) {
   return true;
 }
 
+// a point of a lattice over the two regions' common bounds, at the finer spacing (at most 100 per axis), in both
+std::optional<Vec3> common_point(const RefineSpec& ra, const RefineSpec& rb) {
+  const Vec3 lo = ra.bounds().min.cwiseMax(rb.bounds().min), hi = ra.bounds().max.cwiseMin(rb.bounds().max);
+  if (!(lo.array() <= hi.array()).all()) return std::nullopt;
+  const double step = std::max(std::min(ra.spacing, rb.spacing), (hi - lo).maxCoeff() / 100);
+  for (double x = lo.x(); x <= hi.x(); x += step)
+    for (double y = lo.y(); y <= hi.y(); y += step)
+      for (double z = lo.z(); z <= hi.z(); z += step)
+        if (ra.contains(Vec3(x, y, z), 0) && rb.contains(Vec3(x, y, z), 0)) return Vec3(x, y, z);
+  return std::nullopt;
+}
+
 void check_refine_regions_apart(const Scene& scene) {
   for (std::size_t a = 0; a < scene.refine.size(); ++a)
     for (std::size_t b = a + 1; b < scene.refine.size(); ++b) {
       const RefineSpec &ra = scene.refine[a], &rb = scene.refine[b];
       if (!applies(scene, ra.object) || !applies(scene, rb.object)) continue;
-      const Vec3 lo = ra.bounds().min.cwiseMax(rb.bounds().min), hi = ra.bounds().max.cwiseMin(rb.bounds().max);
-      if (!(lo.array() <= hi.array()).all()) continue;
-      const double step = std::max(std::min(ra.spacing, rb.spacing), (hi - lo).maxCoeff() / 100);
-      for (double x = lo.x(); x <= hi.x(); x += step)
-        for (double y = lo.y(); y <= hi.y(); y += step)
-          for (double z = lo.z(); z <= hi.z(); z += step)
-            if (ra.contains(Vec3(x, y, z), 0) && rb.contains(Vec3(x, y, z), 0)) {
-              const bool nested =
-                  (rb.spacing < ra.spacing && lies_inside(rb, ra)) || (ra.spacing < rb.spacing && lies_inside(ra, rb));
-              if (nested) goto next_pair;
-              throw Error(fmt::format(
-                  "{}:{}: refine[{}] overlaps refine[{}] (line {}) at ({:.4g}, {:.4g}, {:.4g}): [[refine]] regions "
-                  "must not overlap unless one lies wholly inside the other with a finer spacing (join them into one)",
-                  scene.path, rb.line, b, a, ra.line, x, y, z));
-            }
-    next_pair:;
+      const std::optional<Vec3> p = common_point(ra, rb);
+      if (!p) continue;
+      const bool nested =
+          (rb.spacing < ra.spacing && lies_inside(rb, ra)) || (ra.spacing < rb.spacing && lies_inside(ra, rb));
+      if (!nested)
+        throw Error(fmt::format(
+            "{}:{}: refine[{}] overlaps refine[{}] (line {}) at ({:.4g}, {:.4g}, {:.4g}): [[refine]] regions must "
+            "not overlap unless one lies wholly inside the other with a finer spacing (join them into one)",
+            scene.path, rb.line, b, a, ra.line, p->x(), p->y(), p->z()));
     }
 }
 

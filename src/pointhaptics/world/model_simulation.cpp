@@ -332,14 +332,14 @@ void ModelSimulation::place_tools() {
   for (PosedBody& o : posed_bodies_)
     if (!o.path.keyframes().empty() || o.jaw != 0)
       o.contact.set_pose(o.pose_at(state_.time + (solver_.kind == SolverKind::STATIC ? 0.0 : solver_.dt)));
-  // the first static solve starts with what presses already stuck (SurfaceContact::anchor_pressing): a body held by
+  // the first static solve starts with what presses already stuck (SurfaceContact::begin_static_solve): a body held by
   // tools' friction alone has no equilibrium in a first minimisation without it. Only the first: in a quasi-static
   // drag (a static solve per move of the tool) the vertices that came to press at a step's start stuck there, short
   // of their cone, and the sliding friction fell to 0.2857 of the pressure for mu = 0.3 (6.5% from mu at worst,
   // against 3.7% without; experiment contact --quick); they are anchored where they are at the first update instead
   if (solver_.kind == SolverKind::STATIC && diagnostics_.steps == 0) {
-    for (PosedBody& o : posed_bodies_) o.contact.contact().anchor_pressing(state_.u);
-    if (held_tool_) held_tool_->contact().anchor_pressing(state_.u);
+    for (PosedBody& o : posed_bodies_) o.contact.contact().begin_static_solve(state_.u);
+    if (held_tool_) held_tool_->contact().begin_static_solve(state_.u);
   }
   bool cutting = false;
   for (std::size_t k = 0; k < hands_.size(); ++k) cutting = place_hand(hands_[k], inputs_[k]) || cutting;
