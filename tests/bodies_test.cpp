@@ -57,6 +57,10 @@ material = {{ young = 2e5, density = 2000.0 }}
                      spacing, 0.02 + gap, spacing, solver, more);
 }
 
+// the two blocks under gravity on a table (friction 0.5)
+const std::string on_a_table =
+    "[[load]]\nkind = \"gravity\"\n[[obstacle]]\nname = \"table\"\nfriction = 0.5\nplane = { normal = [0.0, 1.0, 0.0] }";
+
 constexpr double lower_weight = 0.04 * 0.02 * 0.04 * 1000.0 * 9.81;  // N
 constexpr double upper_weight = 0.02 * 0.02 * 0.02 * 2000.0 * 9.81;  // N
 
@@ -258,11 +262,9 @@ TEST(Bodies, AFreeCollisionConservesMomentum) {
 // the lower block on a table, the upper on it, under gravity, run to rest: the upper block carried by the lower,
 // the table carrying both, the bodies apart by at most a hundredth of the spacing; the result has a block per body
 TEST(Bodies, ABlockOnABlockOnATableEachCarriesWhatIsAboveIt) {
-  SceneSession s = open_scene(parse_scene(two_blocks(0.0, "kind = \"implicit\"\ndt = 2e-3\nduration = 0.5",
-                                                     "[[load]]\nkind = \"gravity\"\n[[obstacle]]\nname = \"table\"\n"
-                                                     "friction = 0.5\nplane = { normal = [0.0, 1.0, 0.0] }"),
-                                          "scene.toml"),
-                              two_threads());
+  SceneSession s = open_scene(
+      parse_scene(two_blocks(0.0, "kind = \"implicit\"\ndt = 2e-3\nduration = 0.5", on_a_table), "scene.toml"),
+      two_threads());
   s.simulation->run(0.5);
   const RunSummary summary = s.simulation->summary();
   ASSERT_TRUE(summary.converged) << summary.failure;
@@ -288,13 +290,9 @@ TEST(Bodies, ABlockOnABlockOnATableEachCarriesWhatIsAboveIt) {
 // solve's first tangent counts them as pressing (SurfaceContact's kink tangent); without it the stack had no
 // vertical stiffness in the first Newton iteration, its CG diverged and the solve found no equilibrium at all
 TEST(Bodies, TwoFreeBlocksStackedOnATableSolveStatically) {
-  SceneSession s =
-      open_scene(parse_scene(two_blocks(0.0, "kind = \"static\"",
-                                        "[contact]\nfriction = 0.5\n[[load]]\nkind = \"gravity\"\n"
-                                        "[[obstacle]]\nname = \"table\"\nfriction = 0.5\nplane = { normal = "
-                                        "[0.0, 1.0, 0.0] }"),
-                             "scene.toml"),
-                 two_threads());
+  SceneSession s = open_scene(
+      parse_scene(two_blocks(0.0, "kind = \"static\"", "[contact]\nfriction = 0.5\n" + on_a_table), "scene.toml"),
+      two_threads());
   s.simulation->run(0);
   const RunSummary summary = s.simulation->summary();
   ASSERT_TRUE(summary.converged) << summary.failure;
