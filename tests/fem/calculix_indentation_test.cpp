@@ -80,5 +80,64 @@ TEST(CalculixIndentationRun, ShallowIndentationOfAThickBlockIsHertzs) {
   EXPECT_NEAR(s.curve[0].force / s.curve[1].force, std::pow(0.5, 1.5), 0.015);
 }
 
+TEST(CalculixSphereOnPlaneDeck, HasTheSphereThePlaneTheContactTheCapAndTheCentre) {
+  SphereOnPlaneProblem p;
+  p.material.model = MaterialModel::NEO_HOOKEAN;
+  p.material.young = 1e5;
+  p.material.poisson = 0.3;
+  p.elements_per_radius = 20;
+  int nodes = 0, elements = 0;
+  const std::string deck = write_sphere_on_plane_inp(p, &nodes, &elements);
+  EXPECT_EQ(count(deck, std::regex("\\*ELEMENT, TYPE=CAX8")), 2);
+  EXPECT_NE(deck.find("*CONTACT PAIR, INTERACTION=FRICTIONLESS, TYPE=SURFACE TO SURFACE\nSBALL, SPLANE"),
+            std::string::npos);
+  EXPECT_NE(deck.find("NMOVE, 2, 2, -0.0006"), std::string::npos);
+  EXPECT_NE(deck.find("*NODE PRINT, NSET=NCENTRE\nU"), std::string::npos);
+  // one node at the centre, and the sphere's surface faces near the plane listed
+  const std::size_t centre = deck.find("*NSET, NSET=NCENTRE\n");
+  ASSERT_NE(centre, std::string::npos);
+  EXPECT_TRUE(std::regex_search(deck.substr(centre), std::regex("^\\*NSET, NSET=NCENTRE\\n\\d+,\\n\\*NSET")));
+  EXPECT_GT(count(deck, std::regex("\\n\\d+, S\\d\\n")), 10);
+  p.elements_per_radius = 40;
+  int finer_elements = 0;
+  write_sphere_on_plane_inp(p, nullptr, &finer_elements);
+  EXPECT_GT(finer_elements, 2 * elements);
+  p.max_travel = 0.003;  // past R/4
+  EXPECT_THROW(write_sphere_on_plane_inp(p), Error);
+  p = SphereOnPlaneProblem{};
+  p.cap_from = -0.001;  // not in the upper half
+  EXPECT_THROW(write_sphere_on_plane_inp(p), Error);
+}
+
+TEST(CalculixSphereOnPlaneRun, ASmallPressIsNearHertzsAndTheForceGrowsAsTheTravelToThreeHalves) {
+  // Hertz's sphere on a rigid plane: F = 4/3 E/(1 - nu^2) sqrt(R) d^1.5, d the centre's travel. Measured with this
+  // deck at R/20, R/40 and R/80 (agreeing within 0.3%): neo-Hookean, 1.053 and 1.080 of Hertz at d = 0.0095 R and
+  // 0.0185 R, growing to 1.14 at 0.044 R (the contact's strains are finite; St. Venant-Kirchhoff, which softens in
+  // compression, gives 1.013 and 1.019)
+  SphereOnPlaneProblem p;
+  p.material.model = MaterialModel::NEO_HOOKEAN;
+  p.material.young = 1e5;
+  p.material.poisson = 0.3;
+  p.max_travel = 0.0002;
+  p.increments = 2;
+  p.elements_per_radius = 20;
+  const SphereOnPlaneSolution s = solve_sphere_on_plane(p, 2);
+  ASSERT_EQ(s.curve.size(), 2u);
+  for (const SphereOnPlanePoint& point : s.curve) {
+    // the centre travels less than the cap (the sphere between them is compressed), but not much less
+    EXPECT_LT(point.centre_travel, point.cap_travel);
+    EXPECT_GT(point.centre_travel, 0.85 * point.cap_travel);
+    const double hertz = 4.0 / 3.0 * 1e5 / (1 - 0.09) * std::sqrt(0.01) * std::pow(point.centre_travel, 1.5);
+    EXPECT_GT(point.force / hertz, 1.02);
+    EXPECT_LT(point.force / hertz, 1.10);
+  }
+  EXPECT_NEAR(s.curve[1].cap_travel, 0.0002, 1e-12);
+  EXPECT_NEAR(s.curve[1].force / s.curve[0].force, std::pow(s.curve[1].centre_travel / s.curve[0].centre_travel, 1.5),
+              0.05 * s.curve[1].force / s.curve[0].force);
+  EXPECT_DOUBLE_EQ(s.force_at_cap(0.0002), s.curve[1].force);
+  EXPECT_NEAR(s.force_at_cap(0.00015), 0.5 * (s.curve[0].force + s.curve[1].force), 1e-12);
+  EXPECT_THROW(s.force_at_cap(0.00021), Error);
+}
+
 }  // namespace
 }  // namespace pointhaptics::fem

@@ -226,6 +226,24 @@ TEST(CalculixDat, ReadsTheReactionTotalsOfEachIncrement) {
   EXPECT_THROW(read_dat_totals(bad, "NMOVE1", "job.dat"), Error);
 }
 
+TEST(CalculixDat, ReadsOneSetsDisplacementAtEveryIncrement) {
+  std::istringstream dat(
+      " displacements (vx,vy,vz) for set NCENTRE and time  0.5000000E+00\n\n"
+      "       247  0.000000E+00 -2.500000E-04  0.000000E+00\n\n"
+      " displacements (vx,vy,vz) for set NOTHIS and time  0.5000000E+00\n\n        9 9 9 9\n"
+      " displacements (vx,vy,vz) for set NCENTRE and time  0.1000000E+01\n\n"
+      "       247  1.000000E-06 -5.000000E-04  0.000000E+00\n");
+  const auto u = read_dat_set_displacements(dat, "NCENTRE", "job.dat");
+  ASSERT_EQ(u.size(), 2u);
+  EXPECT_DOUBLE_EQ(u[0].first, 0.5);
+  EXPECT_DOUBLE_EQ(u[0].second.y(), -2.5e-4);
+  EXPECT_DOUBLE_EQ(u[1].second.x(), 1e-6);
+  std::istringstream bad(" displacements (vx,vy,vz) for set NCENTRE and time  0.5\n\n   247 1.0 nan-ish 0\n");
+  EXPECT_THROW(read_dat_set_displacements(bad, "NCENTRE", "job.dat"), Error);
+  std::istringstream short_line(" displacements (vx,vy,vz) for set NCENTRE and time  0.5\n\n   247 1.0\n");
+  EXPECT_THROW(read_dat_set_displacements(short_line, "NCENTRE", "job.dat"), Error);
+}
+
 // ccx is installed by scripts/setup (Debian calculix-ccx); its absence is a failure here, not a skip
 TEST(CalculixRun, CantileverMatchesTheReferenceValues) {
   // linear, 20 x 4 x 4 C3D20R: within ~0.4% of the converged 1.6795 mm at the tip-face centre node

@@ -361,6 +361,40 @@ std::vector<Reaction> read_dat_totals(std::istream& dat, const std::string& set,
   return out;
 }
 
+std::vector<std::pair<double, Vec3>> read_dat_set_displacements(std::istream& dat, const std::string& set,
+                                                                const std::string& source) {
+  std::vector<std::pair<double, Vec3>> out;
+  std::string line;
+  long long line_no = 0;
+  const std::string key = "displacements (vx,vy,vz) for set " + set + " and time";
+  while (std::getline(dat, line)) {
+    ++line_no;
+    const size_t at = line.find(key);
+    if (at == std::string::npos) continue;
+    char* end = nullptr;
+    const std::string time = line.substr(at + key.size());
+    const double t = std::strtod(time.c_str(), &end);
+    if (end == time.c_str()) throw Error(fmt::format("{}:{}: no time in \"{}\"", source, line_no, line));
+    while (std::getline(dat, line)) {  // the node's line follows after a blank line
+      ++line_no;
+      if (line.find_first_not_of(" \t\r") != std::string::npos) break;
+    }
+    std::istringstream in(line);
+    std::string tokens[4];
+    Vec3 u;
+    for (int a = 0; a < 4; ++a) {
+      if (!(in >> tokens[a]))
+        throw Error(fmt::format("{}:{}: malformed displacement line \"{}\"", source, line_no, line));
+      if (a == 0) continue;
+      u[a - 1] = std::strtod(tokens[a].c_str(), &end);
+      if (end == tokens[a].c_str() || !std::isfinite(u[a - 1]))
+        throw Error(fmt::format("{}:{}: malformed displacement line \"{}\"", source, line_no, line));
+    }
+    out.emplace_back(t, u);
+  }
+  return out;
+}
+
 void set_material(BoxProblem& problem, const MaterialParams& material) {
   problem.young = material.young;
   problem.poisson = material.poisson;

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <iosfwd>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace pointhaptics::fem {
@@ -119,6 +120,10 @@ Points read_dat_displacements(std::istream& dat, index_t n_nodes, const std::str
 /// The "total force" blocks of *NODE PRINT, TOTALS=ONLY for the set named `set` (upper case), in file order.
 /// Throws Error naming `source` on a malformed block.
 std::vector<Reaction> read_dat_totals(std::istream& dat, const std::string& set, const std::string& source);
+/// The displacement of the first node of the set named `set` (upper case) in every "displacements" block of *NODE
+/// PRINT for that set, with its step time, in file order. Throws Error naming `source` on a malformed block.
+std::vector<std::pair<double, Vec3>> read_dat_set_displacements(std::istream& dat, const std::string& set,
+                                                                const std::string& source);
 /// *MATERIAL, NAME=name with the problem's constitutive card and density (13 significant digits: they fit ccx's
 /// 20-character fields).
 std::string material_card(const std::string& name, const BoxProblem& problem);
