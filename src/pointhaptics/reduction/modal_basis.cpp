@@ -1,0 +1,229 @@
+#include <pointhaptics/reduction/modal_basis.hpp>
+
+#include <pointhaptics/core/error.hpp>
+#include <pointhaptics/core/run_control.hpp>
+#include <pointhaptics/mechanics/tangent.hpp>
+#include <pointhaptics/mechanics/tangent_matrix.hpp>
+#include <pointhaptics/solvers/sparse_cholesky.hpp>
+
+#include <Spectra/SymGEigsShiftSolver.h>
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace pointhaptics {
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+Eigen::Map<const Eigen::VectorXd> flat(const Points& p) { return {p.data(), p.size()}; }
+
+/// (K - sigma M)^-1 on the free degrees of freedom through the rest tangent's factor (sigma is always 0 here:
+/// the lowest modes of a held object), as Spectra's shift-invert mode wants it.
+class InverseTangent {
+ public:
+  using Scalar = double;
+  InverseTangent(const Model& model, SparseCholesky& factor, const std::vector<index_t>& free_points)
+      : factor_(factor), free_(free_points), r_(Points::Zero(3, model.n_points)), z_(3, model.n_points) {}
+  Eigen::Index rows() const { return 3 * static_cast<Eigen::Index>(free_.size()); }
+  Eigen::Index cols() const { return rows(); }
+  void set_shift(double sigma) {
+    if (sigma != 0) throw Error("modal basis: only a shift of zero is factorised (a bug)");
+  }
+  void perform_op(const double* x, double* y) {
+    throw_if_stop_requested("modal basis (the vibration modes)");
+    for (std::size_t k = 0; k < free_.size(); ++k)
+      for (int a = 0; a < 3; ++a) r_(a, free_[k]) = x[3 * k + a];
+    factor_.solve(r_, z_);
+    for (std::size_t k = 0; k < free_.size(); ++k)
+      for (int a = 0; a < 3; ++a) y[3 * k + a] = z_(a, free_[k]);
+    ++solves;
+  }
+  int solves = 0;
+
+ private:
+  SparseCholesky& factor_;
+  const std::vector<index_t>& free_;
+  Points r_, z_;
+};
+
+/// The lumped mass matrix on the free degrees of freedom.
+class FreeMass {
+ public:
+  using Scalar = double;
+  FreeMass(const Model& model, const std::vector<index_t>& free_points) : mass_(3 * free_points.size()) {
+    for (std::size_t k = 0; k < free_points.size(); ++k)
+      mass_.segment<3>(3 * k).setConstant(model.mass[free_points[k]]);
+  }
+  Eigen::Index rows() const { return mass_.size(); }
+  Eigen::Index cols() const { return mass_.size(); }
+  void perform_op(const double* x, double* y) const {
+    for (Eigen::Index k = 0; k < mass_.size(); ++k) y[k] = mass_[k] * x[k];
+  }
+
+ private:
+  Eigen::VectorXd mass_;
+};
+
+}  // namespace
+
+Points displacement_of(const Eigen::MatrixXd& U, const Eigen::VectorXd& q, index_t n_points) {
+  Points u(3, n_points);
+  Eigen::Map<Eigen::VectorXd>(u.data(), u.size()).noalias() = U * q;
+  return u;
+}
+
+ModalBasis build_modal_basis(const Model& model, const ModalBasisSettings& settings, Workspace& ws) {
+  const auto start = std::chrono::steady_clock::now();
+  const int r = settings.size;
+  std::vector<index_t> free_points;
+  for (index_t i = 0; i < model.n_points; ++i)
+    if (!model.fixed[static_cast<std::size_t>(i)]) free_points.push_back(i);
+  const Eigen::Index n_free = 3 * static_cast<Eigen::Index>(free_points.size());
+  if (r < 1) throw Error(fmt::format("reduction.modes: {} must be at least 1", r));
+  if (free_points.size() == static_cast<std::size_t>(model.n_points))
+    throw Error(
+        "reduction: nothing is held ([[fixed]]): a free object's rest tangent is singular, and its rigid "
+        "motions are not in a modal basis");
+  if (n_free < r + 2)
+    throw Error(
+        fmt::format("reduction.modes: {} basis vectors asked for, but the object has only {} free degrees of "
+                    "freedom",
+                    r, n_free));
+  int m = settings.linear_modes;
+  if (m <= 0)
+    for (m = 1; m + m * (m + 1) / 2 < static_cast<int>(std::ceil(1.3 * r));) ++m;
+  m = static_cast<int>(std::min<Eigen::Index>(m, n_free - 2));
+
+  ModalBasis basis;
+  // the rest tangent, assembled and factorised once
+  Tangent tangent;
+  const Points rest = Points::Zero(3, model.n_points);
+  tangent.linearise(model, rest, TangentMode::EXACT, &ws);
+  TangentMatrix K;
+  assemble_tangent(model, tangent, K, &ws);
+  SparseCholesky factor;
+  factor.analyse(model, K);
+  if (!factor.factorise(K))
+    throw Error(
+        "reduction: the rest tangent is not positive definite over the free points (is every part of the "
+        "object held?)");
+  basis.factor_bytes = factor.stats().factor_bytes;
+  basis.factorise_s = seconds_since(start);
+
+  // the lowest modes: K phi = omega^2 M phi, shift-invert about zero
+  const auto modes_start = std::chrono::steady_clock::now();
+  InverseTangent inverse(model, factor, free_points);
+  FreeMass mass(model, free_points);
+  const Eigen::Index ncv = std::min<Eigen::Index>(n_free, std::max(2 * m + 1, m + 20));
+  Spectra::SymGEigsShiftSolver<InverseTangent, FreeMass, Spectra::GEigsMode::ShiftInvert> eigen(inverse, mass, m, ncv,
+                                                                                                0.0);
+  eigen.init();
+  const Eigen::Index converged = eigen.compute(Spectra::SortRule::LargestMagn, 1000, 1e-10);
+  if (eigen.info() != Spectra::CompInfo::Successful)
+    throw Error(
+        fmt::format("reduction: the eigen-solver converged on {} of the {} lowest vibration modes", converged, m));
+  // ascending (Spectra gives them back transformed from 1 / omega^2, highest first)
+  const Eigen::VectorXd values = eigen.eigenvalues();
+  const Eigen::MatrixXd vectors = eigen.eigenvectors();  // M-orthonormal on the free dofs
+  std::vector<Eigen::Index> order(static_cast<std::size_t>(values.size()));
+  for (Eigen::Index k = 0; k < values.size(); ++k) order[static_cast<std::size_t>(k)] = k;
+  std::sort(order.begin(), order.end(), [&](Eigen::Index a, Eigen::Index b) { return values[a] < values[b]; });
+  basis.eigenvalues.resize(values.size());
+  Eigen::MatrixXd phi_free(vectors.rows(), vectors.cols());
+  for (Eigen::Index k = 0; k < values.size(); ++k) {
+    basis.eigenvalues[k] = values[order[static_cast<std::size_t>(k)]];
+    phi_free.col(k) = vectors.col(order[static_cast<std::size_t>(k)]);
+  }
+  basis.linear_modes = m;
+  basis.modes_s = seconds_since(modes_start);
+
+  // candidates in the full layout: modes, derivatives, load responses
+  const auto scatter = [&](const Eigen::VectorXd& free, Points& out) {
+    out.setZero(3, model.n_points);
+    for (std::size_t k = 0; k < free_points.size(); ++k)
+      out.col(free_points[k]) = free.segment<3>(3 * static_cast<Eigen::Index>(k));
+  };
+  const int n_derivatives = m * (m + 1) / 2;
+  const int n_loads = static_cast<int>(settings.loads.size());
+  Eigen::MatrixXd candidates(3 * model.n_points, m + n_derivatives + n_loads);
+  std::vector<double> weights;  // the principal components' weights (Barbic & James: modes by omega_1^2 / omega_i^2)
+  const double lowest = basis.eigenvalues[0];
+  std::vector<Points> phi(static_cast<std::size_t>(m));
+  for (int i = 0; i < m; ++i) {
+    scatter(phi_free.col(i), phi[static_cast<std::size_t>(i)]);
+    candidates.col(i) = flat(phi[static_cast<std::size_t>(i)]);
+    weights.push_back(lowest / basis.eigenvalues[i]);
+  }
+
+  // modal derivatives: K Psi_ij = -H(phi_i, phi_j), H(a, b) = d/de [K(e b) a] at e = 0 by central differences
+  const auto derivatives_start = std::chrono::steady_clock::now();
+  Points plus(3, model.n_points), minus(3, model.n_points), rhs(3, model.n_points), psi(3, model.n_points);
+  Tangent at_plus, at_minus;
+  int column = m;
+  for (int j = 0; j < m; ++j) {
+    throw_if_stop_requested("modal basis (the modal derivatives)");
+    const Points& b = phi[static_cast<std::size_t>(j)];
+    // a step small against the mode's size but far above round-off: the tangent is quadratic in u, so the
+    // central difference is exact up to it
+    const double step = 1e-3 * model.spacing / std::max(b.cwiseAbs().maxCoeff(), 1e-300);
+    at_plus.linearise(model, step * b, TangentMode::EXACT, &ws);
+    at_minus.linearise(model, -step * b, TangentMode::EXACT, &ws);
+    for (int i = 0; i <= j; ++i) {
+      const Points& a = phi[static_cast<std::size_t>(i)];
+      at_plus.apply(model, a, ws, plus);
+      at_minus.apply(model, a, ws, minus);
+      rhs = -(plus - minus) / (2 * step);
+      for (index_t p = 0; p < model.n_points; ++p)
+        if (model.fixed[static_cast<std::size_t>(p)]) rhs.col(p).setZero();
+      factor.solve(rhs, psi);
+      candidates.col(column++) = flat(psi);
+      weights.push_back(lowest * lowest / (basis.eigenvalues[i] * basis.eigenvalues[j]));
+    }
+  }
+  basis.derivatives = n_derivatives;
+  basis.derivatives_s = seconds_since(derivatives_start);
+  // static responses to the dead loads, weighted above every mode so that they are kept whole
+  for (const Points& load : settings.loads) {
+    rhs = load;
+    for (index_t p = 0; p < model.n_points; ++p)
+      if (model.fixed[static_cast<std::size_t>(p)]) rhs.col(p).setZero();
+    factor.solve(rhs, psi);
+    candidates.col(column++) = flat(psi);
+    weights.push_back(10.0);
+  }
+  basis.load_vectors = n_loads;
+
+  // mass-weighted principal components: the candidates made mass-unit and weighted, then the leading left
+  // singular vectors of M^1/2 V, mapped back by M^-1/2 (mass-orthonormal)
+  Eigen::VectorXd sqrt_mass(3 * model.n_points);
+  for (index_t p = 0; p < model.n_points; ++p) {
+    if (!(model.mass[p] > 0) && !model.fixed[static_cast<std::size_t>(p)])
+      throw Error(
+          fmt::format("reduction: point {} has no mass (a mass-orthonormal basis needs every free point's)", p));
+    sqrt_mass.segment<3>(3 * p).setConstant(model.mass[p] > 0 ? std::sqrt(model.mass[p]) : 1.0);
+  }
+  Eigen::MatrixXd weighted = sqrt_mass.asDiagonal() * candidates;
+  for (Eigen::Index k = 0; k < weighted.cols(); ++k) {
+    const double norm = weighted.col(k).norm();
+    if (norm > 0) weighted.col(k) *= weights[static_cast<std::size_t>(k)] / norm;
+  }
+  Eigen::BDCSVD<Eigen::MatrixXd> svd(weighted, Eigen::ComputeThinU);
+  const int kept = static_cast<int>(std::min<Eigen::Index>(r, svd.rank()));
+  if (kept < r)
+    throw Error(
+        fmt::format("reduction.modes: only {} independent basis vectors came out of {} modes and their "
+                    "derivatives (ask for fewer, or for more linear_modes)",
+                    kept, m));
+  basis.U = sqrt_mass.cwiseInverse().asDiagonal() * svd.matrixU().leftCols(r);
+  for (index_t p = 0; p < model.n_points; ++p)
+    if (model.fixed[static_cast<std::size_t>(p)]) basis.U.middleRows<3>(3 * p).setZero();
+  basis.total_s = seconds_since(start);
+  return basis;
+}
+
+}  // namespace pointhaptics
