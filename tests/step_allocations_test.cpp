@@ -2,6 +2,10 @@
 // them), for every solver kind. The program replaces malloc to count allocations.
 #include <pointhaptics/pointhaptics.hpp>
 
+#include <pointhaptics/reduction/modal_basis.hpp>
+#include <pointhaptics/reduction/reduced_integrator.hpp>
+
+#include "support/test_models.hpp"
 #include "support/test_scenes.hpp"
 
 #include <gtest/gtest.h>
@@ -111,6 +115,35 @@ INSTANTIATE_TEST_SUITE_P(Solvers, StepTest,
                                            "implicit_viscoelastic", "static_viscoelastic", "implicit_cholesky",
                                            "implicit_two_level"),
                          [](const auto& info) { return info.param; });
+
+// a reduced step (issue 49): the polynomial's products and Newton in r unknowns, all on kept scratch
+TEST(ReducedStep, AllocatesNothing) {
+  MaterialParams m;
+  m.young = 1e5;
+  m.poisson = 0.3;
+  Model model = build_model(test::jittered_box(10, 3, 3, 0.01, 0.1), m, KernelParams{});
+  for (index_t i = 0; i < model.n_points; ++i) model.fixed[static_cast<std::size_t>(i)] = model.X(0, i) < 0.005;
+  model.f_ext.setZero(3, model.n_points);
+  model.f_ext.row(1).setConstant(-1e-3);
+  Workspace ws(model, 2);
+  ModalBasisSettings settings;
+  settings.size = 8;
+  const ModalBasis basis = build_modal_basis(model, settings, ws);
+  const SvkPolynomial polynomial(model, basis.U, ws);
+  ReducedIntegrator integrator(
+      polynomial, basis.U.transpose() * Eigen::Map<const Eigen::VectorXd>(model.f_ext.data(), model.f_ext.size()), 5.0);
+  ReducedState state{Eigen::VectorXd::Zero(8), Eigen::VectorXd::Zero(8)};
+  ASSERT_TRUE(integrator.step(state, 1e-3).converged);
+  const long long before = allocations.load();
+  int converged = 0;
+  for (int k = 0; k < 20; ++k) converged += integrator.step(state, 1e-3).converged;
+  const long long made = allocations.load() - before;
+  EXPECT_EQ(converged, 20);
+  if (PH_COUNTS_ALLOCATIONS) {
+    EXPECT_EQ(made, 0) << "allocations in 20 reduced steps";
+  }
+  EXPECT_GT(state.q.norm(), 0);
+}
 
 }  // namespace
 }  // namespace pointhaptics

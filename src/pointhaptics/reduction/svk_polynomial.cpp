@@ -171,7 +171,11 @@ void SvkPolynomial::contract(const Eigen::VectorXd& q) const {
 
 double SvkPolynomial::energy(const Eigen::VectorXd& q) const {
   contract(q);
-  return q.dot(0.5 * (A_ * q) + (1.0 / 6.0) * (B_ * q) + (1.0 / 24.0) * (C_ * q));
+  // through kept scratch: a product inside a dot would allocate its temporary
+  bq_.head(r_).noalias() = A_ * q;
+  bq_.head(r_).noalias() += (1.0 / 3.0) * (B_ * q);
+  bq_.head(r_).noalias() += (1.0 / 12.0) * (C_ * q);
+  return 0.5 * q.dot(bq_.head(r_));
 }
 
 void SvkPolynomial::evaluate(const Eigen::VectorXd& q, Eigen::VectorXd& gradient, Eigen::MatrixXd* hessian) const {

@@ -1,0 +1,50 @@
+#pragma once
+/// @file Steps and static solves in the reduced coordinates (issue 49): full Newton in r unknowns on the reduced
+/// energy (svk_polynomial.hpp), the same backward Euler as the full implicit solver (solvers/implicit_solver.hpp)
+/// with the basis' unit mass (U^T M U = I):
+///   q' minimises W(q') - f . q' + |q' - q - dt v|^2 / (2 dt^2) + c |q' - q|^2 / (2 dt),   v' = (q' - q) / dt,
+/// whose Hessian is K(q') + (1 / dt^2 + c / dt) I. A static solve minimises W(q) - f . q, in load steps when
+/// one Newton solve does not converge. No allocation after construction.
+#include <pointhaptics/reduction/svk_polynomial.hpp>
+
+namespace pointhaptics {
+
+struct ReducedState {
+  Eigen::VectorXd q, v;  ///< coordinates and their rates
+};
+
+struct ReducedSolveReport {
+  bool converged = false;
+  int iterations = 0;       ///< Newton's
+  double residual = 0;      ///< |gradient of what is minimised| at the end, in the basis' units
+  double load_reached = 1;  ///< a static solve's share of its load (1 when converged)
+};
+
+class ReducedIntegrator {
+ public:
+  /// `external`: U^T f of the dead loads (gravity, tractions); `damping`: mass-proportional, 1/s.
+  ReducedIntegrator(const SvkPolynomial& forces, Eigen::VectorXd external, double damping);
+  const Eigen::VectorXd& external() const { return external_; }
+  /// One backward Euler step of dt. Newton stops at a residual below `tolerance` times the load's size (or the
+  /// inertia's, whichever is larger) or after `max_iterations`; a step that does not converge leaves `state` as
+  /// it was.
+  ReducedSolveReport step(ReducedState& state, double dt, double tolerance = 1e-9, int max_iterations = 20);
+  /// The equilibrium W'(q) = load_scale f, from q (its start, and its answer).
+  ReducedSolveReport solve_static(Eigen::VectorXd& q, double tolerance = 1e-10, int max_iterations = 50);
+
+ private:
+  /// Newton on phi(x) = W(x) - f . x + inertia |x - anchor|^2 / 2 with a backtracking line search, from x.
+  ReducedSolveReport minimise(Eigen::VectorXd& x, const Eigen::VectorXd& force, double inertia,
+                              const Eigen::VectorXd& anchor, double tolerance, int max_iterations);
+  double objective(const Eigen::VectorXd& x, const Eigen::VectorXd& force, double inertia,
+                   const Eigen::VectorXd& anchor) const;
+  const SvkPolynomial& forces_;
+  Eigen::VectorXd external_;
+  double damping_;
+  // scratch
+  Eigen::VectorXd gradient_, direction_, trial_, anchor_, scaled_force_, start_;
+  Eigen::MatrixXd hessian_;
+  Eigen::LLT<Eigen::MatrixXd> llt_;
+};
+
+}  // namespace pointhaptics
