@@ -19,6 +19,8 @@
 #include <pointhaptics/world/simulation.hpp>
 #include <pointhaptics/solvers/explicit_solver.hpp>
 #include <pointhaptics/solvers/sparse_cholesky.hpp>
+#include <pointhaptics/reduction/modal_basis.hpp>
+#include <pointhaptics/reduction/reduced_integrator.hpp>
 
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
@@ -234,6 +236,63 @@ void beam_benchmark(benchmark::State& state) {
   state.counters["threads"] = threads;
   state.counters["compute_s_per_simulated_s"] = benchmark::Counter(
       static_cast<double>(state.iterations()) * simulated, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+// the 4 x 1 x 1 beam as a reduced model (issue 49): r = range(0) modes and derivatives, svk's polynomial, on 2
+// threads; range(1): Newton iterations per step in real time (0: each step converged to 1e-9). Counters: the set-up (basis: factor, modes, derivatives; the polynomial's tables), the tables' memory,
+// and the reduced static sag at the free end; the timed loop is one backward Euler step at dt = 1 ms (one Newton
+// solve in r unknowns), the Vega comparison's "step"
+void reduced_beam_benchmark(benchmark::State& state) {
+  const int r = static_cast<int>(state.range(0)), budget = static_cast<int>(state.range(1));
+  const Scene scene = beam_4x1x1(SolverKind::IMPLICIT);
+  const Model model = build_scene_model(scene);
+  Workspace ws(model, 2);
+  ModalBasisSettings settings;
+  settings.size = r;
+  settings.loads = {model.f_ext};
+  const ModalBasis basis = build_modal_basis(model, settings, ws);
+  const SvkPolynomial polynomial(model, basis.U, ws);
+  ReducedIntegrator integrator(
+      polynomial, basis.U.transpose() * Eigen::Map<const Eigen::VectorXd>(model.f_ext.data(), model.f_ext.size()),
+      model.material.damping);
+  Eigen::VectorXd sag = Eigen::VectorXd::Zero(r);
+  integrator.solve_static(sag);
+  const Points u = displacement_of(basis.U, sag, model.n_points);
+  double tip = 0;
+  int n_tip = 0;
+  for (index_t i = 0; i < model.n_points; ++i)
+    if (model.X(0, i) > 4.0 - 1e-6) {
+      tip += u(1, i);
+      ++n_tip;
+    }
+  // the first 0.2 s of the sag from rest, again and again: every step moves (a beam at rest would need no Newton
+  // iteration at all)
+  ReducedState reduced{Eigen::VectorXd::Zero(r), Eigen::VectorXd::Zero(r)};
+  long long newton = 0, steps = 0;
+  for (auto _ : state) {
+    if (steps % 200 == 0) {
+      reduced.q.setZero();
+      reduced.v.setZero();
+    }
+    const ReducedSolveReport report =
+        budget > 0 ? integrator.step(reduced, 1e-3, 1e-9, budget, true) : integrator.step(reduced, 1e-3);
+    newton += report.iterations;
+    ++steps;
+    benchmark::DoNotOptimize(reduced.q.data());
+  }
+  state.counters["points"] = model.n_points;
+  state.counters["modes"] = r;
+  state.counters["linear_modes"] = basis.linear_modes;
+  state.counters["basis_s"] = basis.total_s;
+  state.counters["factorise_s"] = basis.factorise_s;
+  state.counters["eigen_s"] = basis.modes_s;
+  state.counters["derivatives_s"] = basis.derivatives_s;
+  state.counters["polynomial_s"] = polynomial.build_s();
+  state.counters["setup_s"] = basis.total_s + polynomial.build_s();
+  state.counters["factor_mb"] = basis.factor_bytes / 1e6;
+  state.counters["tables_mb"] = polynomial.bytes() / 1e6;
+  state.counters["static_tip_sag_m"] = -tip / n_tip;
+  state.counters["newton_per_step"] = static_cast<double>(newton) / static_cast<double>(std::max(steps, 1LL));
 }
 
 // the seed's cantilever, 0.15 x 0.03 x 0.03 m, clamped at x = 0 (nu = 0.4, 1000 kg/m^3, damping 20 / s)
@@ -615,6 +674,15 @@ int run_bench_suite(const BenchOptions& options) {
           ->Args({solver, t})
           ->Unit(benchmark::kMillisecond)
           ->Iterations(1)
+          ->UseRealTime();
+  for (int r : {20, 40})
+    for (int budget : {0, 1})
+      benchmark::RegisterBenchmark(
+          fmt::format("reduced_beam4x1x1/modes:{}/{}/threads:2", r, budget ? "newton:1" : "converged").c_str(),
+          reduced_beam_benchmark)
+          ->Args({r, budget})
+          ->Unit(benchmark::kMicrosecond)
+          ->MinTime(options.min_time)
           ->UseRealTime();
   for (int variant = 0; variant < static_cast<int>(stream_variants.size()); ++variant)
     for (int hourglass : {1, 0})

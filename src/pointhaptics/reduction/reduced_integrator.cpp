@@ -15,32 +15,41 @@ ReducedIntegrator::ReducedIntegrator(const SvkPolynomial& forces, Eigen::VectorX
   anchor_.resize(r);
   scaled_force_.resize(r);
   start_.resize(r);
+  iterate_.resize(r);
   hessian_.resize(r, r);
   llt_ = Eigen::LLT<Eigen::MatrixXd>(r);
 }
 
-double ReducedIntegrator::objective(const Eigen::VectorXd& x, const Eigen::VectorXd& force, double inertia,
-                                    const Eigen::VectorXd& anchor) const {
-  return forces_.energy(x) - force.dot(x) + 0.5 * inertia * (x - anchor).squaredNorm();
-}
-
 ReducedSolveReport ReducedIntegrator::minimise(Eigen::VectorXd& x, const Eigen::VectorXd& force, double inertia,
-                                               const Eigen::VectorXd& anchor, double tolerance, int max_iterations) {
+                                               const Eigen::VectorXd& anchor, double tolerance, int max_iterations,
+                                               bool stop_at_budget) {
   ReducedSolveReport report;
   // the residual's scale: the load, or what the rest stiffness makes of the current coordinates, or inertia's
   trial_.noalias() = forces_.rest_stiffness() * x;
   const double scale = std::max({force.norm(), trial_.norm(), inertia * (x - anchor).norm(), 1e-300});
-  for (report.iterations = 0; report.iterations <= max_iterations; ++report.iterations) {
-    forces_.evaluate(x, gradient_, &hessian_);
+  // Newton with backtracking (Armijo) on the objective, which each evaluation gives with the gradient: a step is
+  // taken whole and halved only when the objective at its end says so, so a good step costs one evaluation
+  double before = 0, slope = 0, alpha = 1;
+  bool checking = false;  // the last step's end is to be checked against `before`
+  for (int evaluations = 0; evaluations < 4 * max_iterations + 30; ++evaluations) {
+    double energy = 0;
+    forces_.evaluate(x, gradient_, &hessian_, &energy);
+    const double value = energy - force.dot(x) + 0.5 * inertia * (x - anchor).squaredNorm();
+    if (!std::isfinite(value)) return report;
+    if (checking && value > before + 1e-4 * alpha * slope) {
+      if ((alpha *= 0.5) < 1e-9) return report;
+      x = start_ + alpha * direction_;
+      continue;
+    }
     gradient_ -= force;
     gradient_.noalias() += inertia * (x - anchor);
     report.residual = gradient_.norm();
-    if (!std::isfinite(report.residual)) return report;
     if (report.residual <= tolerance * scale) {
       report.converged = true;
       return report;
     }
-    if (report.iterations == max_iterations) break;
+    if (report.iterations == max_iterations) return report;
+    ++report.iterations;
     hessian_.diagonal().array() += inertia;
     llt_.compute(hessian_);
     if (llt_.info() != Eigen::Success) {
@@ -51,32 +60,33 @@ ReducedSolveReport ReducedIntegrator::minimise(Eigen::VectorXd& x, const Eigen::
     }
     direction_ = llt_.solve(gradient_);
     direction_ *= -1;
-    // backtracking on the objective (Armijo), Newton's full step first
-    const double before = objective(x, force, inertia, anchor), slope = gradient_.dot(direction_);
-    // near the answer the objective's change falls below its round-off: then Newton's full step is taken
-    const bool resolvable = -slope > 1e-11 * std::abs(before);
-    double alpha = 1;
-    trial_ = x + direction_;
-    for (int halving = 0; resolvable && halving < 30; ++halving) {
-      if (objective(trial_, force, inertia, anchor) <= before + 1e-4 * alpha * slope) break;
-      alpha *= 0.5;
-      trial_ = x + alpha * direction_;
+    before = value;
+    slope = gradient_.dot(direction_);
+    alpha = 1;
+    // near the answer the objective's change falls below its round-off: then Newton's step is not checked
+    checking = -slope > 1e-11 * std::abs(value);
+    start_ = x;
+    x += direction_;
+    if (stop_at_budget && report.iterations == max_iterations) {
+      report.at_budget = true;
+      return report;
     }
-    x = trial_;
   }
   return report;
 }
 
-ReducedSolveReport ReducedIntegrator::step(ReducedState& state, double dt, double tolerance, int max_iterations) {
+ReducedSolveReport ReducedIntegrator::step(ReducedState& state, double dt, double tolerance, int max_iterations,
+                                           bool accept_at_budget) {
   // q' minimises W - f.q' + (1/dt^2 + c/dt) |q' - a|^2 / 2 with a = q + dt v / (1 + c dt): the two quadratic terms
   // |q' - q - dt v|^2 / (2 dt^2) + c |q' - q|^2 / (2 dt) differ from it by a constant
   const double inertia = 1 / (dt * dt) + damping_ / dt;
   anchor_ = state.q + (dt / (1 + damping_ * dt)) * state.v;
-  start_ = state.q + dt * state.v;  // warm start
-  const ReducedSolveReport report = minimise(start_, external_, inertia, anchor_, tolerance, max_iterations);
-  if (!report.converged) return report;
-  state.v = (start_ - state.q) / dt;
-  state.q = start_;
+  iterate_ = state.q + dt * state.v;  // warm start
+  const ReducedSolveReport report =
+      minimise(iterate_, external_, inertia, anchor_, tolerance, max_iterations, accept_at_budget);
+  if (!report.converged && !report.at_budget) return report;
+  state.v = (iterate_ - state.q) / dt;
+  state.q = iterate_;
   return report;
 }
 
@@ -89,11 +99,11 @@ ReducedSolveReport ReducedIntegrator::solve_static(Eigen::VectorXd& q, double to
   while (reached < 1) {
     const double target = std::min(1.0, reached + share);
     scaled_force_ = target * external_;
-    start_ = q;
-    report = minimise(start_, scaled_force_, 0.0, anchor_, tolerance, max_iterations);
+    iterate_ = q;
+    report = minimise(iterate_, scaled_force_, 0.0, anchor_, tolerance, max_iterations);
     total += report.iterations;
     if (report.converged) {
-      q = start_;
+      q = iterate_;
       reached = target;
       share *= 2;
     } else if ((share *= 0.5) < 1e-4) {

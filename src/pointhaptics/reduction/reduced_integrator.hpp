@@ -18,6 +18,7 @@ struct ReducedSolveReport {
   int iterations = 0;       ///< Newton's
   double residual = 0;      ///< |gradient of what is minimised| at the end, in the basis' units
   double load_reached = 1;  ///< a static solve's share of its load (1 when converged)
+  bool at_budget = false;   ///< a real-time step ended by its iteration budget and kept its iterate
 };
 
 class ReducedIntegrator {
@@ -27,22 +28,23 @@ class ReducedIntegrator {
   const Eigen::VectorXd& external() const { return external_; }
   /// One backward Euler step of dt. Newton stops at a residual below `tolerance` times the load's size (or the
   /// inertia's, whichever is larger) or after `max_iterations`; a step that does not converge leaves `state` as
-  /// it was.
-  ReducedSolveReport step(ReducedState& state, double dt, double tolerance = 1e-9, int max_iterations = 20);
+  /// it was, unless `accept_at_budget` (real time, as the full implicit solver's iteration budget): then the
+  /// iterate after max_iterations Newton steps is taken without evaluating it again (at_budget in the report).
+  ReducedSolveReport step(ReducedState& state, double dt, double tolerance = 1e-9, int max_iterations = 20,
+                          bool accept_at_budget = false);
   /// The equilibrium W'(q) = load_scale f, from q (its start, and its answer).
   ReducedSolveReport solve_static(Eigen::VectorXd& q, double tolerance = 1e-10, int max_iterations = 50);
 
  private:
   /// Newton on phi(x) = W(x) - f . x + inertia |x - anchor|^2 / 2 with a backtracking line search, from x.
   ReducedSolveReport minimise(Eigen::VectorXd& x, const Eigen::VectorXd& force, double inertia,
-                              const Eigen::VectorXd& anchor, double tolerance, int max_iterations);
-  double objective(const Eigen::VectorXd& x, const Eigen::VectorXd& force, double inertia,
-                   const Eigen::VectorXd& anchor) const;
+                              const Eigen::VectorXd& anchor, double tolerance, int max_iterations,
+                              bool stop_at_budget = false);
   const SvkPolynomial& forces_;
   Eigen::VectorXd external_;
   double damping_;
   // scratch
-  Eigen::VectorXd gradient_, direction_, trial_, anchor_, scaled_force_, start_;
+  Eigen::VectorXd gradient_, direction_, trial_, anchor_, scaled_force_, start_, iterate_;
   Eigen::MatrixXd hessian_;
   Eigen::LLT<Eigen::MatrixXd> llt_;
 };

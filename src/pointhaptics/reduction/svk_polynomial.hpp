@@ -25,8 +25,10 @@ class SvkPolynomial {
   int size() const { return r_; }
   /// W(q), J.
   double energy(const Eigen::VectorXd& q) const;
-  /// gradient = dW/dq (N in reduced units) and, when given, hessian = d2W/dq2, at q. No allocation.
-  void evaluate(const Eigen::VectorXd& q, Eigen::VectorXd& gradient, Eigen::MatrixXd* hessian) const;
+  /// gradient = dW/dq (N in reduced units) and, when given, hessian = d2W/dq2 and energy = W, at q, from one
+  /// contraction of the tables. No allocation.
+  void evaluate(const Eigen::VectorXd& q, Eigen::VectorXd& gradient, Eigen::MatrixXd* hessian,
+                double* energy = nullptr) const;
   /// The rest stiffness U^T K U.
   const Eigen::MatrixXd& rest_stiffness() const { return A_; }
   double build_s() const { return build_s_; }
