@@ -239,18 +239,34 @@ void beam_benchmark(benchmark::State& state) {
 }
 
 // the 4 x 1 x 1 beam as a reduced model (issue 49): r = range(0) modes and derivatives, svk's polynomial, on 2
-// threads; range(1): Newton iterations per step in real time (0: each step converged to 1e-9). Counters: the set-up (basis: factor, modes, derivatives; the polynomial's tables), the tables' memory,
+// threads; range(1): Newton iterations per step in real time (0: each step converged to 1e-9); range(2): the
+// basis made on a sampling that many times coarser (1: on the points themselves). Counters: the set-up (basis: factor, modes, derivatives; the polynomial's tables), the tables' memory,
 // and the reduced static sag at the free end; the timed loop is one backward Euler step at dt = 1 ms (one Newton
 // solve in r unknowns), the Vega comparison's "step"
 void reduced_beam_benchmark(benchmark::State& state) {
-  const int r = static_cast<int>(state.range(0)), budget = static_cast<int>(state.range(1));
+  const int r = static_cast<int>(state.range(0)), budget = static_cast<int>(state.range(1)),
+            coarsening = static_cast<int>(state.range(2));
   const Scene scene = beam_4x1x1(SolverKind::IMPLICIT);
   const Model model = build_scene_model(scene);
   Workspace ws(model, 2);
   ModalBasisSettings settings;
   settings.size = r;
-  settings.loads = {model.f_ext};
-  const ModalBasis basis = build_modal_basis(model, settings, ws);
+  ModalBasis basis;
+  if (coarsening > 1) {
+    // the basis on a sampling `coarsening` times coarser, carried to the points
+    Scene coarse_scene = scene;
+    coarse_scene.object.spacing *= coarsening;
+    const Model coarse = build_scene_model(coarse_scene);
+    Workspace coarse_ws(coarse, 2);
+    settings.loads = {coarse.f_ext};
+    const auto start = std::chrono::steady_clock::now();
+    const ModalBasis on_coarse = build_modal_basis(coarse, settings, coarse_ws);
+    basis = carry_basis(on_coarse, coarse, model);
+    basis.total_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  } else {
+    settings.loads = {model.f_ext};
+    basis = build_modal_basis(model, settings, ws);
+  }
   const SvkPolynomial polynomial(model, basis.U, ws);
   ReducedIntegrator integrator(
       polynomial, basis.U.transpose() * Eigen::Map<const Eigen::VectorXd>(model.f_ext.data(), model.f_ext.size()),
@@ -677,13 +693,15 @@ int run_bench_suite(const BenchOptions& options) {
           ->UseRealTime();
   for (int r : {20, 40})
     for (int budget : {0, 1})
-      benchmark::RegisterBenchmark(
-          fmt::format("reduced_beam4x1x1/modes:{}/{}/threads:2", r, budget ? "newton:1" : "converged").c_str(),
-          reduced_beam_benchmark)
-          ->Args({r, budget})
-          ->Unit(benchmark::kMicrosecond)
-          ->MinTime(options.min_time)
-          ->UseRealTime();
+      for (int coarsening : {1, 2})
+        benchmark::RegisterBenchmark(fmt::format("reduced_beam4x1x1/modes:{}/{}/basis_spacing:{}/threads:2", r,
+                                                 budget ? "newton:1" : "converged", coarsening)
+                                         .c_str(),
+                                     reduced_beam_benchmark)
+            ->Args({r, budget, coarsening})
+            ->Unit(benchmark::kMicrosecond)
+            ->MinTime(options.min_time)
+            ->UseRealTime();
   for (int variant = 0; variant < static_cast<int>(stream_variants.size()); ++variant)
     for (int hourglass : {1, 0})
       benchmark::RegisterBenchmark(

@@ -2,6 +2,7 @@
 
 #include <pointhaptics/core/error.hpp>
 #include <pointhaptics/core/run_control.hpp>
+#include <pointhaptics/mechanics/surface_map.hpp>
 #include <pointhaptics/mechanics/tangent.hpp>
 #include <pointhaptics/mechanics/tangent_matrix.hpp>
 #include <pointhaptics/solvers/sparse_cholesky.hpp>
@@ -224,6 +225,39 @@ ModalBasis build_modal_basis(const Model& model, const ModalBasisSettings& setti
     if (model.fixed[static_cast<std::size_t>(p)]) basis.U.middleRows<3>(3 * p).setZero();
   basis.total_s = seconds_since(start);
   return basis;
+}
+
+ModalBasis carry_basis(const ModalBasis& basis, const Model& coarse, const Model& model) {
+  const auto start = std::chrono::steady_clock::now();
+  if (basis.U.rows() != 3 * coarse.n_points)
+    throw Error(
+        fmt::format("reduction: a basis of {} rows for a coarse model of {} points", basis.U.rows(), coarse.n_points));
+  const SurfaceMap map = build_surface_map(coarse, model.X);
+  const Eigen::Index r = basis.U.cols();
+  Eigen::MatrixXd carried(3 * model.n_points, r);
+  Eigen::MatrixXd at_points;
+  for (Eigen::Index k = 0; k < r; ++k) {
+    interpolate_at_surface(map, Eigen::Map<const Eigen::MatrixXd>(basis.U.col(k).data(), 3, coarse.n_points),
+                           at_points);
+    carried.col(k) = Eigen::Map<const Eigen::VectorXd>(at_points.data(), at_points.size());
+  }
+  Eigen::VectorXd mass(3 * model.n_points);
+  for (index_t p = 0; p < model.n_points; ++p) {
+    mass.segment<3>(3 * p).setConstant(model.mass[p]);
+    if (model.fixed[static_cast<std::size_t>(p)]) carried.middleRows<3>(3 * p).setZero();
+  }
+  // mass-orthonormal: U = V L^-T with L L^T = V^T M V
+  const Eigen::MatrixXd gram = carried.transpose() * mass.asDiagonal() * carried;
+  const Eigen::LLT<Eigen::MatrixXd> llt(gram);
+  if (llt.info() != Eigen::Success || !(llt.matrixL().toDenseMatrix().diagonal().minCoeff() >
+                                        1e-8 * llt.matrixL().toDenseMatrix().diagonal().maxCoeff()))
+    throw Error(
+        "reduction: the basis carried from the coarse points lost its independence (a coarser "
+        "basis_spacing than the object's features?)");
+  ModalBasis out = basis;
+  out.U = llt.matrixU().solve<Eigen::OnTheRight>(carried);
+  out.total_s = basis.total_s + seconds_since(start);
+  return out;
 }
 
 }  // namespace pointhaptics

@@ -38,6 +38,14 @@ struct ModalBasis {
 /// eigen-solver does not converge; Interrupted on a stop request.
 ModalBasis build_modal_basis(const Model& model, const ModalBasisSettings& settings, Workspace& ws);
 
+/// A basis made on `coarse`, a coarser sampling of the same object held alike (`[reduction] basis_spacing`), carried
+/// to `model`'s points by the moving least squares interpolant of `coarse`'s points (mechanics/surface_map.hpp),
+/// zeroed at `model`'s held points and made mass-orthonormal with `model`'s masses. The modes and derivatives
+/// then cost a factor of the coarse tangent (tens of times smaller): the basis is a little less than optimal,
+/// but the reduced model stays the exact projection of `model`'s energy on it. Throws Error when a point of
+/// `model` lies beyond `coarse`'s points or the carried vectors are not independent.
+ModalBasis carry_basis(const ModalBasis& basis, const Model& coarse, const Model& model);
+
 /// u = U q, the displacement of reduced coordinates q (3 x n).
 Points displacement_of(const Eigen::MatrixXd& U, const Eigen::VectorXd& q, index_t n_points);
 
