@@ -136,6 +136,14 @@ enum class Refactorisation {
                ///< time, at the next step's start otherwise (waiting for it there, so a run is reproducible)
 };
 
+/// [reduction]: the object stepped in a reduced basis of `modes` vectors (issue 49; docs/reduction.md): linear
+/// vibration modes, their modal derivatives and the loads' static responses (reduction/modal_basis.hpp), St.
+/// Venant-Kirchhoff's reduced energy as an exact polynomial (reduction/svk_polynomial.hpp).
+struct ReductionSpec {
+  int modes = 0;  ///< r; 0: the full model
+  int line = 0;   ///< the table's line in the scene file (0: none), for errors
+};
+
 /// [solver]: which solver advances the object, and how far.
 struct SolverSpec {
   SolverKind kind = SolverKind::EXPLICIT;
@@ -151,6 +159,7 @@ struct SolverSpec {
   /// explicit, several bodies: a body at rest that nothing touches sleeps (its stencils are not evaluated, its
   /// points not moved) until something touches it (world/model_simulation.hpp)
   bool sleep = true;
+  ReductionSpec reduction{};  ///< [reduction]: static and implicit solves in a reduced basis
 };
 
 /// The one table per enum of the names the scene file, the command line and Python use: to_string(),

@@ -461,6 +461,22 @@ void read_solver(TableReader& r, SolverSpec& s) {
   s.sleep = r.boolean("sleep", s.sleep);
 }
 
+void read_reduction(TableReader& r, ReductionSpec& s) {
+  const auto node = r.find("modes");
+  if (!node) r.fail_table("modes", "missing: the reduced basis' size, modes = r (e.g. 20)");
+  const long long modes = r.integer("modes", 0);
+  if (modes < 1 || modes > 200) r.fail_at(*node, "modes", "must lie in [1, 200]");
+  s.modes = static_cast<int>(modes);
+  // the basis' source and the forces' evaluation: one of each is built so far, the others are named
+  if (r.choice("basis", "modal", {"modal", "snapshots"}) != "modal")
+    r.fail_at(*r.find("basis"), "basis",
+              "\"snapshots\" (proper orthogonal decomposition) is not built yet: use \"modal\"");
+  if (r.choice("forces", "polynomial", {"polynomial", "hyper"}) != "polynomial")
+    r.fail_at(*r.find("forces"), "forces",
+              "\"hyper\" (integration points for any material) is not built yet: use \"polynomial\" (St. "
+              "Venant-Kirchhoff)");
+}
+
 // box = { min, max }, sphere = { centre, radius } or cylinder = { centre, axis, radius, half_length }: exactly one
 void read_selector(TableReader& r, PointSelector& f) {
   const int selectors = (r.find("box") != nullptr) + (r.find("sphere") != nullptr) + (r.find("cylinder") != nullptr);
@@ -1155,6 +1171,10 @@ Scene parse_scene(std::string_view text, const std::string& name, const std::str
   bind_tools(scene, device_section);
   section("lod", [&](TableReader& r) { read_lod(r, scene.lod); });
   section("contact", [&](TableReader& r) { read_contact(r, scene.contact); });
+  if (const toml::node* reduction = root.get("reduction")) {
+    scene.solver.reduction.line = static_cast<int>(reduction->source().begin.line);
+    section("reduction", [&](TableReader& r) { read_reduction(r, scene.solver.reduction); });
+  }
   // each device-driven tool (a hand): [probe], or a [[tool]] with a device
   const auto check_hand = [&](const ProbeSpec& probe, const DeviceSpec& device, const std::string& what) {
     if (device.kind == "virtual" && probe.trajectory.empty() && probe.keyframes.empty())
@@ -1217,6 +1237,23 @@ Scene parse_scene(std::string_view text, const std::string& name, const std::str
                             scene.refine.front().line));
   top.finish();
   check_body_names(scene);
+  if (scene.solver.reduction.modes > 0) {
+    // what a reduced model does not do yet (issue 49): each named, at the [reduction] table
+    const std::pair<bool, const char*> not_yet[] = {
+        {scene.solver.kind == SolverKind::EXPLICIT, "needs solver.kind = \"implicit\" or \"static\""},
+        {scene.probe.present || !scene.tools.empty() || !scene.other_hands.empty(),
+         "not yet with a [probe] or [[tool]] tables (the contact region in full, coupled to the reduced rest, is "
+         "issue 49's next part)"},
+        {!scene.obstacles.empty(), "not yet with [[obstacle]] tables"},
+        {scene.bodies.size() > 1, "not yet with several [[object]] tables"},
+        {scene.lod.present, "not yet with [lod]"},
+        {!scene.cuts.empty(), "not yet with [[cut]] tables (a cut invalidates the basis)"},
+        {scene.material.model != MaterialModel::SVK,
+         "forces = \"polynomial\" needs material.model = \"svk\" (St. Venant-Kirchhoff's energy is a polynomial)"},
+    };
+    for (const auto& [refused, why] : not_yet)
+      if (refused) throw Error(fmt::format("{}:{}: reduction: {}", name, scene.solver.reduction.line, why));
+  }
   if (scene.lod.present && !scene.probe.present && !scene.lod.contact.allFinite()) {
     int point_loads = 0;
     for (const LoadSpec& l : scene.loads) point_loads += l.kind == LoadKind::POINT;

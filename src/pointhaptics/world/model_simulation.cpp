@@ -1,5 +1,7 @@
 #include <pointhaptics/world/model_simulation.hpp>
 
+#include <pointhaptics/reduction/reduced_solver.hpp>
+
 #include <pointhaptics/lod/active_surface.hpp>
 
 #include <pointhaptics/core/error.hpp>
@@ -80,7 +82,9 @@ ModelSimulation::ModelSimulation(Model model, const SolverSpec& solver, int n_th
   stable_dt_ = stable_dt > 0                          ? stable_dt
                : solver_.kind == SolverKind::EXPLICIT ? stable_time_step(model_, 0.8, 40, n_threads)
                                                       : 0.0;
-  solver_impl_ = make_solver(model_, solver_, stable_dt_);
+  // a reduced model's solver makes its basis here (the set-up)
+  solver_impl_ = solver_.reduction.modes > 0 ? std::make_unique<ReducedSolver>(model_, solver_, ws_)
+                                             : make_solver(model_, solver_, stable_dt_);
   hold_points(model_, 0.0, state_.u);  // held points start at their prescribed displacement at t = 0
 }
 
