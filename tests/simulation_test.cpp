@@ -77,16 +77,7 @@ TEST(SceneBuilder, FixedTablesSelectBySphereOrCylinder) {
   }
 }
 
-double tip_deflection(const Simulation& sim) {
-  double tip = 0;
-  int n = 0;
-  for (index_t i = 0; i < sim.model().n_points; ++i)
-    if (sim.model().X(0, i) == 0.15) {
-      tip += sim.state().u(1, i);
-      ++n;
-    }
-  return -tip / n;
-}
+double tip_deflection(const Simulation& sim) { return test::cantilever_tip_deflection(sim.model(), sim.state().u); }
 
 TEST(SceneBuilder, ObjectsTooBigForTheMachineAreRefusedBeforeTheyAreBuilt) {
   // issue 21: 10^7-10^9 points allocated gigabytes first and failed minutes later as "internal error"

@@ -10,16 +10,7 @@
 namespace pointhaptics {
 namespace {
 
-double tip_deflection(const Simulation& sim) {
-  double tip = 0;
-  int n = 0;
-  for (index_t i = 0; i < sim.model().n_points; ++i)
-    if (sim.model().X(0, i) == 0.15) {
-      tip += sim.state().u(1, i);
-      ++n;
-    }
-  return -tip / n;
-}
+double tip_deflection(const Simulation& sim) { return test::cantilever_tip_deflection(sim.model(), sim.state().u); }
 
 std::string reduced(const std::string& solver, const std::string& more = "") {
   return test::cantilever_scene(solver) + "[reduction]\nmodes = 20\n" + more;

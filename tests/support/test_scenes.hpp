@@ -1,5 +1,7 @@
 #pragma once
 // Scene files shared by the tests, as TOML text.
+#include <pointhaptics/core/model.hpp>
+
 #include <string>
 
 namespace pointhaptics::test {
@@ -30,6 +32,18 @@ dt = )" + dt +
          R"(
 duration = 2.0
 )";
+}
+
+/// The seed cantilever's (cantilever_scene()) tip deflection: minus the mean u_y of its points at x = 0.15 m, m.
+inline double cantilever_tip_deflection(const Model& model, const Points& u) {
+  double tip = 0;
+  int n = 0;
+  for (index_t i = 0; i < model.n_points; ++i)
+    if (model.X(0, i) == 0.15) {
+      tip += u(1, i);
+      ++n;
+    }
+  return -tip / n;
 }
 
 }  // namespace pointhaptics::test

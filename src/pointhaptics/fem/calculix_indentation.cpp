@@ -56,6 +56,20 @@ std::string cax8(int element, std::array<int, 8> n, const std::vector<Vec3>& whe
   return fmt::format("{}, {}, {}, {}, {}, {}, {}, {}, {}\n", element, n[0], n[1], n[2], n[3], n[4], n[5], n[6], n[7]);
 }
 
+// The force at `x` along a curve of points from (0, 0) in increasing `abscissa` (a member of Point), linear between
+// them and exact at them; the caller has checked that x lies within it.
+template <class Point>
+double force_along(const std::vector<Point>& curve, double x, double Point::*abscissa) {
+  double x0 = 0, f0 = 0;
+  for (const Point& point : curve) {
+    const double xp = point.*abscissa;
+    if (xp >= x * (1 - 1e-9)) return xp - x0 <= 0 ? point.force : f0 + (point.force - f0) * (x - x0) / (xp - x0);
+    x0 = xp;
+    f0 = point.force;
+  }
+  return curve.back().force;
+}
+
 void write_ids(std::string& out, const std::vector<int>& ids) {
   for (std::size_t k = 0; k < ids.size(); ++k)
     out += fmt::format("{}{}", ids[k], (k + 1) % 16 == 0 || k + 1 == ids.size() ? ",\n" : ", ");
@@ -168,15 +182,7 @@ double IndentationSolution::force_at(double depth) const {
   if (curve.empty() || depth < 0 || depth > curve.back().depth * (1 + 1e-9))
     throw Error(fmt::format("CalculiX indentation: no force at depth {} m (the curve ends at {} m)", depth,
                             curve.empty() ? 0.0 : curve.back().depth));
-  IndentationPoint before{0, 0};
-  for (const IndentationPoint& point : curve) {
-    if (point.depth >= depth * (1 - 1e-9)) {
-      const double span = point.depth - before.depth;
-      return span <= 0 ? point.force : before.force + (point.force - before.force) * (depth - before.depth) / span;
-    }
-    before = point;
-  }
-  return curve.back().force;
+  return force_along(curve, depth, &IndentationPoint::depth);
 }
 
 IndentationSolution solve_indentation(const IndentationProblem& problem, int threads) {
@@ -370,16 +376,7 @@ double SphereOnPlaneSolution::force_at_cap(double cap_travel) const {
   if (curve.empty() || cap_travel < 0 || cap_travel > curve.back().cap_travel * (1 + 1e-9))
     throw Error(fmt::format("CalculiX sphere on a plane: no force at a cap's travel of {} m (the curve ends at {} m)",
                             cap_travel, curve.empty() ? 0.0 : curve.back().cap_travel));
-  SphereOnPlanePoint before{};
-  for (const SphereOnPlanePoint& point : curve) {
-    if (point.cap_travel >= cap_travel * (1 - 1e-9)) {
-      const double span = point.cap_travel - before.cap_travel;
-      return span <= 0 ? point.force
-                       : before.force + (point.force - before.force) * (cap_travel - before.cap_travel) / span;
-    }
-    before = point;
-  }
-  return curve.back().force;
+  return force_along(curve, cap_travel, &SphereOnPlanePoint::cap_travel);
 }
 
 SphereOnPlaneSolution solve_sphere_on_plane(const SphereOnPlaneProblem& problem, int threads) {
