@@ -253,13 +253,11 @@ void reduced_beam_benchmark(benchmark::State& state) {
   settings.size = r;
   ModalBasis basis;
   if (coarsening > 1) {
-    // the basis on a sampling `coarsening` times coarser, carried to the points
-    Scene coarse_scene = scene;
-    coarse_scene.object.spacing *= coarsening;
-    const Model coarse = build_scene_model(coarse_scene);
+    // the basis on a sampling `coarsening` times coarser (`[reduction] basis_spacing`), carried to the points
+    const auto start = std::chrono::steady_clock::now();
+    const Model coarse = coarse_model(model, coarsening * model.spacing);
     Workspace coarse_ws(coarse, 2);
     settings.loads = {coarse.f_ext};
-    const auto start = std::chrono::steady_clock::now();
     const ModalBasis on_coarse = build_modal_basis(coarse, settings, coarse_ws);
     basis = carry_basis(on_coarse, coarse, model);
     basis.total_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

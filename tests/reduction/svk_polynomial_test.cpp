@@ -85,6 +85,40 @@ TEST(ModalBasis, RefusesAnObjectWithNothingHeldOrTooFewDegreesOfFreedom) {
   EXPECT_THROW(build_modal_basis(held, settings, ws), Error);
 }
 
+TEST(ModalBasis, ACoarseSamplingKeepsTheVolumeTheLoadsAndTheHeldFace) {
+  Model model = cantilever();
+  model.f_ext = tip_load(model, 0.01);
+  const Model coarse = coarse_model(model, 2 * spacing);
+  EXPECT_LT(coarse.n_points, model.n_points / 2);
+  EXPECT_GT(coarse.n_points, model.n_points / 12);
+  EXPECT_NEAR(coarse.volume.sum(), model.volume.sum(), 1e-12 * model.volume.sum());
+  EXPECT_NEAR(coarse.f_ext.row(1).sum(), -0.01, 1e-15);
+  int held = 0;
+  for (index_t i = 0; i < coarse.n_points; ++i)
+    if (coarse.fixed[static_cast<std::size_t>(i)]) {
+      ++held;
+      EXPECT_LT(coarse.X(0, i), 0.5 * spacing);
+    }
+  EXPECT_GT(held, 0);
+  EXPECT_THROW(coarse_model(model, 0.5 * spacing), Error);
+  // its basis carried to the points: mass-orthonormal and zero where held there
+  Workspace ws(coarse, 2);
+  ModalBasisSettings settings;
+  settings.size = 8;
+  settings.loads = {coarse.f_ext};
+  const ModalBasis carried = carry_basis(build_modal_basis(coarse, settings, ws), coarse, model);
+  ASSERT_EQ(carried.U.rows(), 3 * model.n_points);
+  Eigen::VectorXd mass(3 * model.n_points);
+  for (index_t i = 0; i < model.n_points; ++i) mass.segment<3>(3 * i).setConstant(model.mass[i]);
+  EXPECT_LT(
+      (carried.U.transpose() * mass.asDiagonal() * carried.U - Eigen::MatrixXd::Identity(8, 8)).cwiseAbs().maxCoeff(),
+      1e-10);
+  for (index_t i = 0; i < model.n_points; ++i)
+    if (model.fixed[static_cast<std::size_t>(i)]) {
+      EXPECT_EQ(carried.U.middleRows<3>(3 * i).cwiseAbs().maxCoeff(), 0.0);
+    }
+}
+
 class SvkPolynomialTest : public ::testing::Test {
  protected:
   void SetUp() override {

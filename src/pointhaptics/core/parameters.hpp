@@ -140,8 +140,9 @@ enum class Refactorisation {
 /// vibration modes, their modal derivatives and the loads' static responses (reduction/modal_basis.hpp), St.
 /// Venant-Kirchhoff's reduced energy as an exact polynomial (reduction/svk_polynomial.hpp).
 struct ReductionSpec {
-  int modes = 0;  ///< r; 0: the full model
-  int line = 0;   ///< the table's line in the scene file (0: none), for errors
+  int modes = 0;             ///< r; 0: the full model
+  double basis_spacing = 0;  ///< m: the basis made on a sampling this coarse and carried to the points (0: on them)
+  int line = 0;              ///< the table's line in the scene file (0: none), for errors
 };
 
 /// [solver]: which solver advances the object, and how far.

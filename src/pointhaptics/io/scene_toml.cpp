@@ -467,6 +467,7 @@ void read_reduction(TableReader& r, ReductionSpec& s) {
   const long long modes = r.integer("modes", 0);
   if (modes < 1 || modes > 200) r.fail_at(*node, "modes", "must lie in [1, 200]");
   s.modes = static_cast<int>(modes);
+  s.basis_spacing = r.number("basis_spacing", 0.0, positive_up_to(1e3), "must lie in (0, 1e3] (m)");
   // the basis' source and the forces' evaluation: one of each is built so far, the others are named
   if (r.choice("basis", "modal", {"modal", "snapshots"}) != "modal")
     r.fail_at(*r.find("basis"), "basis",

@@ -2,6 +2,7 @@
 
 #include <pointhaptics/core/error.hpp>
 #include <pointhaptics/core/run_control.hpp>
+#include <pointhaptics/mechanics/model_builder.hpp>
 #include <pointhaptics/mechanics/surface_map.hpp>
 #include <pointhaptics/mechanics/tangent.hpp>
 #include <pointhaptics/mechanics/tangent_matrix.hpp>
@@ -13,6 +14,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <map>
+#include <tuple>
 
 namespace pointhaptics {
 namespace {
@@ -225,6 +228,55 @@ ModalBasis build_modal_basis(const Model& model, const ModalBasisSettings& setti
     if (model.fixed[static_cast<std::size_t>(p)]) basis.U.middleRows<3>(3 * p).setZero();
   basis.total_s = seconds_since(start);
   return basis;
+}
+
+Model coarse_model(const Model& model, double spacing) {
+  if (!(spacing > model.spacing))
+    throw Error(fmt::format("reduction.basis_spacing: {} m must be coarser than the object's spacing ({} m)", spacing,
+                            model.spacing));
+  const Vec3 lowest = model.X.rowwise().minCoeff();
+  // the cube of each point, and each cube's chosen point and sums
+  struct Cube {
+    index_t chosen = -1;
+    double distance = 0, volume = 0;
+    Vec3 load = Vec3::Zero();
+  };
+  std::map<std::tuple<long long, long long, long long>, Cube> cubes;
+  for (index_t i = 0; i < model.n_points; ++i) {
+    const Vec3 at = (model.X.col(i) - lowest) / spacing;
+    const auto key = std::tuple{std::llround(at.x()), std::llround(at.y()), std::llround(at.z())};
+    const Vec3 centre(static_cast<double>(std::get<0>(key)), static_cast<double>(std::get<1>(key)),
+                      static_cast<double>(std::get<2>(key)));
+    Cube& cube = cubes[key];
+    const double distance = (at - centre).norm();
+    if (cube.chosen < 0 || distance < cube.distance - 1e-9) {
+      cube.chosen = i;
+      cube.distance = distance;
+    }
+    cube.volume += model.volume[i];
+    if (model.f_ext.size() == 3 * model.n_points) cube.load += model.f_ext.col(i);
+  }
+  PointCloud cloud;
+  cloud.X.resize(3, static_cast<Eigen::Index>(cubes.size()));
+  cloud.volume.resize(static_cast<Eigen::Index>(cubes.size()));
+  cloud.surface.assign(cubes.size(), 0);
+  cloud.spacing = spacing;
+  std::vector<unsigned char> held;
+  Points loads(3, static_cast<Eigen::Index>(cubes.size()));
+  Eigen::Index k = 0;
+  for (const auto& [key, cube] : cubes) {
+    cloud.X.col(k) = model.X.col(cube.chosen);
+    cloud.volume[k] = cube.volume;
+    loads.col(k) = cube.load;
+    held.push_back(model.fixed[static_cast<std::size_t>(cube.chosen)]);
+    ++k;
+  }
+  KernelParams kernel = model.kernel;
+  if (kernel.support > 0) kernel.support *= spacing / model.spacing;
+  Model coarse = build_model(cloud, model.material, kernel);
+  coarse.fixed = held;
+  coarse.f_ext = loads;
+  return coarse;
 }
 
 ModalBasis carry_basis(const ModalBasis& basis, const Model& coarse, const Model& model) {

@@ -22,8 +22,16 @@ ReducedSolver::ReducedSolver(const Model& model, const SolverSpec& spec, Workspa
                       group.name));
   ModalBasisSettings settings;
   settings.size = spec.reduction.modes;
-  if (model.f_ext.size() == 3 * model.n_points && model.f_ext.squaredNorm() > 0) settings.loads = {model.f_ext};
-  basis_ = build_modal_basis(model, settings, ws);
+  if (spec.reduction.basis_spacing > 0) {
+    // the basis of a coarser sampling, carried to the points: the set-up's factor tens of times smaller
+    const Model coarse = coarse_model(model, spec.reduction.basis_spacing);
+    Workspace coarse_ws(coarse, ws.n_threads());
+    if (coarse.f_ext.squaredNorm() > 0) settings.loads = {coarse.f_ext};
+    basis_ = carry_basis(build_modal_basis(coarse, settings, coarse_ws), coarse, model);
+  } else {
+    if (model.f_ext.size() == 3 * model.n_points && model.f_ext.squaredNorm() > 0) settings.loads = {model.f_ext};
+    basis_ = build_modal_basis(model, settings, ws);
+  }
   polynomial_ = std::make_unique<SvkPolynomial>(model, basis_.U, ws);
   Eigen::VectorXd external = Eigen::VectorXd::Zero(spec.reduction.modes);
   if (model.f_ext.size() == 3 * model.n_points)
