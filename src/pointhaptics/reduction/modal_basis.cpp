@@ -234,16 +234,24 @@ Model coarse_model(const Model& model, double spacing) {
   if (!(spacing > model.spacing))
     throw Error(fmt::format("reduction.basis_spacing: {} m must be coarser than the object's spacing ({} m)", spacing,
                             model.spacing));
-  const Vec3 lowest = model.X.rowwise().minCoeff();
+  const Vec3 lowest = model.X.rowwise().minCoeff(), extent = model.X.rowwise().maxCoeff() - lowest;
+  // per axis, a whole number of cubes across the points' extent (about `spacing` each), so that the first and last
+  // layers of cubes are centred on the faces, as a sampling that includes its faces is
+  Vec3 cube_size;
+  for (int a = 0; a < 3; ++a) {
+    const double cubes_across = std::max(1.0, std::round(extent[a] / spacing));
+    cube_size[a] = extent[a] > 0 ? extent[a] / cubes_across : spacing;
+  }
   // the cube of each point, and each cube's chosen point and sums
   struct Cube {
     index_t chosen = -1;
     double distance = 0, volume = 0;
-    Vec3 load = Vec3::Zero();
+    Vec3 load = Vec3::Zero(), centroid = Vec3::Zero();
+    bool held = false;
   };
   std::map<std::tuple<long long, long long, long long>, Cube> cubes;
   for (index_t i = 0; i < model.n_points; ++i) {
-    const Vec3 at = (model.X.col(i) - lowest) / spacing;
+    const Vec3 at = (model.X.col(i) - lowest).cwiseQuotient(cube_size);
     const auto key = std::tuple{std::llround(at.x()), std::llround(at.y()), std::llround(at.z())};
     const Vec3 centre(static_cast<double>(std::get<0>(key)), static_cast<double>(std::get<1>(key)),
                       static_cast<double>(std::get<2>(key)));
@@ -254,6 +262,8 @@ Model coarse_model(const Model& model, double spacing) {
       cube.distance = distance;
     }
     cube.volume += model.volume[i];
+    cube.centroid += model.volume[i] * model.X.col(i);
+    cube.held = cube.held || model.fixed[static_cast<std::size_t>(i)];
     if (model.f_ext.size() == 3 * model.n_points) cube.load += model.f_ext.col(i);
   }
   PointCloud cloud;
@@ -265,10 +275,10 @@ Model coarse_model(const Model& model, double spacing) {
   Points loads(3, static_cast<Eigen::Index>(cubes.size()));
   Eigen::Index k = 0;
   for (const auto& [key, cube] : cubes) {
-    cloud.X.col(k) = model.X.col(cube.chosen);
+    cloud.X.col(k) = cube.centroid / cube.volume;
     cloud.volume[k] = cube.volume;
     loads.col(k) = cube.load;
-    held.push_back(model.fixed[static_cast<std::size_t>(cube.chosen)]);
+    held.push_back(cube.held);
     ++k;
   }
   KernelParams kernel = model.kernel;

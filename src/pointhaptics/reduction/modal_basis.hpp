@@ -38,8 +38,9 @@ struct ModalBasis {
 /// eigen-solver does not converge; Interrupted on a stop request.
 ModalBasis build_modal_basis(const Model& model, const ModalBasisSettings& settings, Workspace& ws);
 
-/// A coarser sampling of `model`'s object for its basis (`[reduction] basis_spacing`): the points binned in cubes of
-/// side `spacing` centred on a lattice from the points' lowest corner, one point per cube (the one nearest its
+/// A coarser sampling of `model`'s object for its basis (`[reduction] basis_spacing`): the points binned in boxes of
+/// about `spacing` (a whole number across the points' extent on each axis) centred on a lattice from their lowest
+/// corner, one point per cube (the one nearest its
 /// centre, so a lattice sampled at a divisor of `spacing` keeps a sub-lattice), standing for the cube's volume, held
 /// if it is held in `model`, carrying the cube's constant loads; the material and kernel are `model`'s (the
 /// kernel's support scaled with the spacing). Throws Error when `spacing` is not coarser than the model's.
