@@ -93,6 +93,15 @@ void print_summary(ph::Simulation& sim, const ph::RunSummary& s, double setup_s)
     fmt::print("preconditioner  two_level: a coarse level of {} points, its factor {:.2f} MB{}\n", s.coarse_points,
                s.factor_bytes / 1e6,
                s.coarse_points == 0 ? " (none: the object is too small; block-Jacobi alone)" : "");
+  if (s.reduction.modes > 0) {
+    const pointhaptics::ReductionSummary& r = s.reduction;
+    fmt::print(
+        "reduction       r = {} ({} modes, {} derivatives, {} load responses{}); set-up {:.2f} s (factor {:.2f} s, "
+        "{:.0f} MB; modes {:.2f} s; derivatives {:.2f} s; polynomial {:.2f} s, {:.2f} MB)\n",
+        r.modes, r.linear_modes, r.derivatives, r.load_vectors,
+        r.basis_spacing > 0 ? fmt::format(", made at {} m", r.basis_spacing) : std::string(), r.setup_s, r.factorise_s,
+        r.factor_bytes / 1e6, r.modes_s, r.derivatives_s, r.polynomial_s, r.tables_bytes / 1e6);
+  }
   fmt::print("displacement    max {:.4g} m at point {} ({:.4g}, {:.4g}, {:.4g})\n", max_u, worst, m.X(0, worst),
              m.X(1, worst), m.X(2, worst));
   // the out-of-balance force: |f_int + f_ext| over the free points relative to the load; in dynamics it is

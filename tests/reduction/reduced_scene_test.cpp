@@ -6,6 +6,7 @@
 #include "support/test_scenes.hpp"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 namespace pointhaptics {
 namespace {
@@ -68,6 +69,18 @@ TEST(ReducedScene, ImplicitStepsSettleOnTheFullModelsSag) {
   sim.run(1.0);
   ASSERT_TRUE(sim.summary().converged) << sim.summary().failure;
   EXPECT_NEAR(sim.state().time, 1.0, 1e-9);
+  // the set-up is reported, in the result JSON too
+  const RunSummary summary = sim.summary();
+  EXPECT_EQ(summary.reduction.modes, 20);
+  EXPECT_GT(summary.reduction.linear_modes, 0);
+  EXPECT_GT(summary.reduction.derivatives, 0);
+  EXPECT_EQ(summary.reduction.load_vectors, 1);
+  EXPECT_GT(summary.reduction.setup_s, 0);
+  EXPECT_GT(summary.reduction.tables_bytes, 0);
+  const auto json = nlohmann::json::parse(result_json(sim.model(), sim.state(), summary));
+  EXPECT_EQ(json.at("reduction").at("modes").get<int>(), 20);
+  EXPECT_GT(json.at("reduction").at("setup_s").get<double>(), 0);
+  EXPECT_FALSE(nlohmann::json::parse(result_json(full.model(), full.state(), full.summary())).contains("reduction"));
   EXPECT_NEAR(tip_deflection(sim), tip_deflection(full), 0.02 * tip_deflection(full));
 }
 

@@ -149,6 +149,21 @@ std::string result_json(const Model& model, const State& state, const RunSummary
                   {"surface_splits", c.surface_splits},
                   {"max_split_ms", c.max_split_ms}};
   }
+  if (s.reduction.modes > 0) {
+    const ReductionSummary& r = s.reduction;
+    doc["reduction"] = {{"modes", r.modes},
+                        {"linear_modes", r.linear_modes},
+                        {"derivatives", r.derivatives},
+                        {"load_vectors", r.load_vectors},
+                        {"basis_spacing", r.basis_spacing},
+                        {"setup_s", r.setup_s},
+                        {"factorise_s", r.factorise_s},
+                        {"modes_s", r.modes_s},
+                        {"derivatives_s", r.derivatives_s},
+                        {"polynomial_s", r.polynomial_s},
+                        {"factor_mb", r.factor_bytes / 1e6},
+                        {"tables_mb", r.tables_bytes / 1e6}};
+  }
   // without levels of detail every point is simulated
   const LodSummary& l = s.lod;
   doc["lod"] = {{"enabled", l.enabled},

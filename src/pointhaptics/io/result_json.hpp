@@ -84,6 +84,15 @@ struct BodyContactSummary {
   double penetration = 0;  ///< m
 };
 
+/// A reduced model's set-up (`[reduction]`, docs/reduction.md): its basis and polynomial, and where the time went.
+struct ReductionSummary {
+  int modes = 0;  ///< r (0: no reduction)
+  int linear_modes = 0, derivatives = 0, load_vectors = 0;
+  double basis_spacing = 0;  ///< m (0: the basis made on the points)
+  double setup_s = 0, factorise_s = 0, modes_s = 0, derivatives_s = 0, polynomial_s = 0;
+  double factor_bytes = 0, tables_bytes = 0;
+};
+
 struct RunSummary {
   std::string solver_kind;
   bool converged = false;
@@ -124,6 +133,7 @@ struct RunSummary {
   long long haptic_passivity_ticks = 0;
   LocalModelSummary local_model;
   LodSummary lod;
+  ReductionSummary reduction;
   ToolSummary tool;
   /// The obstacles by name: what the object does to each (`kind` its shape, `position` its pose's origin).
   std::vector<std::pair<std::string, ToolSummary>> obstacles;

@@ -170,6 +170,8 @@ class ModelSimulation {
   /// a hand the simulation does not have.
   StepInputs& inputs(std::size_t hand = 0);
   const SolverSpec& solver() const { return solver_; }
+  /// The solver that steps the model (a ReducedSolver with [reduction]).
+  const Solver& solver_impl() const { return *solver_impl_; }
   /// The explicit stable step (computed at construction for explicit steps, else when first asked; from the
   /// simulation's own thread).
   double stable_dt() const;

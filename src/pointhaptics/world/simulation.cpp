@@ -8,6 +8,7 @@
 #include <pointhaptics/mechanics/forces.hpp>
 #include <pointhaptics/mechanics/inversion.hpp>
 #include <pointhaptics/mechanics/viscoelasticity.hpp>
+#include <pointhaptics/reduction/reduced_solver.hpp>
 #include <pointhaptics/solvers/reactions.hpp>
 
 #include <fmt/format.h>
@@ -548,6 +549,21 @@ RunSummary Simulation::summary() {
   const StepDiagnostics& d = sim.diagnostics();
   RunSummary s;
   s.solver_kind = std::string(to_string(sim.solver().kind));
+  if (const auto* reduced = dynamic_cast<const ReducedSolver*>(&sim.solver_impl())) {
+    const ModalBasis& b = reduced->basis();
+    s.reduction = {static_cast<int>(b.U.cols()),
+                   b.linear_modes,
+                   b.derivatives,
+                   b.load_vectors,
+                   sim.solver().reduction.basis_spacing,
+                   reduced->setup_s(),
+                   b.factorise_s,
+                   b.modes_s,
+                   b.derivatives_s,
+                   reduced->polynomial().build_s(),
+                   b.factor_bytes,
+                   reduced->polynomial().bytes()};
+  }
   s.converged = state.u.allFinite() && !d.failed && interrupted_step_.empty();
   s.failure = interrupted_step_.empty() ? d.failure : interrupted_step_;
   s.interrupted = !interrupted_step_.empty();
