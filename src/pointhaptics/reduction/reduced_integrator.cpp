@@ -7,7 +7,7 @@
 namespace pointhaptics {
 
 ReducedIntegrator::ReducedIntegrator(const SvkPolynomial& forces, Eigen::VectorXd external, double damping)
-    : forces_(forces), external_(std::move(external)), damping_(damping) {
+    : forces_(forces), external_(std::move(external)), damping_(damping), llt_(forces.size()) {
   const int r = forces.size();
   gradient_.resize(r);
   direction_.resize(r);
@@ -16,8 +16,7 @@ ReducedIntegrator::ReducedIntegrator(const SvkPolynomial& forces, Eigen::VectorX
   scaled_force_.resize(r);
   start_.resize(r);
   iterate_.resize(r);
-  hessian_.resize(r, r);
-  llt_ = Eigen::LLT<Eigen::MatrixXd>(r);
+  hessian_.resize(r, r);  // llt_ is sized where it is made: an assigned LLT would copy its unset status
 }
 
 ReducedSolveReport ReducedIntegrator::minimise(Eigen::VectorXd& x, const Eigen::VectorXd& force, double inertia,
