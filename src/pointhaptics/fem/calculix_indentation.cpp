@@ -70,6 +70,22 @@ double force_along(const std::vector<Point>& curve, double x, double Point::*abs
   return curve.back().force;
 }
 
+// The two bodies' cards: element set `tissue` of the material's constants, `rigid` linear and 10^4 times stiffer
+// than `young`, and frictionless penalty contact (no *FRICTION card) of surface `dependent` against `independent`.
+std::string tissue_and_rigid_in_contact(const BoxProblem& constants, double young, const char* tissue,
+                                        const char* rigid, const char* dependent, const char* independent,
+                                        double penalty) {
+  std::string out = material_card("TISSUE", constants);
+  out += fmt::format("*MATERIAL, NAME=RIGID\n*ELASTIC\n{:.13g}, 0.3\n", 1e4 * young);
+  out += fmt::format("*SOLID SECTION, ELSET={}, MATERIAL=TISSUE\n*SOLID SECTION, ELSET={}, MATERIAL=RIGID\n", tissue,
+                     rigid);
+  out += fmt::format(
+      "*SURFACE INTERACTION, NAME=FRICTIONLESS\n*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n{:.13g}\n"
+      "*CONTACT PAIR, INTERACTION=FRICTIONLESS, TYPE=SURFACE TO SURFACE\n{}, {}\n",
+      penalty, dependent, independent);
+  return out;
+}
+
 void write_ids(std::string& out, const std::vector<int>& ids) {
   for (std::size_t k = 0; k < ids.size(); ++k)
     out += fmt::format("{}{}", ids[k], (k + 1) % 16 == 0 || k + 1 == ids.size() ? ",\n" : ", ");
@@ -162,14 +178,7 @@ std::string write_indentation_inp(const IndentationProblem& p, int* node_count, 
   for (int e : top_faces) out += fmt::format("{}, S3\n", e);
   out += "*SURFACE, NAME=SBALL, TYPE=ELEMENT\n";
   for (int e : sphere_faces) out += fmt::format("{}, S2\n", e);
-  out += material_card("TISSUE", constants);
-  out += fmt::format("*MATERIAL, NAME=RIGID\n*ELASTIC\n{:.13g}, 0.3\n", 1e4 * p.material.young);
-  out += "*SOLID SECTION, ELSET=BLOCK, MATERIAL=TISSUE\n*SOLID SECTION, ELSET=SPHERE, MATERIAL=RIGID\n";
-  // frictionless: no *FRICTION card
-  out += fmt::format(
-      "*SURFACE INTERACTION, NAME=FRICTIONLESS\n*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n{:.13g}\n"
-      "*CONTACT PAIR, INTERACTION=FRICTIONLESS, TYPE=SURFACE TO SURFACE\nSTOP, SBALL\n",
-      penalty);
+  out += tissue_and_rigid_in_contact(constants, p.material.young, "BLOCK", "SPHERE", "STOP", "SBALL", penalty);
   out += "*BOUNDARY\nNBOTTOM, 1, 2, 0\nNAXIS, 1, 1, 0\n";
   out += fmt::format(
       "*STEP{}, INC=1000\n*STATIC, DIRECT\n{:.13g}, 1\n*BOUNDARY\nNMOVE, 1, 1, 0\nNMOVE, 2, 2, {:.13g}\n"
@@ -357,13 +366,7 @@ std::string write_sphere_on_plane_inp(const SphereOnPlaneProblem& p, int* node_c
   for (const auto& [e, face] : ball_faces) out += fmt::format("{}, S{}\n", e, face);
   out += "*SURFACE, NAME=SPLANE, TYPE=ELEMENT\n";
   for (const auto& [e, face] : plane_faces) out += fmt::format("{}, S{}\n", e, face);
-  out += material_card("TISSUE", constants);
-  out += fmt::format("*MATERIAL, NAME=RIGID\n*ELASTIC\n{:.13g}, 0.3\n", 1e4 * p.material.young);
-  out += "*SOLID SECTION, ELSET=SPHERE, MATERIAL=TISSUE\n*SOLID SECTION, ELSET=PLANE, MATERIAL=RIGID\n";
-  out += fmt::format(
-      "*SURFACE INTERACTION, NAME=FRICTIONLESS\n*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n{:.13g}\n"
-      "*CONTACT PAIR, INTERACTION=FRICTIONLESS, TYPE=SURFACE TO SURFACE\nSBALL, SPLANE\n",
-      penalty);
+  out += tissue_and_rigid_in_contact(constants, p.material.young, "SPHERE", "PLANE", "SBALL", "SPLANE", penalty);
   out += "*BOUNDARY\nNPLANEBOTTOM, 1, 2, 0\nNPLANEAXIS, 1, 1, 0\nNAXIS, 1, 1, 0\n";
   out += fmt::format(
       "*STEP, NLGEOM, INC=1000\n*STATIC, DIRECT\n{:.13g}, 1\n*BOUNDARY\nNMOVE, 1, 1, 0\nNMOVE, 2, 2, {:.13g}\n"
