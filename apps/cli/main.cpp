@@ -7,6 +7,7 @@
 #include "experiment_force_profile.hpp"
 #include "experiment_lod.hpp"
 #include "experiment_materials.hpp"
+#include "experiment_reduction.hpp"
 #include "progress_bar.hpp"
 #include "python_command.hpp"
 
@@ -101,6 +102,11 @@ void print_summary(ph::Simulation& sim, const ph::RunSummary& s, double setup_s)
         r.modes, r.linear_modes, r.derivatives, r.load_vectors,
         r.basis_spacing > 0 ? fmt::format(", made at {} m", r.basis_spacing) : std::string(), r.setup_s, r.factorise_s,
         r.factor_bytes / 1e6, r.modes_s, r.derivatives_s, r.polynomial_s, r.tables_bytes / 1e6);
+    fmt::print("                lowest natural frequency {:.4g} Hz; basis {}\n", r.first_frequency_hz,
+               r.from_cache           ? fmt::format("read from {}", r.cache_file)
+               : r.cache_file.empty() ? std::string("not kept")
+                                      : fmt::format("kept in {}", r.cache_file));
+    if (!r.cache_note.empty()) fmt::print("                {}\n", r.cache_note);
   }
   fmt::print("displacement    max {:.4g} m at point {} ({:.4g}, {:.4g}, {:.4g})\n", max_u, worst, m.X(0, worst),
              m.X(1, worst), m.X(2, worst));
@@ -557,6 +563,10 @@ int cli_main(int argc, char** argv) {
   beam_cmd->add_option("--duration", beam.duration, "Simulated seconds of the dynamic runs")
       ->check(CLI::PositiveNumber);
   beam_cmd->add_flag("!--no-implicit", beam.implicit, "Skip the (slow) implicit runs");
+  beam_cmd
+      ->add_option("--modes", beam.modes,
+                   "The point_reduced row's basis size r ([reduction] modes; default 20, 0: no reduced row)")
+      ->check(CLI::Range(0, 200));
 
   ph::experiments::ContactOptions contact;
   CLI::App* contact_cmd = experiment_cmd->add_subcommand(
@@ -600,6 +610,25 @@ int cli_main(int argc, char** argv) {
       "Cutting: a device's blade cuts the cantilever through near its root, a scripted one cuts a slit that opens under load");
   cut_cmd->add_option("--out", cut_experiment.out, "Output folder")->required();
   cut_cmd->add_option("--threads", cut_experiment.threads, "Threads (0: all)")->check(thread_count);
+
+  ph::experiments::ReductionOptions reduction_experiment;
+  CLI::App* reduction_cmd = experiment_cmd->add_subcommand(
+      "reduction",
+      "The reduced model against the full point model and CalculiX NLGEOM on two cantilevers: static tip "
+      "displacement up to 20% of the length, a sudden load's history and the first natural frequency, against the "
+      "number of modes");
+  reduction_cmd->add_option("--out", reduction_experiment.out, "Output folder")->required();
+  reduction_cmd->add_flag("--quick", reduction_experiment.quick,
+                          "A coarser check beam, two loads, r = 6, 12, 20 and one CalculiX mesh (about a minute)");
+  reduction_cmd->add_option("--modes", reduction_experiment.modes, "The basis sizes r (default 6,10,15,20,30,40)")
+      ->delimiter(',')
+      ->check(CLI::Range(1, 200));
+  reduction_cmd
+      ->add_option("--checked-modes", reduction_experiment.checked_modes,
+                   "The r checked against the goals: 2% static and dynamic, 1% frequency (default 20)")
+      ->check(CLI::Range(1, 200));
+  reduction_cmd->add_option("--threads", reduction_experiment.threads, "Threads (0: all)")->check(thread_count);
+  reduction_cmd->add_option("--plot-script", reduction_experiment.plot_script, "plot_reduction.py to use");
 
   ph::experiments::ContactPairsOptions pairs;
   CLI::App* pairs_cmd = experiment_cmd->add_subcommand(
@@ -674,6 +703,7 @@ int cli_main(int argc, char** argv) {
     if (*profile_cmd) return ph::experiments::run_force_profile_experiment(profile);
     if (*cut_cmd) return ph::experiments::run_cut_experiment(cut_experiment);
     if (*pairs_cmd) return ph::experiments::run_contact_pairs_experiment(pairs);
+    if (*reduction_cmd) return ph::experiments::run_reduction_experiment(reduction_experiment);
     if (*lod_table_cmd) return ph::experiments::run_lod_table_experiment(lod_table);
     if (*propagation_cmd) return ph::experiments::run_propagation_experiment(propagation);
     if (*lod_error_cmd) return ph::experiments::run_lod_error_experiment(lod_error);

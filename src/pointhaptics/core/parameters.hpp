@@ -142,7 +142,10 @@ enum class Refactorisation {
 struct ReductionSpec {
   int modes = 0;             ///< r; 0: the full model
   double basis_spacing = 0;  ///< m: the basis made on a sampling this coarse and carried to the points (0: on them)
-  int line = 0;              ///< the table's line in the scene file (0: none), for errors
+  /// the folder the basis is kept in and read back from (reduction/basis_cache.hpp): "auto" for the user's cache
+  /// folder, empty for none (a scene's default is "auto")
+  std::string cache;
+  int line = 0;  ///< the table's line in the scene file (0: none), for errors
 };
 
 /// [solver]: which solver advances the object, and how far.

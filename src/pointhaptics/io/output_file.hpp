@@ -14,7 +14,7 @@ namespace pointhaptics {
 /// (e.g. "--json") and the path. Creates nothing.
 void check_output_path(const std::string& path, std::string_view what);
 
-/// A text file written beside its target and renamed over it by commit(), so that an interrupted run or a
+/// A file (text, or bytes through write()) written beside its target and renamed over it by commit(), so that an interrupted run or a
 /// full disk never leaves a truncated file and a file written before stays as it was; a device or FIFO
 /// (e.g. /dev/stdout) is written in place. print() buffers and never throws: a failed write (a full disk)
 /// is kept, later prints are dropped, and commit() reports it. So a file can be streamed through a long run
@@ -33,6 +33,12 @@ class TextOutput {
   void print(fmt::format_string<T...> format, T&&... args) {
     if (error_ != 0) return;
     fmt::format_to(std::back_inserter(buffer_), format, std::forward<T>(args)...);
+    if (buffer_.size() > (1u << 20)) flush();
+  }
+  /// Append raw bytes (a binary file written through the same guarantees).
+  void write(std::string_view bytes) {
+    if (error_ != 0) return;
+    buffer_.append(bytes.data(), bytes.data() + bytes.size());
     if (buffer_.size() > (1u << 20)) flush();
   }
   /// Write out, close and rename over the target; throws Error naming `what`, the path and the system's

@@ -162,7 +162,11 @@ std::string result_json(const Model& model, const State& state, const RunSummary
                         {"derivatives_s", r.derivatives_s},
                         {"polynomial_s", r.polynomial_s},
                         {"factor_mb", r.factor_bytes / 1e6},
-                        {"tables_mb", r.tables_bytes / 1e6}};
+                        {"tables_mb", r.tables_bytes / 1e6},
+                        {"first_frequency_hz", r.first_frequency_hz},
+                        {"cache_file", r.cache_file},
+                        {"from_cache", r.from_cache},
+                        {"cache_note", r.cache_note}};
   }
   // without levels of detail every point is simulated
   const LodSummary& l = s.lod;

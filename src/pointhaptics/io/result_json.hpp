@@ -91,6 +91,10 @@ struct ReductionSummary {
   double basis_spacing = 0;  ///< m (0: the basis made on the points)
   double setup_s = 0, factorise_s = 0, modes_s = 0, derivatives_s = 0, polynomial_s = 0;
   double factor_bytes = 0, tables_bytes = 0;
+  double first_frequency_hz = 0;  ///< the reduced model's lowest natural frequency about rest
+  std::string cache_file;         ///< where the basis was read from or kept (empty: not kept)
+  bool from_cache = false;  ///< the basis was read from cache_file (the set-up's factor, modes and derivatives skipped)
+  std::string cache_note;   ///< what went wrong with the cache file, when something did
 };
 
 struct RunSummary {

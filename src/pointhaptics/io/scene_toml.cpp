@@ -461,7 +461,9 @@ void read_solver(TableReader& r, SolverSpec& s) {
   s.sleep = r.boolean("sleep", s.sleep);
 }
 
-void read_reduction(TableReader& r, ReductionSpec& s) {
+std::string resolve(const Context& ctx, const std::string& file);
+
+void read_reduction(TableReader& r, const Context& ctx, ReductionSpec& s) {
   const auto node = r.find("modes");
   if (!node) r.fail_table("modes", "missing: the reduced basis' size, modes = r (e.g. 20)");
   const long long modes = r.integer("modes", 0);
@@ -476,6 +478,11 @@ void read_reduction(TableReader& r, ReductionSpec& s) {
     r.fail_at(*r.find("forces"), "forces",
               "\"hyper\" (integration points for any material) is not built yet: use \"polynomial\" (St. "
               "Venant-Kirchhoff)");
+  // where the basis is kept between runs: "auto" (the user's cache folder), "none", or a folder (relative to the
+  // scene file)
+  const std::string cache = r.string("cache", "auto");
+  if (cache.empty()) r.fail_at(*r.find("cache"), "cache", "give \"auto\", \"none\" or a folder");
+  s.cache = cache == "none" ? std::string() : cache == "auto" ? cache : resolve(ctx, cache);
 }
 
 // box = { min, max }, sphere = { centre, radius } or cylinder = { centre, axis, radius, half_length }: exactly one
@@ -1174,7 +1181,7 @@ Scene parse_scene(std::string_view text, const std::string& name, const std::str
   section("contact", [&](TableReader& r) { read_contact(r, scene.contact); });
   if (const toml::node* reduction = root.get("reduction")) {
     scene.solver.reduction.line = static_cast<int>(reduction->source().begin.line);
-    section("reduction", [&](TableReader& r) { read_reduction(r, scene.solver.reduction); });
+    section("reduction", [&](TableReader& r) { read_reduction(r, ctx, scene.solver.reduction); });
   }
   // each device-driven tool (a hand): [probe], or a [[tool]] with a device
   const auto check_hand = [&](const ProbeSpec& probe, const DeviceSpec& device, const std::string& what) {

@@ -11,4 +11,8 @@ namespace pointhaptics {
 /// evaluation (ws.gradients: compute_internal_forces fills them), on ws's threads, without allocation.
 index_t count_inverted(const Model& model, Workspace& ws);
 
+/// The same for the gradients of displacement `u`, computed here (a stencil pass, without storing them): for a
+/// solver that evaluates no forces point by point (a reduced model's polynomial).
+index_t count_inverted(const Model& model, const Points& u, Workspace& ws);
+
 }  // namespace pointhaptics

@@ -1,10 +1,18 @@
 #include <pointhaptics/reduction/reduced_solver.hpp>
 
 #include <pointhaptics/core/error.hpp>
+#include <pointhaptics/core/run_control.hpp>
+#include <pointhaptics/mechanics/deformation.hpp>
+#include <pointhaptics/mechanics/inversion.hpp>
+#include <pointhaptics/reduction/basis_cache.hpp>
+
+#include <Eigen/Eigenvalues>
 
 #include <fmt/format.h>
 
 #include <chrono>
+#include <cmath>
+#include <numbers>
 
 namespace pointhaptics {
 
@@ -22,27 +30,78 @@ ReducedSolver::ReducedSolver(const Model& model, const SolverSpec& spec, Workspa
                       group.name));
   ModalBasisSettings settings;
   settings.size = spec.reduction.modes;
-  if (spec.reduction.basis_spacing > 0) {
-    // the basis of a coarser sampling, carried to the points: the set-up's factor tens of times smaller
-    const Model coarse = coarse_model(model, spec.reduction.basis_spacing);
-    Workspace coarse_ws(coarse, ws.n_threads());
-    if (coarse.f_ext.squaredNorm() > 0) settings.loads = {coarse.f_ext};
-    basis_ = carry_basis(build_modal_basis(coarse, settings, coarse_ws), coarse, model);
-  } else {
-    if (model.f_ext.size() == 3 * model.n_points && model.f_ext.squaredNorm() > 0) settings.loads = {model.f_ext};
-    basis_ = build_modal_basis(model, settings, ws);
+  const std::string cache_dir = spec.reduction.cache == "auto" ? default_basis_cache_dir() : spec.reduction.cache;
+  const std::uint64_t key = cache_dir.empty() ? 0 : basis_key(model, settings, spec.reduction.basis_spacing);
+  if (!cache_dir.empty()) {
+    cache_file_ = basis_cache_file(cache_dir, key);
+    CachedBasis cached = read_basis_cache(cache_file_, key, model.n_points, settings.size);
+    if (cached.basis) {
+      basis_ = std::move(*cached.basis);
+      from_cache_ = true;
+    } else if (!cached.missing) {
+      cache_note_ = fmt::format("the kept basis {} was not used ({}): made again", cache_file_, cached.why);
+    }
+  }
+  if (!from_cache_) {
+    if (spec.reduction.basis_spacing > 0) {
+      // the basis of a coarser sampling, carried to the points: the set-up's factor tens of times smaller
+      const Model coarse = coarse_model(model, spec.reduction.basis_spacing);
+      Workspace coarse_ws(coarse, ws.n_threads());
+      if (coarse.f_ext.squaredNorm() > 0) settings.loads = {coarse.f_ext};
+      basis_ = carry_basis(build_modal_basis(coarse, settings, coarse_ws), coarse, model);
+    } else {
+      if (model.f_ext.size() == 3 * model.n_points && model.f_ext.squaredNorm() > 0) settings.loads = {model.f_ext};
+      basis_ = build_modal_basis(model, settings, ws);
+    }
+    if (!cache_file_.empty()) {
+      // a basis that cannot be kept (a full disk, a folder without rights) costs the next run its set-up, not
+      // this run its result
+      try {
+        write_basis_cache(cache_file_, key, basis_);
+      } catch (const Error& e) {
+        cache_note_ = fmt::format("the basis was not kept: {}", e.what());
+        cache_file_.clear();
+      }
+    }
   }
   polynomial_ = std::make_unique<SvkPolynomial>(model, basis_.U, ws);
   Eigen::VectorXd external = Eigen::VectorXd::Zero(spec.reduction.modes);
   if (model.f_ext.size() == 3 * model.n_points)
     external = basis_.U.transpose() * Eigen::Map<const Eigen::VectorXd>(model.f_ext.data(), model.f_ext.size());
   integrator_ = std::make_unique<ReducedIntegrator>(*polynomial_, std::move(external), model.material.damping);
+  // the reduced model's lowest natural frequency: its mass is the identity (U is mass-orthonormal), so omega^2 are
+  // the eigenvalues of its rest stiffness
+  const Eigen::VectorXd omega2 =
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(polynomial_->rest_stiffness(), Eigen::EigenvaluesOnly)
+          .eigenvalues();
+  first_frequency_hz_ = std::sqrt(std::max(omega2.minCoeff(), 0.0)) / (2 * std::numbers::pi);
+  // the bound of the points' displacement gradients per unit |q| (count_inverted): one stencil pass per vector
+  {
+    Eigen::VectorXd c2 = Eigen::VectorXd::Zero(model.n_points);
+    Points u(3, model.n_points);
+    for (Eigen::Index k = 0; k < basis_.U.cols(); ++k) {
+      throw_if_stop_requested("reduction (the basis' gradients)");
+      Eigen::Map<Eigen::VectorXd>(u.data(), u.size()) = basis_.U.col(k);
+      for (index_t p = 0; p < model.stencil_end(); ++p) c2[p] += displacement_gradient(model, u, p).squaredNorm();
+    }
+    gradient_bound_ = std::sqrt(c2.maxCoeff());
+  }
   reduced_.q = Eigen::VectorXd::Zero(spec.reduction.modes);
   reduced_.v = Eigen::VectorXd::Zero(spec.reduction.modes);
   setup_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-StepReport ReducedSolver::step(const Model& model, State& state, Workspace& /*ws*/, DynamicForces* forces) {
+index_t ReducedSolver::count_inverted(const Model& model, const State& state, Workspace& ws) {
+  if (reduced_.q.norm() * gradient_bound_ < 1) {  // |G_p| < 1 at every point: det(I + G_p) > 0
+    steps_since_count_ = exact_count_every;
+    return last_count_ = 0;
+  }
+  if (++steps_since_count_ < exact_count_every) return last_count_;
+  steps_since_count_ = 0;
+  return last_count_ = pointhaptics::count_inverted(model, state.u, ws);
+}
+
+StepReport ReducedSolver::step(const Model& model, State& state, Workspace& ws, DynamicForces* forces) {
   StepReport report;
   if (forces) {
     report.status = StepStatus::FAILED;
@@ -74,8 +133,14 @@ StepReport ReducedSolver::step(const Model& model, State& state, Workspace& /*ws
                           solved.residual);
     return report;
   }
-  Eigen::Map<Eigen::VectorXd>(state.u.data(), state.u.size()).noalias() = basis_.U * reduced_.q;
-  Eigen::Map<Eigen::VectorXd>(state.velocity.data(), state.velocity.size()).noalias() = basis_.U * reduced_.v;
+  // u = U q and v = U q' on the step's threads, each its rows of U (both products are most of a step's time)
+  Eigen::Map<Eigen::VectorXd> u(state.u.data(), state.u.size()), v(state.velocity.data(), state.velocity.size());
+  ws.for_each_chunk([&](int chunk) {
+    const Eigen::Index begin = 3 * static_cast<Eigen::Index>(ws.chunk_begin(chunk));
+    const Eigen::Index rows = 3 * static_cast<Eigen::Index>(ws.chunk_end(chunk)) - begin;
+    u.segment(begin, rows).noalias() = basis_.U.middleRows(begin, rows) * reduced_.q;
+    v.segment(begin, rows).noalias() = basis_.U.middleRows(begin, rows) * reduced_.v;
+  });
   (void)model;
   return report;
 }

@@ -8,6 +8,7 @@
 #include <pointhaptics/solvers/solver.hpp>
 
 #include <memory>
+#include <string>
 
 namespace pointhaptics {
 
@@ -23,6 +24,23 @@ class ReducedSolver final : public Solver {
   const ModalBasis& basis() const { return basis_; }
   const SvkPolynomial& polynomial() const { return *polynomial_; }
   double setup_s() const { return setup_s_; }
+  /// the file the basis was read from or kept in (`[reduction] cache`; empty: none), whether it was read from
+  /// it, and what went wrong with the file when something did (the run goes on: the basis is made, or not kept)
+  const std::string& cache_file() const { return cache_file_; }
+  bool from_cache() const { return from_cache_; }
+  const std::string& cache_note() const { return cache_note_; }
+  /// The inverted neighbourhoods at `state` (= U q), for the step's diagnostics. No force evaluation leaves
+  /// gradients in `ws` here, and a stencil pass costs about a step, so it answers by a bound first:
+  /// |G_p(q)|_2 <= |q| c_p, with c_p^2 = sum_k |G_pk|_F^2 over the basis vectors' gradients G_pk; while
+  /// |q| max c_p < 1 no det(I + G_p) can reach zero and the count is 0 without a pass. Beyond it (large
+  /// rotations pass it too), every point's gradient is computed from u at every `exact_count_every`-th step, the
+  /// last count standing in between. The run's summary counts exactly from the end state whatever the solver.
+  index_t count_inverted(const Model& model, const State& state, Workspace& ws) override;
+  static constexpr int exact_count_every = 16;
+  /// max_p c_p above, per unit of q
+  double gradient_bound() const { return gradient_bound_; }
+  /// the reduced model's lowest natural frequency about rest, Hz
+  double first_frequency_hz() const { return first_frequency_hz_; }
 
  private:
   SolverSpec spec_;
@@ -31,6 +49,12 @@ class ReducedSolver final : public Solver {
   std::unique_ptr<ReducedIntegrator> integrator_;
   ReducedState reduced_;
   double setup_s_ = 0;
+  std::string cache_file_, cache_note_;
+  bool from_cache_ = false;
+  double first_frequency_hz_ = 0;
+  double gradient_bound_ = 0;
+  int steps_since_count_ = exact_count_every;
+  index_t last_count_ = 0;
 };
 
 }  // namespace pointhaptics

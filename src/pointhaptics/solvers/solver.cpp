@@ -1,6 +1,7 @@
 #include <pointhaptics/solvers/solver.hpp>
 
 #include <pointhaptics/core/error.hpp>
+#include <pointhaptics/mechanics/inversion.hpp>
 #include <pointhaptics/solvers/explicit_solver.hpp>
 #include <pointhaptics/solvers/implicit_solver.hpp>
 #include <pointhaptics/solvers/static_solver.hpp>
@@ -23,6 +24,10 @@ NewtonSettings newton_settings(const SolverSpec& spec) {
     s.accept_at_budget = true;
   }
   return s;
+}
+
+index_t Solver::count_inverted(const Model& model, const State& /*state*/, Workspace& ws) {
+  return pointhaptics::count_inverted(model, ws);
 }
 
 std::unique_ptr<Solver> make_solver(const Model& model, const SolverSpec& spec, double stable_dt) {

@@ -80,6 +80,10 @@ class Solver {
   /// simulation's thread (the Cholesky preconditioner's refactorisation) is then taken up when it is ready
   /// instead of at a reproducible point.
   virtual void set_real_time(bool /*real_time*/) {}
+  /// The neighbourhoods inverted (det F <= 0) at `state`, the last step's result, for the step's diagnostics: by
+  /// default those of the gradients its force evaluations left in `ws` (mechanics/inversion.hpp); a solver that
+  /// leaves none there answers from `state` itself.
+  virtual index_t count_inverted(const Model& model, const State& state, Workspace& ws);
 };
 
 /// The solver a spec asks for, for `model`. `stable_dt`: explicit only, the stable step if already known

@@ -436,7 +436,7 @@ void ModelSimulation::check_finite(StepReport& report) const {
 
 void ModelSimulation::count_inverted_neighbourhoods() {
   StepDiagnostics& d = diagnostics_;
-  d.inverted = count_inverted(model_, ws_);
+  d.inverted = solver_impl_->count_inverted(model_, state_, ws_);
   d.inverted_steps += d.inverted > 0;
 }
 

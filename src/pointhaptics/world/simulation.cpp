@@ -551,18 +551,23 @@ RunSummary Simulation::summary() {
   s.solver_kind = std::string(to_string(sim.solver().kind));
   if (const auto* reduced = dynamic_cast<const ReducedSolver*>(&sim.solver_impl())) {
     const ModalBasis& b = reduced->basis();
-    s.reduction = {static_cast<int>(b.U.cols()),
-                   b.linear_modes,
-                   b.derivatives,
-                   b.load_vectors,
-                   sim.solver().reduction.basis_spacing,
-                   reduced->setup_s(),
-                   b.factorise_s,
-                   b.modes_s,
-                   b.derivatives_s,
-                   reduced->polynomial().build_s(),
-                   b.factor_bytes,
-                   reduced->polynomial().bytes()};
+    ReductionSummary& r = s.reduction;
+    r.modes = static_cast<int>(b.U.cols());
+    r.linear_modes = b.linear_modes;
+    r.derivatives = b.derivatives;
+    r.load_vectors = b.load_vectors;
+    r.basis_spacing = sim.solver().reduction.basis_spacing;
+    r.setup_s = reduced->setup_s();
+    r.factorise_s = b.factorise_s;
+    r.modes_s = b.modes_s;
+    r.derivatives_s = b.derivatives_s;
+    r.polynomial_s = reduced->polynomial().build_s();
+    r.factor_bytes = b.factor_bytes;
+    r.tables_bytes = reduced->polynomial().bytes();
+    r.first_frequency_hz = reduced->first_frequency_hz();
+    r.cache_file = reduced->cache_file();
+    r.from_cache = reduced->from_cache();
+    r.cache_note = reduced->cache_note();
   }
   s.converged = state.u.allFinite() && !d.failed && interrupted_step_.empty();
   s.failure = interrupted_step_.empty() ? d.failure : interrupted_step_;
