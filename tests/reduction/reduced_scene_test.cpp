@@ -1,7 +1,11 @@
 // Tests for [reduction] in a scene: the seed's cantilever (St. Venant-Kirchhoff, tip traction) solved statically and
 // stepped implicitly in a reduced basis agrees with the full point model; what a reduced model does not do yet is
 // refused by name at the table's line.
+#include <pointhaptics/mechanics/deformation.hpp>
+#include <pointhaptics/mechanics/inversion.hpp>
 #include <pointhaptics/pointhaptics.hpp>
+#include <pointhaptics/reduction/reduced_solver.hpp>
+#include <pointhaptics/world/model_simulation.hpp>
 
 #include "support/test_scenes.hpp"
 
@@ -83,6 +87,30 @@ TEST(ReducedScene, ImplicitStepsSettleOnTheFullModelsSag) {
   EXPECT_GT(json.at("reduction").at("setup_s").get<double>(), 0);
   EXPECT_FALSE(nlohmann::json::parse(result_json(full.model(), full.state(), full.summary())).contains("reduction"));
   EXPECT_NEAR(tip_deflection(sim), tip_deflection(full), 0.02 * tip_deflection(full));
+}
+
+TEST(ReducedScene, TheGradientBoundHoldsAtEveryPointSoNoInvertedPointIsMissed) {
+  // count_inverted answers 0 without a stencil pass while |q| max_p c_p < 1: that must bound every point's |G_p|
+  for (const char* total : {"-0.01", "-0.2"}) {
+    std::string text = reduced("static");
+    text.replace(text.find("total = [0.0, -0.01, 0.0]"), std::string("total = [0.0, -0.01, 0.0]").size(),
+                 fmt::format("total = [0.0, {}, 0.0]", total));
+    Scene scene = parse_scene(text);
+    ModelSimulation sim(build_scene_model(scene), scene.solver, 2);
+    sim.step();
+    const Model& model = sim.model();
+    const Points& u = sim.state().u;
+    double q2 = 0;  // |q|^2 = u^T M u: the basis is mass-orthonormal
+    for (index_t i = 0; i < model.n_points; ++i) q2 += model.mass[i] * u.col(i).squaredNorm();
+    auto& solver = dynamic_cast<ReducedSolver&>(sim.solver_impl());
+    double largest = 0;
+    for (index_t p = 0; p < model.stencil_end(); ++p)
+      largest = std::max(largest, displacement_gradient(model, u, p).operatorNorm());
+    EXPECT_GT(largest, 0);
+    EXPECT_LE(largest, std::sqrt(q2) * solver.gradient_bound() * (1 + 1e-9)) << "total " << total;
+    // and the count it gives is the state's
+    EXPECT_EQ(solver.count_inverted(model, sim.state(), sim.workspace()), count_inverted(model, u, sim.workspace()));
+  }
 }
 
 TEST(ReducedScene, WhatIsNotReducedYetIsANamedError) {

@@ -172,6 +172,7 @@ class ModelSimulation {
   const SolverSpec& solver() const { return solver_; }
   /// The solver that steps the model (a ReducedSolver with [reduction]).
   const Solver& solver_impl() const { return *solver_impl_; }
+  Solver& solver_impl() { return *solver_impl_; }
   /// The explicit stable step (computed at construction for explicit steps, else when first asked; from the
   /// simulation's own thread).
   double stable_dt() const;
