@@ -114,8 +114,11 @@ void print_summary(ph::Simulation& sim, const ph::RunSummary& s, double setup_s)
   // the inertia (and a probe's push), not an error
   fmt::print("energy          strain {:.4g} J, kinetic {:.4g} J\n", s.strain_energy, s.kinetic_energy);
   fmt::print("out-of-balance  {:.3g} of the load{}\n", s.residual,
-             s.solver_kind == "static" ? std::string(" (the equilibrium's residual)")
-                                       : std::string(" (in dynamics the inertia and any probe force, not an error)"));
+             s.reduction.modes > 0 && s.solver_kind == "static"
+                 ? std::string(" (the full model's at u = U q: a reduced model balances the forces projected on its "
+                               "basis, not every point's)")
+             : s.solver_kind == "static" ? std::string(" (the equilibrium's residual)")
+                                         : std::string(" (in dynamics the inertia and any probe force, not an error)"));
   for (size_t g = 0; g < s.reactions.size(); ++g)
     fmt::print("reaction        {}: ({:.4g}, {:.4g}, {:.4g}) N on {} points\n", m.fixed_groups[g].name,
                s.reactions[g][0], s.reactions[g][1], s.reactions[g][2], m.fixed_groups[g].points.size());

@@ -105,6 +105,10 @@ int render_screenshot(const ViewerOptions& o) {
       o.probe == "auto" ? (scripted ? ProbeSource::SCRIPT : ProbeSource::MOUSE) : probe_source_of(o.probe);
   auto prepared = prepare(scene, source, o.threads);
   const DisplayFrame frame = simulate_frame(*prepared, o.time);
+  // a picture of a run that failed would show a state that is no result
+  if (prepared->simulation->diagnostics().failed)
+    throw Error(fmt::format("view: {}: the run failed at t = {:.4g} s: {}", scene.path, frame.time,
+                            prepared->simulation->diagnostics().failure));
 
   HeadlessContext context(o.width, o.height);
   ImGuiContextGuard imgui;

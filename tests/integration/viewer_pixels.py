@@ -191,6 +191,16 @@ if mode == "headless":
     r = subprocess.run([exe, "view", os.path.join(out, "missing.toml"), "--screenshot", png0], capture_output=True,
                        text=True, env=env)
     assert r.returncode == 1 and "missing.toml" in r.stderr, r.stderr
+    # a reduced model takes no contact yet: the viewer (whose probe touches) names it instead of showing a run
+    # whose first step failed
+    reduced = os.path.join(out, "reduced.toml")
+    with open(os.path.join(scenes, "cantilever_static.toml")) as f:
+        text = f.read()
+    with open(reduced, "w") as f:
+        f.write(text + '\n[reduction]\nmodes = 12\ncache = "none"\n')
+    r = subprocess.run([exe, "view", reduced, "--screenshot", png0, "--time", "0.1"], capture_output=True, text=True,
+                       env=env)
+    assert r.returncode == 1 and "[reduction]" in r.stderr, r.stderr
     print("headless screenshots: ok")
     sys.exit(0)
 

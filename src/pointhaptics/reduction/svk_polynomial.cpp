@@ -5,9 +5,6 @@
 #include <pointhaptics/mechanics/tangent.hpp>
 
 #include <fmt/format.h>
-#include <oneapi/tbb/blocked_range.h>
-#include <oneapi/tbb/enumerable_thread_specific.h>
-#include <oneapi/tbb/parallel_for.h>
 
 #include <chrono>
 #include <vector>
@@ -83,49 +80,53 @@ SvkPolynomial::SvkPolynomial(const Model& model, const Eigen::MatrixXd& U, Works
     A_ = 0.5 * (A_ + A_.transpose()).eval();
   }
 
-  // the Gram tables of e and h over the points, in blocks of points, per thread
+  // the Gram tables of e and h over the points, in blocks of points, per chunk of the workspace's (fixed point
+  // ranges, summed in their order: the tables are the same to the bit whatever the threads did)
   struct Sums {
     Eigen::MatrixXd hh, eh;
   };
-  tbb::enumerable_thread_specific<Sums> sums([&] {
-    return Sums{Eigen::MatrixXd::Zero(pairs_, pairs_), Eigen::MatrixXd::Zero(r_, pairs_)};
-  });
+  std::vector<Sums> sums(static_cast<std::size_t>(ws.n_threads()),
+                         Sums{Eigen::MatrixXd::Zero(pairs_, pairs_), Eigen::MatrixXd::Zero(r_, pairs_)});
   constexpr index_t block = 64;
   const index_t n_stencils = model.stencil_end();
-  tbb::parallel_for(tbb::blocked_range<index_t>(0, n_stencils, block), [&](const tbb::blocked_range<index_t>& range) {
-    throw_if_stop_requested("reduction (the polynomial's tables)");
-    Sums& s = sums.local();
-    const index_t n = range.end() - range.begin();
-    Eigen::MatrixXd e_hat(6 * n, r_), h_hat(6 * n, pairs_);
-    Eigen::Matrix<double, 9, Eigen::Dynamic> G(9, r_);  // vec(G_k) per column (column-major 3x3)
-    for (index_t i = range.begin(); i < range.end(); ++i) {
-      G.setZero();
-      for (index_t e = model.neighbours.begin(i); e < model.neighbours.end(i); ++e) {
-        const index_t j = model.neighbours.index[e];
-        const auto du = (U.middleRows<3>(3 * j) - U.middleRows<3>(3 * i)).eval();  // 3 x r
-        for (int c = 0; c < 3; ++c) G.middleRows<3>(3 * c) += model.d(c, e) * du;
-      }
-      const double scale = std::sqrt(model.stiffness_volume[i]);
-      const index_t row = 6 * (i - range.begin());
-      for (int k = 0; k < r_; ++k) {
-        const auto g = [&](int a, int b) { return G(3 * b + a, k); };  // (G_k)_ab
-        Eigen::Matrix<double, 6, 1> voigt;
-        voigt << g(0, 0), g(1, 1), g(2, 2), 0.5 * (g(0, 1) + g(1, 0)), 0.5 * (g(1, 2) + g(2, 1)),
-            0.5 * (g(2, 0) + g(0, 2));
-        e_hat.block<6, 1>(row, k) = scale * metric(voigt);
-      }
-      // h_kl = sym(G_k^T G_l): (G_k^T G_l)_ab = column a of G_k . column b of G_l
-      for (int k = 0; k < r_; ++k)
-        for (int l = k; l < r_; ++l) {
-          const auto dot = [&](int a, int b) { return G.block<3, 1>(3 * a, k).dot(G.block<3, 1>(3 * b, l)); };
-          Eigen::Matrix<double, 6, 1> voigt;
-          voigt << dot(0, 0), dot(1, 1), dot(2, 2), 0.5 * (dot(0, 1) + dot(1, 0)), 0.5 * (dot(1, 2) + dot(2, 1)),
-              0.5 * (dot(2, 0) + dot(0, 2));
-          h_hat.block<6, 1>(row, pair(k, l)) = scale * metric(voigt);
+  ws.for_each_chunk([&](int chunk) {
+    Sums& s = sums[static_cast<std::size_t>(chunk)];
+    const index_t chunk_end = std::min(ws.chunk_end(chunk), n_stencils);
+    for (index_t first = ws.chunk_begin(chunk); first < chunk_end; first += block) {
+      throw_if_stop_requested("reduction (the polynomial's tables)");
+      const index_t last = std::min(first + block, chunk_end);
+      const index_t n = last - first;
+      Eigen::MatrixXd e_hat(6 * n, r_), h_hat(6 * n, pairs_);
+      Eigen::Matrix<double, 9, Eigen::Dynamic> G(9, r_);  // vec(G_k) per column (column-major 3x3)
+      for (index_t i = first; i < last; ++i) {
+        G.setZero();
+        for (index_t e = model.neighbours.begin(i); e < model.neighbours.end(i); ++e) {
+          const index_t j = model.neighbours.index[e];
+          const auto du = (U.middleRows<3>(3 * j) - U.middleRows<3>(3 * i)).eval();  // 3 x r
+          for (int c = 0; c < 3; ++c) G.middleRows<3>(3 * c) += model.d(c, e) * du;
         }
+        const double scale = std::sqrt(model.stiffness_volume[i]);
+        const index_t row = 6 * (i - first);
+        for (int k = 0; k < r_; ++k) {
+          const auto g = [&](int a, int b) { return G(3 * b + a, k); };  // (G_k)_ab
+          Eigen::Matrix<double, 6, 1> voigt;
+          voigt << g(0, 0), g(1, 1), g(2, 2), 0.5 * (g(0, 1) + g(1, 0)), 0.5 * (g(1, 2) + g(2, 1)),
+              0.5 * (g(2, 0) + g(0, 2));
+          e_hat.block<6, 1>(row, k) = scale * metric(voigt);
+        }
+        // h_kl = sym(G_k^T G_l): (G_k^T G_l)_ab = column a of G_k . column b of G_l
+        for (int k = 0; k < r_; ++k)
+          for (int l = k; l < r_; ++l) {
+            const auto dot = [&](int a, int b) { return G.block<3, 1>(3 * a, k).dot(G.block<3, 1>(3 * b, l)); };
+            Eigen::Matrix<double, 6, 1> voigt;
+            voigt << dot(0, 0), dot(1, 1), dot(2, 2), 0.5 * (dot(0, 1) + dot(1, 0)), 0.5 * (dot(1, 2) + dot(2, 1)),
+                0.5 * (dot(2, 0) + dot(0, 2));
+            h_hat.block<6, 1>(row, pair(k, l)) = scale * metric(voigt);
+          }
+      }
+      s.hh.selfadjointView<Eigen::Lower>().rankUpdate(h_hat.transpose());
+      s.eh.noalias() += e_hat.transpose() * h_hat;
     }
-    s.hh.selfadjointView<Eigen::Lower>().rankUpdate(h_hat.transpose());
-    s.eh.noalias() += e_hat.transpose() * h_hat;
   });
   Eigen::MatrixXd hh = Eigen::MatrixXd::Zero(pairs_, pairs_), eh = Eigen::MatrixXd::Zero(r_, pairs_);
   for (const Sums& s : sums) {
