@@ -20,7 +20,8 @@ namespace pointhaptics {
 namespace {
 
 // the file: magic, then the header and the numbers in this machine's byte order, then the FNV-1a hash of all the
-// bytes between the magic and it. Version 1; a change of layout or of what the key covers changes the magic.
+// bytes between the magic and it. Version 1. The magic is part of the key too: a change of the layout, of what the
+// key covers or of how the basis is made (reduction/modal_basis.cpp) must change it, so that no older file is read.
 constexpr std::string_view magic = "PHBASIS1";
 
 class Fnv1a {

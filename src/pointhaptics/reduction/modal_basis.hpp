@@ -36,6 +36,7 @@ struct ModalBasis {
 /// of the exact tangent (exact for St. Venant-Kirchhoff, whose tangent is quadratic in u). Throws Error when the
 /// model has fewer free degrees of freedom than r + 2, nothing held (the rest tangent is singular), or the
 /// eigen-solver does not converge; Interrupted on a stop request.
+/// (A change to how the basis is made must change basis_cache.cpp's magic: files kept by older code are then not read.)
 ModalBasis build_modal_basis(const Model& model, const ModalBasisSettings& settings, Workspace& ws);
 
 /// A coarser sampling of `model`'s object for its basis (`[reduction] basis_spacing`): the points binned in boxes of
