@@ -1,8 +1,6 @@
 #include <pointhaptics/reduction/reduced_solver.hpp>
 
 #include <pointhaptics/core/error.hpp>
-#include <pointhaptics/core/run_control.hpp>
-#include <pointhaptics/mechanics/deformation.hpp>
 #include <pointhaptics/mechanics/inversion.hpp>
 #include <pointhaptics/reduction/basis_cache.hpp>
 
@@ -16,22 +14,11 @@
 
 namespace pointhaptics {
 
-ReducedSolver::ReducedSolver(const Model& model, const SolverSpec& spec, Workspace& ws) : spec_(spec) {
-  const auto start = std::chrono::steady_clock::now();
-  if (spec.kind == SolverKind::EXPLICIT)
-    throw Error(
-        "reduction: needs solver.kind = \"implicit\" or \"static\" (a reduced model is stepped by Newton in "
-        "its coordinates; explicit steps would gain nothing)");
-  for (const FixedGroup& group : model.fixed_groups)
-    if (group.displacement.squaredNorm() > 0)
-      throw Error(
-          fmt::format("reduction: {} moves its points (displacement); a reduced model's held points stay at "
-                      "rest (not yet otherwise)",
-                      group.name));
+void ReducedSolver::make_or_read_basis(const Model& model, Workspace& ws) {
   ModalBasisSettings settings;
-  settings.size = spec.reduction.modes;
-  const std::string cache_dir = spec.reduction.cache == "auto" ? default_basis_cache_dir() : spec.reduction.cache;
-  const std::uint64_t key = cache_dir.empty() ? 0 : basis_key(model, settings, spec.reduction.basis_spacing);
+  settings.size = spec_.reduction.modes;
+  const std::string cache_dir = spec_.reduction.cache == "auto" ? default_basis_cache_dir() : spec_.reduction.cache;
+  const std::uint64_t key = cache_dir.empty() ? 0 : basis_key(model, settings, spec_.reduction.basis_spacing);
   if (!cache_dir.empty()) {
     cache_file_ = basis_cache_file(cache_dir, key);
     CachedBasis cached = read_basis_cache(cache_file_, key, model.n_points, settings.size);
@@ -43,9 +30,9 @@ ReducedSolver::ReducedSolver(const Model& model, const SolverSpec& spec, Workspa
     }
   }
   if (!from_cache_) {
-    if (spec.reduction.basis_spacing > 0) {
+    if (spec_.reduction.basis_spacing > 0) {
       // the basis of a coarser sampling, carried to the points: the set-up's factor tens of times smaller
-      const Model coarse = coarse_model(model, spec.reduction.basis_spacing);
+      const Model coarse = coarse_model(model, spec_.reduction.basis_spacing);
       Workspace coarse_ws(coarse, ws.n_threads());
       if (coarse.f_ext.squaredNorm() > 0) settings.loads = {coarse.f_ext};
       basis_ = carry_basis(build_modal_basis(coarse, settings, coarse_ws), coarse, model);
@@ -64,6 +51,21 @@ ReducedSolver::ReducedSolver(const Model& model, const SolverSpec& spec, Workspa
       }
     }
   }
+}
+
+ReducedSolver::ReducedSolver(const Model& model, const SolverSpec& spec, Workspace& ws) : spec_(spec) {
+  const auto start = std::chrono::steady_clock::now();
+  if (spec.kind == SolverKind::EXPLICIT)
+    throw Error(
+        "reduction: needs solver.kind = \"implicit\" or \"static\" (a reduced model is stepped by Newton in "
+        "its coordinates; explicit steps would gain nothing)");
+  for (const FixedGroup& group : model.fixed_groups)
+    if (group.displacement.squaredNorm() > 0)
+      throw Error(
+          fmt::format("reduction: {} moves its points (displacement); a reduced model's held points stay at "
+                      "rest (not yet otherwise)",
+                      group.name));
+  make_or_read_basis(model, ws);
   polynomial_ = std::make_unique<SvkPolynomial>(model, basis_.U, ws);
   Eigen::VectorXd external = Eigen::VectorXd::Zero(spec.reduction.modes);
   if (model.f_ext.size() == 3 * model.n_points)
@@ -75,24 +77,13 @@ ReducedSolver::ReducedSolver(const Model& model, const SolverSpec& spec, Workspa
       Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(polynomial_->rest_stiffness(), Eigen::EigenvaluesOnly)
           .eigenvalues();
   first_frequency_hz_ = std::sqrt(std::max(omega2.minCoeff(), 0.0)) / (2 * std::numbers::pi);
-  // the bound of the points' displacement gradients per unit |q| (count_inverted): one stencil pass per vector
-  {
-    Eigen::VectorXd c2 = Eigen::VectorXd::Zero(model.n_points);
-    Points u(3, model.n_points);
-    for (Eigen::Index k = 0; k < basis_.U.cols(); ++k) {
-      throw_if_stop_requested("reduction (the basis' gradients)");
-      Eigen::Map<Eigen::VectorXd>(u.data(), u.size()) = basis_.U.col(k);
-      for (index_t p = 0; p < model.stencil_end(); ++p) c2[p] += displacement_gradient(model, u, p).squaredNorm();
-    }
-    gradient_bound_ = std::sqrt(c2.maxCoeff());
-  }
   reduced_.q = Eigen::VectorXd::Zero(spec.reduction.modes);
   reduced_.v = Eigen::VectorXd::Zero(spec.reduction.modes);
   setup_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 index_t ReducedSolver::count_inverted(const Model& model, const State& state, Workspace& ws) {
-  if (reduced_.q.norm() * gradient_bound_ < 1) {  // |G_p| < 1 at every point: det(I + G_p) > 0
+  if (reduced_.q.norm() * polynomial_->gradient_bound() < 1) {  // |G_p| < 1 at every point: det(I + G_p) > 0
     steps_since_count_ = exact_count_every;
     return last_count_ = 0;
   }

@@ -37,12 +37,15 @@ class ReducedSolver final : public Solver {
   /// last count standing in between. The run's summary counts exactly from the end state whatever the solver.
   index_t count_inverted(const Model& model, const State& state, Workspace& ws) override;
   static constexpr int exact_count_every = 16;
-  /// max_p c_p above, per unit of q
-  double gradient_bound() const { return gradient_bound_; }
+  /// max_p c_p above, per unit of q (SvkPolynomial::gradient_bound)
+  double gradient_bound() const { return polynomial_->gradient_bound(); }
   /// the reduced model's lowest natural frequency about rest, Hz
   double first_frequency_hz() const { return first_frequency_hz_; }
 
  private:
+  /// The basis (basis_): read from the cache when `spec_.reduction.cache` names one and a good file is there,
+  /// else made (on the points, or on a coarser sampling and carried) and kept there; sets the cache_* members.
+  void make_or_read_basis(const Model& model, Workspace& ws);
   SolverSpec spec_;
   ModalBasis basis_;
   std::unique_ptr<SvkPolynomial> polynomial_;
@@ -52,7 +55,6 @@ class ReducedSolver final : public Solver {
   std::string cache_file_, cache_note_;
   bool from_cache_ = false;
   double first_frequency_hz_ = 0;
-  double gradient_bound_ = 0;
   int steps_since_count_ = exact_count_every;
   index_t last_count_ = 0;
 };

@@ -6,7 +6,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <vector>
 
 namespace pointhaptics {
@@ -84,9 +86,10 @@ SvkPolynomial::SvkPolynomial(const Model& model, const Eigen::MatrixXd& U, Works
   // ranges, summed in their order: the tables are the same to the bit whatever the threads did)
   struct Sums {
     Eigen::MatrixXd hh, eh;
+    double largest_gradients = 0;  ///< max_p sum_k |G_pk|_F^2 (gradient_bound())
   };
   std::vector<Sums> sums(static_cast<std::size_t>(ws.n_threads()),
-                         Sums{Eigen::MatrixXd::Zero(pairs_, pairs_), Eigen::MatrixXd::Zero(r_, pairs_)});
+                         Sums{Eigen::MatrixXd::Zero(pairs_, pairs_), Eigen::MatrixXd::Zero(r_, pairs_), 0.0});
   constexpr index_t block = 64;
   const index_t n_stencils = model.stencil_end();
   ws.for_each_chunk([&](int chunk) {
@@ -105,6 +108,7 @@ SvkPolynomial::SvkPolynomial(const Model& model, const Eigen::MatrixXd& U, Works
           const auto du = (U.middleRows<3>(3 * j) - U.middleRows<3>(3 * i)).eval();  // 3 x r
           for (int c = 0; c < 3; ++c) G.middleRows<3>(3 * c) += model.d(c, e) * du;
         }
+        s.largest_gradients = std::max(s.largest_gradients, G.squaredNorm());
         const double scale = std::sqrt(model.stiffness_volume[i]);
         const index_t row = 6 * (i - first);
         for (int k = 0; k < r_; ++k) {
@@ -132,6 +136,7 @@ SvkPolynomial::SvkPolynomial(const Model& model, const Eigen::MatrixXd& U, Works
   for (const Sums& s : sums) {
     hh += s.hh;
     eh += s.eh;
+    gradient_bound_ = std::max(gradient_bound_, std::sqrt(s.largest_gradients));
   }
   hh = hh.selfadjointView<Eigen::Lower>();
 

@@ -31,6 +31,9 @@ class SvkPolynomial {
                 double* energy = nullptr) const;
   /// The rest stiffness U^T K U.
   const Eigen::MatrixXd& rest_stiffness() const { return A_; }
+  /// max over the points of c_p = sqrt(sum_k |G_pk|_F^2), the basis vectors' displacement gradients there: every
+  /// point's gradient at u = U q is at most |q| c_p (Cauchy-Schwarz), which bounds inversion (reduced_solver.hpp)
+  double gradient_bound() const { return gradient_bound_; }
   double build_s() const { return build_s_; }
   /// the tables' memory, bytes
   double bytes() const;
@@ -43,6 +46,7 @@ class SvkPolynomial {
   Eigen::MatrixXd b_;  ///< pairs x r: b_klm in row pair(k, l), column m
   Eigen::MatrixXd c_;  ///< pairs x pairs: c_klmn in row pair(k, l), column pair(m, n)
   double build_s_ = 0;
+  double gradient_bound_ = 0;
   // scratch (mutable: evaluating is logically const and allocates nothing)
   mutable Eigen::VectorXd w_, bq_, cq_;
   mutable Eigen::MatrixXd B_, C_;
