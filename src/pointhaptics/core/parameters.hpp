@@ -145,6 +145,9 @@ struct ReductionSpec {
   /// the folder the basis is kept in and read back from (reduction/basis_cache.hpp): "auto" for the user's cache
   /// folder, empty for none (a scene's default is "auto")
   std::string cache;
+  /// a tool's contact region in full resolution (reduction/contact_patch.hpp): the points the tools act on grown by
+  /// this many neighbour rings
+  int contact_rings = 3;
   int line = 0;  ///< the table's line in the scene file (0: none), for errors
 };
 

@@ -166,7 +166,10 @@ std::string result_json(const Model& model, const State& state, const RunSummary
                         {"first_frequency_hz", r.first_frequency_hz},
                         {"cache_file", r.cache_file},
                         {"from_cache", r.from_cache},
-                        {"cache_note", r.cache_note}};
+                        {"cache_note", r.cache_note},
+                        {"contact_points", r.contact_points},
+                        {"contact_patches", r.contact_patches},
+                        {"contact_iterations", r.contact_iterations}};
   }
   // without levels of detail every point is simulated
   const LodSummary& l = s.lod;

@@ -95,6 +95,9 @@ struct ReductionSummary {
   std::string cache_file;         ///< where the basis was read from or kept (empty: not kept)
   bool from_cache = false;  ///< the basis was read from cache_file (the set-up's factor, modes and derivatives skipped)
   std::string cache_note;   ///< what went wrong with the cache file, when something did
+  /// a tool's contact region in full resolution (reduction/contact_patch.hpp): the most points it had free, the
+  /// times it was chosen anew, and its own Newton iterations
+  long long contact_points = 0, contact_patches = 0, contact_iterations = 0;
 };
 
 struct RunSummary {

@@ -470,6 +470,11 @@ void read_reduction(TableReader& r, const Context& ctx, ReductionSpec& s) {
   if (modes < 1 || modes > 200) r.fail_at(*node, "modes", "must lie in [1, 200]");
   s.modes = static_cast<int>(modes);
   s.basis_spacing = r.number("basis_spacing", 0.0, positive_up_to(1e3), "must lie in (0, 1e3] (m)");
+  if (const auto rings = r.find("contact_rings")) {
+    const long long n = r.integer("contact_rings", s.contact_rings);
+    if (n < 1 || n > 20) r.fail_at(*rings, "contact_rings", "must lie in [1, 20] (neighbour rings)");
+    s.contact_rings = static_cast<int>(n);
+  }
   // the basis' source and the forces' evaluation: one of each is built so far, the others are named
   if (r.choice("basis", "modal", {"modal", "snapshots"}) != "modal")
     r.fail_at(*r.find("basis"), "basis",
@@ -1249,9 +1254,9 @@ Scene parse_scene(std::string_view text, const std::string& name, const std::str
     // what a reduced model does not do yet (issue 49): each named, at the [reduction] table
     const std::pair<bool, const char*> not_yet[] = {
         {scene.solver.kind == SolverKind::EXPLICIT, "needs solver.kind = \"implicit\" or \"static\""},
-        {scene.probe.present || !scene.tools.empty() || !scene.other_hands.empty(),
-         "not yet with a [probe] or [[tool]] tables (the contact region in full, coupled to the reduced rest, is "
-         "issue 49's next part)"},
+        {scene.probe.held() || scene.probe.cut || scene.probe.grasper || scene.probe.grab || !scene.tools.empty(),
+         "a device's probe pushing (mode = \"push\") is coupled to a reduced model; a held probe (position), a "
+         "blade, a grasper, grabbing and [[tool]] tables are not yet"},
         {!scene.obstacles.empty(), "not yet with [[obstacle]] tables"},
         {scene.bodies.size() > 1, "not yet with several [[object]] tables"},
         {scene.lod.present, "not yet with [lod]"},

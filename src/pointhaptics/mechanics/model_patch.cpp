@@ -31,29 +31,34 @@ std::vector<index_t> neighbourhood(const Model& model, const std::vector<index_t
   return found;
 }
 
-ModelPatch model_patch(const Model& model, const std::vector<index_t>& free) {
+ModelPatch model_patch(const Model& model, const std::vector<index_t>& free, int held_rings) {
+  if (held_rings < 2) throw Error(fmt::format("model patch: {} held rings (at least 2)", held_rings));
   const std::vector<index_t> inner = neighbourhood(model, free, 0);
-  // two rings: a free point's force comes from the stencils that reach it (one ring), and their hourglass
+  // two rings at least: a free point's force comes from the stencils that reach it (one ring), and their hourglass
   // pairs (energies/hourglass.hpp) reach one ring further. The outer ring is passive (Model::n_passive): its
   // stencils hold no free point, and its pairs' terms reach the free points only through the inner ring's
-  // gradients, which the inner ring's own stencils carry (a pair's energy is charged from both ends)
-  // (the outer ring grown from the inner one: its search is not made twice)
-  const std::vector<index_t> first_ring = neighbourhood(model, inner, 1), all = neighbourhood(model, first_ring, 1);
+  // gradients, which the inner ring's own stencils carry (a pair's energy is charged from both ends). Each ring
+  // is grown from the last (no search is made twice)
+  std::vector<std::vector<index_t>> within{inner};  // within[k]: the points at most k rings from the free ones
+  for (int ring = 1; ring <= held_rings; ++ring) within.push_back(neighbourhood(model, within.back(), 1));
   ModelPatch patch;
   patch.n_free = static_cast<index_t>(inner.size());
   patch.full_of = inner;
   std::vector<index_t> patch_of(static_cast<std::size_t>(model.n_points), -1);
   for (std::size_t k = 0; k < inner.size(); ++k) patch_of[static_cast<std::size_t>(inner[k])] = static_cast<index_t>(k);
-  for (const std::vector<index_t>* ring : {&first_ring, &all})
-    for (const index_t i : *ring)
+  std::vector<index_t> part_end{patch.n_free};  // the free points, then each ring, each in the model's order
+  for (int ring = 1; ring <= held_rings; ++ring) {
+    for (const index_t i : within[static_cast<std::size_t>(ring)])
       if (patch_of[static_cast<std::size_t>(i)] < 0) {
         patch_of[static_cast<std::size_t>(i)] = static_cast<index_t>(patch.full_of.size());
         patch.full_of.push_back(i);
       }
+    part_end.push_back(static_cast<index_t>(patch.full_of.size()));
+  }
   const index_t n = static_cast<index_t>(patch.full_of.size());
   Model& m = patch.model;
   m.n_points = n;
-  m.n_passive = static_cast<index_t>(all.size() - first_ring.size());
+  m.n_passive = part_end[part_end.size() - 1] - part_end[part_end.size() - 2];
   m.spacing = model.spacing;
   m.h = model.h;
   m.extent = model.extent;
@@ -88,16 +93,18 @@ ModelPatch model_patch(const Model& model, const std::vector<index_t>& free) {
         model.fixed[static_cast<std::size_t>(patch.full_of[static_cast<std::size_t>(k)])];
   if (!model.material_of.empty())
     for (const index_t i : patch.full_of) m.material_of.push_back(model.material_of[static_cast<std::size_t>(i)]);
-  // the pairs within the patch, each row sorted by the patch's index: the free points, the inner ring and the
-  // outer ring are each numbered in the model's order, so a row (in the model's order) is sorted by taking
-  // its free neighbours, then its inner ring's, then its outer ring's
-  const index_t inner_end = static_cast<index_t>(first_ring.size());
-  auto part_of = [&](index_t k) { return k < patch.n_free ? 0 : k < inner_end ? 1 : 2; };
+  // the pairs within the patch, each row sorted by the patch's index: the free points and each ring are numbered
+  // in the model's order, so a row (in the model's order) is sorted by taking its free neighbours, then its first
+  // ring's, and so on
+  auto part_of = [&](index_t k) {
+    return static_cast<std::size_t>(std::upper_bound(part_end.begin(), part_end.end(), k) - part_end.begin());
+  };
   std::vector<index_t> pair_of;  // patch pair -> the model's
   m.neighbours.offset.assign(1, 0);
   m.neighbours.index.reserve(static_cast<std::size_t>(n) *
                              static_cast<std::size_t>(model.neighbours.row_size(patch.full_of[0]) + 1));
-  std::array<std::vector<std::array<index_t, 2>>, 3> parts;  // (patch neighbour, model pair) per part of a row
+  // (patch neighbour, model pair) per part of a row
+  std::vector<std::vector<std::array<index_t, 2>>> parts(part_end.size());
   for (index_t k = 0; k < n; ++k) {
     const index_t i = patch.full_of[static_cast<std::size_t>(k)];
     for (index_t e = model.neighbours.begin(i); e < model.neighbours.end(i); ++e)

@@ -15,12 +15,16 @@ struct ModelPatch {
   index_t n_free = 0;            ///< the first n_free points: the free ones
 };
 
-/// The points `free` (each once; the model's held ones stay held) and, held, the two rings of neighbours around
-/// them: the stencils that reach a free point, and their hourglass pairs, are whole in the patch where it
-/// matters (a neighbour left out is held at zero), so the patch's tangent with the rings held is the model's
-/// tangent restricted to the free points (its principal submatrix: the eigenvalues interlace). Pairs to points outside the patch are left out; d_self,
-/// masses, volumes and materials are the model's. Throws Error for an index out of range.
-ModelPatch model_patch(const Model& model, const std::vector<index_t>& free);
+/// The points `free` (each once; the model's held ones stay held) and, held, `held_rings` rings of neighbours
+/// around them (at least two; the outermost passive): the stencils that reach a free point, and their hourglass
+/// pairs, are whole in the patch where it matters (a neighbour left out is held at zero), so the patch's tangent
+/// with the rings held is the model's tangent restricted to the free points (its principal submatrix: the
+/// eigenvalues interlace). The patch's energy changes with the free points as the model's does only from three
+/// rings: a pair's hourglass energy reads both ends' gradients, and with two the outer ring's (whose stencils are
+/// not whole) meets the inner ring's, which the free points move (reduction/contact_patch.hpp). Pairs to points
+/// outside the patch are left out; d_self, masses, volumes and materials are the model's. Throws Error for an
+/// index out of range.
+ModelPatch model_patch(const Model& model, const std::vector<index_t>& free, int held_rings = 2);
 
 /// The points within `rings` neighbour steps of `seeds` (the seeds included), each once, in increasing order.
 std::vector<index_t> neighbourhood(const Model& model, const std::vector<index_t>& seeds, int rings);

@@ -16,16 +16,17 @@ ReducedIntegrator::ReducedIntegrator(const SvkPolynomial& forces, Eigen::VectorX
   scaled_force_.resize(r);
   start_.resize(r);
   iterate_.resize(r);
+  coupling_gradient_.resize(r);
   hessian_.resize(r, r);  // llt_ is sized where it is made: an assigned LLT would copy its unset status
 }
 
 ReducedSolveReport ReducedIntegrator::minimise(Eigen::VectorXd& x, const Eigen::VectorXd& force, double inertia,
                                                const Eigen::VectorXd& anchor, double tolerance, int max_iterations,
-                                               bool stop_at_budget) {
+                                               bool stop_at_budget, ReducedCoupling* coupling) {
   ReducedSolveReport report;
   // the residual's scale: the load, or what the rest stiffness makes of the current coordinates, or inertia's
   trial_.noalias() = forces_.rest_stiffness() * x;
-  const double scale = std::max({force.norm(), trial_.norm(), inertia * (x - anchor).norm(), 1e-300});
+  double scale = std::max({force.norm(), trial_.norm(), inertia * (x - anchor).norm(), 1e-300});
   // Newton with backtracking (Armijo) on the objective, which each evaluation gives with the gradient: a step is
   // taken whole and halved only when the objective at its end says so, so a good step costs one evaluation
   double before = 0, slope = 0, alpha = 1;
@@ -33,6 +34,20 @@ ReducedSolveReport ReducedIntegrator::minimise(Eigen::VectorXd& x, const Eigen::
   for (int evaluations = 0; evaluations < 4 * max_iterations + 30; ++evaluations) {
     double energy = 0;
     forces_.evaluate(x, gradient_, &hessian_, &energy);
+    if (coupling) {
+      // a contact region's energy; its forces count in the residual's scale (a tool can press on an object at
+      // rest)
+      double coupled = 0;
+      coupling_gradient_.setZero();
+      if (!coupling->evaluate(x, coupled, coupling_gradient_)) {
+        if (!checking || (alpha *= 0.5) < 1e-9) return report;
+        x = start_ + alpha * direction_;
+        continue;
+      }
+      energy += coupled;
+      gradient_ += coupling_gradient_;
+      scale = std::max(scale, coupling_gradient_.norm());
+    }
     const double value = energy - force.dot(x) + 0.5 * inertia * (x - anchor).squaredNorm();
     if (!std::isfinite(value)) return report;
     if (checking && value > before + 1e-4 * alpha * slope) {
@@ -50,11 +65,13 @@ ReducedSolveReport ReducedIntegrator::minimise(Eigen::VectorXd& x, const Eigen::
     if (report.iterations == max_iterations) return report;
     ++report.iterations;
     hessian_.diagonal().array() += inertia;
+    if (coupling) coupling->add_hessian(hessian_);
     llt_.compute(hessian_);
     if (llt_.info() != Eigen::Success) {
       // indefinite (the geometric term under compression): the rest stiffness, positive definite, instead
       hessian_ = forces_.rest_stiffness();
       hessian_.diagonal().array() += inertia;
+      if (coupling) coupling->add_hessian(hessian_);
       llt_.compute(hessian_);
     }
     direction_ = llt_.solve(gradient_);
@@ -75,14 +92,14 @@ ReducedSolveReport ReducedIntegrator::minimise(Eigen::VectorXd& x, const Eigen::
 }
 
 ReducedSolveReport ReducedIntegrator::step(ReducedState& state, double dt, double tolerance, int max_iterations,
-                                           bool accept_at_budget) {
+                                           bool accept_at_budget, ReducedCoupling* coupling) {
   // q' minimises W - f.q' + (1/dt^2 + c/dt) |q' - a|^2 / 2 with a = q + dt v / (1 + c dt): the two quadratic terms
   // |q' - q - dt v|^2 / (2 dt^2) + c |q' - q|^2 / (2 dt) differ from it by a constant
   const double inertia = 1 / (dt * dt) + damping_ / dt;
   anchor_ = state.q + (dt / (1 + damping_ * dt)) * state.v;
   iterate_ = state.q + dt * state.v;  // warm start
   const ReducedSolveReport report =
-      minimise(iterate_, external_, inertia, anchor_, tolerance, max_iterations, accept_at_budget);
+      minimise(iterate_, external_, inertia, anchor_, tolerance, max_iterations, accept_at_budget, coupling);
   if (!report.converged && !report.at_budget) return report;
   state.v = (iterate_ - state.q) / dt;
   state.q = iterate_;

@@ -13,6 +13,18 @@ struct ReducedState {
   Eigen::VectorXd q, v;  ///< coordinates and their rates
 };
 
+/// A part of the energy beyond the polynomial and the loads, as a function of q: the region a tool touches in full
+/// resolution (contact_patch.hpp), whose points' own correction is minimised out at each q.
+class ReducedCoupling {
+ public:
+  virtual ~ReducedCoupling() = default;
+  /// Its energy at q, J, with its gradient added into `gradient`; false when it cannot be evaluated there (its
+  /// own solve failed): the step then fails or backtracks.
+  virtual bool evaluate(const Eigen::VectorXd& q, double& energy, Eigen::VectorXd& gradient) = 0;
+  /// Its Hessian (or a positive semi-definite approximation of it) at the q last evaluated, added into `hessian`.
+  virtual void add_hessian(Eigen::MatrixXd& hessian) = 0;
+};
+
 struct ReducedSolveReport {
   bool converged = false;
   int iterations = 0;       ///< Newton's
@@ -30,8 +42,9 @@ class ReducedIntegrator {
   /// inertia's, whichever is larger) or after `max_iterations`; a step that does not converge leaves `state` as
   /// it was, unless `accept_at_budget` (real time, as the full implicit solver's iteration budget): then the
   /// iterate after max_iterations Newton steps is taken without evaluating it again (at_budget in the report).
+  /// `coupling`: a further part of the energy (a tool's contact region), minimised with the rest.
   ReducedSolveReport step(ReducedState& state, double dt, double tolerance = 1e-9, int max_iterations = 20,
-                          bool accept_at_budget = false);
+                          bool accept_at_budget = false, ReducedCoupling* coupling = nullptr);
   /// The equilibrium W'(q) = load_scale f, from q (its start, and its answer).
   ReducedSolveReport solve_static(Eigen::VectorXd& q, double tolerance = 1e-10, int max_iterations = 50);
 
@@ -39,12 +52,12 @@ class ReducedIntegrator {
   /// Newton on phi(x) = W(x) - f . x + inertia |x - anchor|^2 / 2 with a backtracking line search, from x.
   ReducedSolveReport minimise(Eigen::VectorXd& x, const Eigen::VectorXd& force, double inertia,
                               const Eigen::VectorXd& anchor, double tolerance, int max_iterations,
-                              bool stop_at_budget = false);
+                              bool stop_at_budget = false, ReducedCoupling* coupling = nullptr);
   const SvkPolynomial& forces_;
   Eigen::VectorXd external_;
   double damping_;
   // scratch
-  Eigen::VectorXd gradient_, direction_, trial_, anchor_, scaled_force_, start_, iterate_;
+  Eigen::VectorXd gradient_, direction_, trial_, anchor_, scaled_force_, start_, iterate_, coupling_gradient_;
   Eigen::MatrixXd hessian_;
   Eigen::LLT<Eigen::MatrixXd> llt_;
 };

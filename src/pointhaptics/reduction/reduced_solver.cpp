@@ -94,22 +94,45 @@ index_t ReducedSolver::count_inverted(const Model& model, const State& state, Wo
 
 StepReport ReducedSolver::step(const Model& model, State& state, Workspace& ws, DynamicForces* forces) {
   StepReport report;
+  ContactPatch* coupling = nullptr;
   if (forces) {
-    report.status = StepStatus::FAILED;
-    report.failure = "reduction: tools, probes and contact are not reduced yet (issue 49, item 2)";
-    return report;
+    if (forces->energy_term()) {
+      report.status = StepStatus::FAILED;
+      report.failure =
+          "reduction: held tools, obstacles and contact between bodies are not coupled to a reduced model yet (a "
+          "probe is)";
+      return report;
+    }
+    // the tools' forces at the step's start and their springs (a probe's, linearly implicit as in the full
+    // implicit solver), on a patch of points in full resolution around where they act
+    if (tool_forces_.cols() != model.n_points) {
+      tool_forces_ = Points::Zero(3, model.n_points);
+      springs_ = ContactPatch::Blocks::Zero(9, model.n_points);
+    }
+    tool_forces_.setZero();
+    springs_.setZero();
+    if (forces->add_beyond_energy(model, state, tool_forces_)) forces->add_stiffness(model, state, springs_);
+    if (!patch_)
+      patch_ = std::make_unique<ContactPatch>(model, basis_.U, spec_.reduction.contact_rings, ws.n_threads());
+    if (patch_->begin_step(model, reduced_.q, tool_forces_, springs_, state.u)) coupling = patch_.get();
   }
   const double tolerance = spec_.tolerance > 0 ? spec_.tolerance : spec_.kind == SolverKind::STATIC ? 1e-8 : 1e-6;
   ReducedSolveReport solved;
   if (spec_.kind == SolverKind::STATIC) {
+    if (coupling) {
+      report.status = StepStatus::FAILED;
+      report.failure = "reduction: a tool on a reduced model needs solver.kind = \"implicit\" (not yet static)";
+      return report;
+    }
     solved = integrator_->solve_static(reduced_.q, tolerance, spec_.max_iterations);
     reduced_.v.setZero();
   } else {
     const bool budget = spec_.iteration_budget > 0;
     solved = integrator_->step(reduced_, spec_.dt, tolerance, budget ? spec_.iteration_budget : spec_.max_iterations,
-                               budget);
-    state.time += spec_.dt;
+                               budget, coupling);
   }
+  // the contact patch's Hessian lags from step to step while Newton converges in a few iterations with it
+  if (coupling && solved.iterations > refresh_after_iterations) coupling->refresh_hessian();
   report.iterations = solved.iterations;
   report.substeps = 1;
   report.residual = solved.residual;
@@ -120,10 +143,13 @@ StepReport ReducedSolver::step(const Model& model, State& state, Workspace& ws, 
     report.failure =
         spec_.kind == SolverKind::STATIC
             ? fmt::format("reduced static solve: no equilibrium beyond {:.3g} of the load", solved.load_reached)
-            : fmt::format("reduced step: Newton did not converge in {} iterations (residual {:.3g})", solved.iterations,
-                          solved.residual);
+            : fmt::format("reduced step: Newton did not converge in {} iterations (residual {:.3g}{}{})",
+                          solved.iterations, solved.residual,
+                          coupling && *coupling->failure() ? "; contact patch: " : "",
+                          coupling ? coupling->failure() : "");
     return report;
   }
+  if (spec_.kind != SolverKind::STATIC) state.time += spec_.dt;
   // u = U q and v = U q' on the step's threads, each its rows of U (both products are most of a step's time)
   Eigen::Map<Eigen::VectorXd> u(state.u.data(), state.u.size()), v(state.velocity.data(), state.velocity.size());
   ws.for_each_chunk([&](int chunk) {
@@ -132,7 +158,8 @@ StepReport ReducedSolver::step(const Model& model, State& state, Workspace& ws, 
     u.segment(begin, rows).noalias() = basis_.U.middleRows(begin, rows) * reduced_.q;
     v.segment(begin, rows).noalias() = basis_.U.middleRows(begin, rows) * reduced_.v;
   });
-  (void)model;
+  // and the contact patch's correction, quasi-static (it carries no velocity of its own)
+  if (coupling) coupling->add_correction(state.u);
   return report;
 }
 

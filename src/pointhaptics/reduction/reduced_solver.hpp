@@ -2,7 +2,9 @@
 /// @file The solver of a reduced model (issue 49, `[reduction]`): the basis and the polynomial are made when it is
 /// (the set-up), then each static solve or backward Euler step runs full Newton in the r reduced coordinates
 /// (reduced_integrator.hpp) and writes u = U q and v = U q' into the state, so every output reads it as a full
-/// model's.
+/// model's. Where tools act (a probe), the points around them are solved in full and coupled to the reduced rest
+/// (contact_patch.hpp): u = U q + P w there.
+#include <pointhaptics/reduction/contact_patch.hpp>
 #include <pointhaptics/reduction/modal_basis.hpp>
 #include <pointhaptics/reduction/reduced_integrator.hpp>
 #include <pointhaptics/solvers/solver.hpp>
@@ -18,11 +20,14 @@ class ReducedSolver final : public Solver {
   /// the polynomial. Throws Error for what a reduced model does not do yet: an explicit solver, held points moved
   /// by a prescribed displacement, a material other than St. Venant-Kirchhoff (svk_polynomial.hpp).
   ReducedSolver(const Model& model, const SolverSpec& spec, Workspace& ws);
-  /// A static solve or one backward Euler step. State-dependent forces (tools, contact) are not reduced yet: a
-  /// step given any FAILS, naming them.
+  /// A static solve or one backward Euler step. The tools' forces and springs (a probe's) act on a contact patch in
+  /// full resolution; forces that are a term of the energy (held tools, obstacles, contact between bodies) are not
+  /// coupled yet: a step given any FAILS, naming them.
   StepReport step(const Model& model, State& state, Workspace& ws, DynamicForces* forces) override;
   const ModalBasis& basis() const { return basis_; }
   const SvkPolynomial& polynomial() const { return *polynomial_; }
+  /// the contact region in full resolution (nullptr until a tool acted)
+  const ContactPatch* contact_patch() const { return patch_.get(); }
   double setup_s() const { return setup_s_; }
   /// the file the basis was read from or kept in (`[reduction] cache`; empty: none), whether it was read from
   /// it, and what went wrong with the file when something did (the run goes on: the basis is made, or not kept)
@@ -37,6 +42,8 @@ class ReducedSolver final : public Solver {
   /// last count standing in between. The run's summary counts exactly from the end state whatever the solver.
   index_t count_inverted(const Model& model, const State& state, Workspace& ws) override;
   static constexpr int exact_count_every = 16;
+  /// a step that took more Newton iterations than this has the contact patch's Hessian made again for the next
+  static constexpr int refresh_after_iterations = 2;
   /// max_p c_p above, per unit of q (SvkPolynomial::gradient_bound)
   double gradient_bound() const { return polynomial_->gradient_bound(); }
   /// the reduced model's lowest natural frequency about rest, Hz
@@ -55,6 +62,9 @@ class ReducedSolver final : public Solver {
   std::string cache_file_, cache_note_;
   bool from_cache_ = false;
   double first_frequency_hz_ = 0;
+  std::unique_ptr<ContactPatch> patch_;
+  Points tool_forces_;
+  ContactPatch::Blocks springs_;
   int steps_since_count_ = exact_count_every;
   index_t last_count_ = 0;
 };

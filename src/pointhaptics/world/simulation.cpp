@@ -568,6 +568,11 @@ RunSummary Simulation::summary() {
     r.cache_file = reduced->cache_file();
     r.from_cache = reduced->from_cache();
     r.cache_note = reduced->cache_note();
+    if (const ContactPatch* patch = reduced->contact_patch()) {
+      r.contact_points = patch->largest_free_points();
+      r.contact_patches = patch->rebuilds();
+      r.contact_iterations = patch->inner_iterations();
+    }
   }
   s.converged = state.u.allFinite() && !d.failed && interrupted_step_.empty();
   s.failure = interrupted_step_.empty() ? d.failure : interrupted_step_;

@@ -1,0 +1,176 @@
+#include <pointhaptics/reduction/contact_patch.hpp>
+
+#include <pointhaptics/core/error.hpp>
+#include <pointhaptics/mechanics/energy.hpp>
+#include <pointhaptics/mechanics/forces.hpp>
+
+#include <algorithm>
+
+namespace pointhaptics {
+
+namespace {
+
+Eigen::Map<Eigen::VectorXd> flat(Points& p) { return {p.data(), p.size()}; }
+
+}  // namespace
+
+ContactPatch::ContactPatch(const Model& model, const Eigen::MatrixXd& U, int rings, int threads)
+    : U_(U), rings_(rings), threads_(threads), newton_(model) {
+  if (rings < 1) throw Error("reduction.contact_rings: at least 1 (the points a tool acts on and a ring around them)");
+  if (U.rows() != 3 * model.n_points) throw Error("contact patch: the basis is not the model's");
+  // the patch's own solves: tight, so that the reduced Newton's line search sees its energy without noise; its
+  // tangent factorised (a few hundred points: a small factor, and the condensation's r solves then take a few
+  // CG iterations each)
+  settings_.tolerance = 1e-9;
+  settings_.max_iterations = 50;
+  settings_.preconditioner = Preconditioner::CHOLESKY;
+  settings_.refactorisation = Refactorisation::IN_PLACE;
+  inside_.assign(static_cast<std::size_t>(model.n_points), 0);
+  patch_of_.assign(static_cast<std::size_t>(model.n_points), -1);
+}
+
+void ContactPatch::build(const Model& model, const std::vector<index_t>& touched) {
+  for (const index_t i : patch_.full_of) patch_of_[static_cast<std::size_t>(i)] = -1;
+  std::fill(inside_.begin(), inside_.end(), 0);
+  patch_ = model_patch(model, neighbourhood(model, touched, rings_), 3);  // three: its energy exact (model_patch.hpp)
+  for (const index_t i : neighbourhood(model, touched, rings_ - 1)) inside_[static_cast<std::size_t>(i)] = 1;
+  const index_t n = patch_.model.n_points;
+  for (index_t k = 0; k < n; ++k) patch_of_[static_cast<std::size_t>(patch_.full_of[static_cast<std::size_t>(k)])] = k;
+  const Eigen::Index r = U_.cols();
+  U_patch_.resize(3 * n, r);
+  for (index_t k = 0; k < n; ++k)
+    U_patch_.middleRows(3 * k, 3) = U_.middleRows(3 * patch_.full_of[static_cast<std::size_t>(k)], 3);
+  // a patch of a few thousand points is faster on one thread than shared (measured: a third of a 225-point
+  // patch's step went to handing chunks between two)
+  ws_ = std::make_unique<Workspace>(patch_.model, n < 4096 ? 1 : threads_);
+  newton_ = NewtonSolver(patch_.model);
+  for (Points* p : {&tool_, &load_, &start_, &rest_, &star_, &w_, &forces_at_rest_, &scratch_, &product_})
+    *p = Points::Zero(3, n);
+  springs_ = Blocks::Zero(9, n);
+  condensed_start_.assign(static_cast<std::size_t>(r), Points::Zero(3, n));
+  largest_free_points_ = std::max(largest_free_points_, patch_.n_free);
+  ++rebuilds_;
+}
+
+bool ContactPatch::begin_step(const Model& model, const Eigen::VectorXd& q, const Points& tool_forces,
+                              const Blocks& springs, const Points& start) {
+  std::vector<index_t> touched;
+  for (index_t i = 0; i < model.n_points; ++i)
+    if (tool_forces.col(i).squaredNorm() > 0 || springs.col(i).squaredNorm() > 0) touched.push_back(i);
+  active_ = !touched.empty();
+  if (!active_) return false;
+  const bool rebuilt = patch_.full_of.empty() || std::any_of(touched.begin(), touched.end(), [&](index_t i) {
+                         return !inside_[static_cast<std::size_t>(i)];
+                       });
+  if (rebuilt) build(model, touched);
+  const index_t n = patch_.model.n_points;
+  for (index_t k = 0; k < n; ++k) {
+    const index_t i = patch_.full_of[static_cast<std::size_t>(k)];
+    tool_.col(k) = tool_forces.col(i);
+    start_.col(k) = start.col(i);
+    springs_.col(k) = springs.col(i);
+  }
+  // the correction the step starts from: what the state carries beyond U q (zero where A is new)
+  basis_product(q, rest_);
+  w_ = start_ - rest_;
+  for (index_t k = patch_.n_free; k < n; ++k) w_.col(k).setZero();
+  load_ = patch_.model.f_ext + tool_;
+  if (rebuilt) hessian_valid_ = false;
+  return true;
+}
+
+void ContactPatch::basis_product(const Eigen::VectorXd& x, Points& out) const { flat(out).noalias() = U_patch_ * x; }
+
+NewtonProblem ContactPatch::problem() {
+  NewtonProblem problem;
+  problem.load = &load_;
+  problem.springs = &springs_;
+  problem.spring_anchor = &start_;
+  return problem;
+}
+
+bool ContactPatch::evaluate(const Eigen::VectorXd& q, double& energy, Eigen::VectorXd& gradient) {
+  const Model& patch = patch_.model;
+  q_ = q;
+  failure_ = "";
+  // the patch's stencils as the reduced model has them (U_P q): their energy and forces, taken out again
+  basis_product(q, rest_);
+  const double rest_energy = strain_energy(patch, rest_, &gradients_).total();
+  compute_internal_forces(patch, rest_, *ws_);
+  forces_at_rest_ = ws_->f_int;
+  // the correction minimised out at this q, the rings held at U_R q (w is zero there), from the last one
+  star_ = rest_ + w_;
+  const NewtonStats stats = newton_.solve(patch, problem(), star_, *ws_, settings_);
+  inner_iterations_ += stats.iterations;
+  if (!stats.converged) {
+    failure_ = stats.failure;
+    return false;
+  }
+  w_ = star_ - rest_;
+  const double star_energy = strain_energy(patch, star_, &gradients_).total();
+  compute_internal_forces(patch, star_, *ws_);
+  // Pi's part (contact_patch.hpp): E_P(u*) - E_P(U_P q) - (f + t)_A . w - t_A . U_A q + springs(u*), and its
+  // gradient in q at this w: U_P^T (f_P(U_P q) - f_P(u*)) + U_A^T (S (u* - c) - t)
+  double e = star_energy - rest_energy;
+  scratch_ = forces_at_rest_ - ws_->f_int;
+  for (index_t k = 0; k < patch_.n_free; ++k) {
+    if (patch.fixed[static_cast<std::size_t>(k)]) continue;
+    const Vec3 stretch = star_.col(k) - start_.col(k);
+    const Mat3 S = Eigen::Map<const Mat3>(springs_.col(k).data());
+    e += 0.5 * stretch.dot(S * stretch) - load_.col(k).dot(w_.col(k)) - tool_.col(k).dot(rest_.col(k));
+    scratch_.col(k) += S * stretch - tool_.col(k);
+  }
+  gradient.noalias() += U_patch_.transpose() * flat(scratch_);
+  energy = e;
+  return true;
+}
+
+void ContactPatch::add_hessian(Eigen::MatrixXd& hessian) {
+  if (!hessian_valid_) {
+    const Model& patch = patch_.model;
+    const Eigen::Index r = U_patch_.cols();
+    const Eigen::Index free_rows = 3 * patch_.n_free;
+    hessian_.setZero(r, r);
+    // less the patch's stencils as the polynomial has them: their exact tangent at U_P q in the basis
+    rest_tangent_.linearise(patch, rest_, TangentMode::EXACT, ws_.get());
+    for (Eigen::Index k = 0; k < r; ++k) {
+      flat(product_) = U_patch_.col(k);
+      rest_tangent_.apply(patch, product_, *ws_, scratch_);
+      hessian_.col(k).noalias() -= U_patch_.transpose() * flat(scratch_);
+    }
+    // plus the full model's there, condensed onto the held rings: z_k = H d_k with d_k = U_R e_k (zero on A),
+    // y_k = H_AA^-1 z_k on A, and d_l . z_k - z_l . y_k
+    const NewtonProblem problem = this->problem();
+    newton_.linearise(patch, problem, star_, *ws_);
+    star_tangent_.linearise(patch, star_, TangentMode::PROJECTED, ws_.get());
+    Eigen::MatrixXd z_free(free_rows, r), y_free(free_rows, r);
+    for (Eigen::Index k = 0; k < r; ++k) {
+      flat(product_) = U_patch_.col(k);
+      product_.leftCols(patch_.n_free).setZero();
+      star_tangent_.apply(patch, product_, *ws_, scratch_);
+      hessian_.col(k).noalias() += U_patch_.bottomRows(U_patch_.rows() - free_rows).transpose() *
+                                   flat(scratch_).tail(U_patch_.rows() - free_rows);
+      Points& y = condensed_start_[static_cast<std::size_t>(k)];
+      const int iterations =
+          newton_.solve_linearised(patch, problem, scratch_, y, condensation_tolerance, condensation_iterations, *ws_);
+      condensation_cg_ += std::abs(iterations);
+      // held points of the model within A carry no correction: zero rows of z and y
+      for (index_t i = 0; i < patch_.n_free; ++i)
+        if (patch.fixed[static_cast<std::size_t>(i)]) scratch_.col(i).setZero(), y.col(i).setZero();
+      z_free.col(k) = flat(scratch_).head(free_rows);
+      y_free.col(k) = flat(y).head(free_rows);
+    }
+    hessian_.noalias() -= z_free.transpose() * y_free;
+    hessian_ = 0.5 * (hessian_ + hessian_.transpose()).eval();
+    hessian_valid_ = true;
+    ++hessians_;
+  }
+  hessian += hessian_;
+}
+
+void ContactPatch::add_correction(Points& u) const {
+  if (!active_) return;
+  for (index_t k = 0; k < patch_.n_free; ++k) u.col(patch_.full_of[static_cast<std::size_t>(k)]) += w_.col(k);
+}
+
+}  // namespace pointhaptics
