@@ -80,9 +80,22 @@ TEST(ContactPatch, ThePatchsEnergyChangeIsTheFullModelsForAnyCorrection) {
 struct Coupled {
   Model model = cantilever();
   ModalBasis basis;
-  Points tool, start;
+  Points tool;
+  State start;
   ContactPatch::Blocks springs;
+  Eigen::VectorXd q0 = Eigen::VectorXd::Zero(10), reduced_anchor = Eigen::VectorXd::Zero(10);
   std::unique_ptr<ContactPatch> patch;
+  ContactPatch::Step step() const {
+    ContactPatch::Step s;
+    s.tool_forces = &tool;
+    s.springs = &springs;
+    s.start = &start;
+    s.q = &q0;
+    s.inertia = 1e4;  // a step of 10 ms: the inertia terms weigh with the rest
+    s.carry = 1e-2;
+    s.reduced_anchor = &reduced_anchor;
+    return s;
+  }
   Coupled() {
     Workspace ws(model, 2);
     ModalBasisSettings settings;
@@ -92,17 +105,20 @@ struct Coupled {
     // toward where the step began
     tool = Points::Zero(3, model.n_points);
     springs = ContactPatch::Blocks::Zero(9, model.n_points);
-    start = Points::Zero(3, model.n_points);
+    start.u = Points::Zero(3, model.n_points);
+    start.velocity = Points::Zero(3, model.n_points);
+    for (index_t i = 0; i < model.n_points; ++i)
+      if (!model.fixed[static_cast<std::size_t>(i)]) start.velocity(1, i) = -1e-3 * model.X(0, i) / (12 * spacing);
+    reduced_anchor(0) = 1e-5;
     for (const index_t i : pressed_points(model)) {
       tool(1, i) = -0.02;
       Mat3 S = Mat3::Zero();
       S(1, 1) = 50;
       Eigen::Map<Mat3>(springs.col(i).data()) = S;
-      start(1, i) = -1e-4;
+      start.u(1, i) = -1e-4;
     }
     patch = std::make_unique<ContactPatch>(model, basis.U, 2, 2);
-    const Eigen::VectorXd q0 = Eigen::VectorXd::Zero(10);
-    EXPECT_TRUE(patch->begin_step(model, q0, tool, springs, start));
+    EXPECT_TRUE(patch->begin_step(model, step()));
   }
   double energy(const Eigen::VectorXd& q, Eigen::VectorXd* gradient = nullptr) {
     Eigen::VectorXd g = Eigen::VectorXd::Zero(q.size());
@@ -138,9 +154,34 @@ TEST(ContactPatch, TheCoupledGradientIsTheEnergysDerivativeAndTheHessianItsOwn) 
                                                                  << curvature.transpose();
   // where there is nothing to correct (no tool, no springs) the patch is not made
   ContactPatch none(c.model, c.basis.U, 2, 1);
-  EXPECT_FALSE(none.begin_step(c.model, q, Points::Zero(3, c.model.n_points),
-                               ContactPatch::Blocks::Zero(9, c.model.n_points), c.start));
+  const Points no_forces = Points::Zero(3, c.model.n_points);
+  const ContactPatch::Blocks no_springs = ContactPatch::Blocks::Zero(9, c.model.n_points);
+  ContactPatch::Step nothing = c.step();
+  nothing.tool_forces = &no_forces;
+  nothing.springs = &no_springs;
+  EXPECT_FALSE(none.begin_step(c.model, nothing));
   EXPECT_EQ(none.patch_points(), 0);
+}
+
+TEST(ContactPatch, StaysWhileItsCorrectionMovesOnAfterTheToolLeavesThenGoes) {
+  // dropped at once, the indentation sprang back into a probe that came back (a stiff cantilever diverged)
+  Coupled c;
+  const Points no_forces = Points::Zero(3, c.model.n_points);
+  const ContactPatch::Blocks no_springs = ContactPatch::Blocks::Zero(9, c.model.n_points);
+  ContactPatch::Step left = c.step();
+  left.tool_forces = &no_forces;
+  left.springs = &no_springs;
+  const index_t free = c.patch->free_points();
+  for (int k = 0; k < ContactPatch::release_steps; ++k) {
+    ASSERT_TRUE(c.patch->begin_step(c.model, left)) << k;
+    EXPECT_EQ(c.patch->free_points(), free);
+  }
+  EXPECT_FALSE(c.patch->begin_step(c.model, left));
+  EXPECT_EQ(c.patch->free_points(), 0);
+  // and a tool that comes back gets a patch again
+  EXPECT_TRUE(c.patch->begin_step(c.model, c.step()));
+  EXPECT_EQ(c.patch->free_points(), free);
+  EXPECT_EQ(c.patch->rebuilds(), 2);
 }
 
 struct Press {

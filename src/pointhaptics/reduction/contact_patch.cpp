@@ -26,16 +26,13 @@ ContactPatch::ContactPatch(const Model& model, const Eigen::MatrixXd& U, int rin
   settings_.preconditioner = Preconditioner::CHOLESKY;
   settings_.refactorisation = Refactorisation::IN_PLACE;
   inside_.assign(static_cast<std::size_t>(model.n_points), 0);
-  patch_of_.assign(static_cast<std::size_t>(model.n_points), -1);
 }
 
 void ContactPatch::build(const Model& model, const std::vector<index_t>& touched) {
-  for (const index_t i : patch_.full_of) patch_of_[static_cast<std::size_t>(i)] = -1;
   std::fill(inside_.begin(), inside_.end(), 0);
   patch_ = model_patch(model, neighbourhood(model, touched, rings_), 3);  // three: its energy exact (model_patch.hpp)
   for (const index_t i : neighbourhood(model, touched, rings_ - 1)) inside_[static_cast<std::size_t>(i)] = 1;
   const index_t n = patch_.model.n_points;
-  for (index_t k = 0; k < n; ++k) patch_of_[static_cast<std::size_t>(patch_.full_of[static_cast<std::size_t>(k)])] = k;
   const Eigen::Index r = U_.cols();
   U_patch_.resize(3 * n, r);
   for (index_t k = 0; k < n; ++k)
@@ -44,7 +41,8 @@ void ContactPatch::build(const Model& model, const std::vector<index_t>& touched
   // patch's step went to handing chunks between two)
   ws_ = std::make_unique<Workspace>(patch_.model, n < 4096 ? 1 : threads_);
   newton_ = NewtonSolver(patch_.model);
-  for (Points* p : {&tool_, &load_, &start_, &rest_, &star_, &w_, &forces_at_rest_, &scratch_, &product_})
+  for (Points* p : {&tool_, &load_, &start_, &rest_, &star_, &w_, &anchor_, &reduced_anchor_, &forces_at_rest_,
+                    &scratch_, &product_})
     *p = Points::Zero(3, n);
   springs_ = Blocks::Zero(9, n);
   condensed_start_.assign(static_cast<std::size_t>(r), Points::Zero(3, n));
@@ -52,13 +50,22 @@ void ContactPatch::build(const Model& model, const std::vector<index_t>& touched
   ++rebuilds_;
 }
 
-bool ContactPatch::begin_step(const Model& model, const Eigen::VectorXd& q, const Points& tool_forces,
-                              const Blocks& springs, const Points& start) {
+bool ContactPatch::begin_step(const Model& model, const Step& step) {
+  const Points& tool_forces = *step.tool_forces;
+  const Blocks& springs = *step.springs;
   std::vector<index_t> touched;
   for (index_t i = 0; i < model.n_points; ++i)
     if (tool_forces.col(i).squaredNorm() > 0 || springs.col(i).squaredNorm() > 0) touched.push_back(i);
-  active_ = !touched.empty();
-  if (!active_) return false;
+  // a patch the tools have left stays for release_steps: its correction, which has mass, moves on as the full
+  // model's points would (dropped at once, the indentation sprang back into a probe that came back to it, and a
+  // stiff cantilever under a sliding probe diverged)
+  steps_untouched_ = touched.empty() ? steps_untouched_ + 1 : 0;
+  active_ = !touched.empty() || (!patch_.full_of.empty() && steps_untouched_ <= release_steps);
+  if (!active_) {
+    patch_ = ModelPatch{};
+    std::fill(inside_.begin(), inside_.end(), 0);
+    return false;
+  }
   const bool rebuilt = patch_.full_of.empty() || std::any_of(touched.begin(), touched.end(), [&](index_t i) {
                          return !inside_[static_cast<std::size_t>(i)];
                        });
@@ -67,15 +74,19 @@ bool ContactPatch::begin_step(const Model& model, const Eigen::VectorXd& q, cons
   for (index_t k = 0; k < n; ++k) {
     const index_t i = patch_.full_of[static_cast<std::size_t>(k)];
     tool_.col(k) = tool_forces.col(i);
-    start_.col(k) = start.col(i);
+    start_.col(k) = step.start->u.col(i);
+    anchor_.col(k) = step.start->u.col(i) + step.carry * step.start->velocity.col(i);
     springs_.col(k) = springs.col(i);
   }
+  inertia_ = step.inertia;
+  basis_product(*step.reduced_anchor, reduced_anchor_);
   // the correction the step starts from: what the state carries beyond U q (zero where A is new)
-  basis_product(q, rest_);
+  basis_product(*step.q, rest_);
   w_ = start_ - rest_;
   for (index_t k = patch_.n_free; k < n; ++k) w_.col(k).setZero();
   load_ = patch_.model.f_ext + tool_;
   if (rebuilt) hessian_valid_ = false;
+  uses_this_step_ = 0;
   return true;
 }
 
@@ -86,6 +97,8 @@ NewtonProblem ContactPatch::problem() {
   problem.load = &load_;
   problem.springs = &springs_;
   problem.spring_anchor = &start_;
+  problem.inertia = inertia_;
+  problem.anchor = &anchor_;
   return problem;
 }
 
@@ -119,6 +132,11 @@ bool ContactPatch::evaluate(const Eigen::VectorXd& q, double& energy, Eigen::Vec
     const Mat3 S = Eigen::Map<const Mat3>(springs_.col(k).data());
     e += 0.5 * stretch.dot(S * stretch) - load_.col(k).dot(w_.col(k)) - tool_.col(k).dot(rest_.col(k));
     scratch_.col(k) += S * stretch - tool_.col(k);
+    // the inertia of u_A in full, less the reduced model's of U_A q
+    const double km = inertia_ * patch.mass[k];
+    const Vec3 behind = star_.col(k) - anchor_.col(k), reduced_behind = rest_.col(k) - reduced_anchor_.col(k);
+    e += 0.5 * km * (behind.squaredNorm() - reduced_behind.squaredNorm());
+    scratch_.col(k) += km * (behind - reduced_behind);
   }
   gradient.noalias() += U_patch_.transpose() * flat(scratch_);
   energy = e;
@@ -126,7 +144,10 @@ bool ContactPatch::evaluate(const Eigen::VectorXd& q, double& energy, Eigen::Vec
 }
 
 void ContactPatch::add_hessian(Eigen::MatrixXd& hessian) {
+  // a step that needs many iterations with the lagged Hessian (a contact that comes and goes) gets a new one
+  if (++uses_this_step_ > lagged_iterations) hessian_valid_ = false;
   if (!hessian_valid_) {
+    uses_this_step_ = 0;
     const Model& patch = patch_.model;
     const Eigen::Index r = U_patch_.cols();
     const Eigen::Index free_rows = 3 * patch_.n_free;
@@ -138,6 +159,11 @@ void ContactPatch::add_hessian(Eigen::MatrixXd& hessian) {
       rest_tangent_.apply(patch, product_, *ws_, scratch_);
       hessian_.col(k).noalias() -= U_patch_.transpose() * flat(scratch_);
     }
+    // less the reduced model's inertia on A, k U_A^T M_A U_A
+    for (index_t i = 0; i < patch_.n_free; ++i)
+      if (!patch.fixed[static_cast<std::size_t>(i)])
+        hessian_.noalias() -=
+            (inertia_ * patch.mass[i]) * U_patch_.middleRows(3 * i, 3).transpose() * U_patch_.middleRows(3 * i, 3);
     // plus the full model's there, condensed onto the held rings: z_k = H d_k with d_k = U_R e_k (zero on A),
     // y_k = H_AA^-1 z_k on A, and d_l . z_k - z_l . y_k
     const NewtonProblem problem = this->problem();
@@ -168,9 +194,13 @@ void ContactPatch::add_hessian(Eigen::MatrixXd& hessian) {
   hessian += hessian_;
 }
 
-void ContactPatch::add_correction(Points& u) const {
+void ContactPatch::write_state(Points& u, Points& velocity, double dt) const {
   if (!active_) return;
-  for (index_t k = 0; k < patch_.n_free; ++k) u.col(patch_.full_of[static_cast<std::size_t>(k)]) += w_.col(k);
+  for (index_t k = 0; k < patch_.n_free; ++k) {
+    const index_t i = patch_.full_of[static_cast<std::size_t>(k)];
+    u.col(i) = star_.col(k);
+    if (dt > 0) velocity.col(i) = (star_.col(k) - start_.col(k)) / dt;
+  }
 }
 
 }  // namespace pointhaptics

@@ -8,11 +8,14 @@
 /// energy E_P changes with A exactly as the object's does (ContactPatch.ThePatchsEnergyChange...). The energy of the coupled system is
 ///   Pi(q, w) = W(q) - f . U q + inertia(q) + E_P(U_P q + w) - E_P(U_P q) - (f + t)_A . w + springs(U_A q + w)
 /// (W: the reduced polynomial, exact for St. Venant-Kirchhoff, which already holds E_P(U_P q); t, S: the tools'
-/// forces and springs at the step's start, as the full implicit solver takes a probe's), and w carries no mass:
-/// the indentation under a tool is quasi-static, its own vibrations far faster than a step. For each q the patch's
-/// correction is minimised out (Newton on the patch, its rings held at U q), so the reduced Newton sees
+/// forces and springs at the step's start, as the full implicit solver takes a probe's), and backward Euler's
+/// inertia of u itself, k/2 |U q + P w - a|_M^2 = k/2 |q - a_q|^2 + k/2 |u_A - a_A|_M^2 - k/2 |U_A (q - a_q)|_M^2
+/// (U is mass-orthonormal): the coupled system is the full model's step restricted to the subspace {U q + P w},
+/// and keeps its stability (a first version without the patch's mass diverged under a hand in real time). For each
+/// q the patch's correction is minimised out (Newton on the patch with its inertia, its rings held at U q), so the
+/// reduced Newton sees
 ///   Phi(q) = Pi(q, w*(q)),   dPhi/dq = dPi/dq at w*,
-///   d2Phi/dq2 = K_W(q) - U_P^T K_P(U_P q) U_P + U_R^T (H_RR - H_RA H_AA^-1 H_AR) U_R,
+///   d2Phi/dq2 = K_W(q) - U_P^T K_P(U_P q) U_P - k U_A^T M_A U_A + U_R^T (H_RR - H_RA H_AA^-1 H_AR) U_R,
 /// the last term the patch's tangent with the springs (H, its positive semi-definite part) condensed onto its held
 /// rings R: the object's stiffness where the tool presses is the full model's, the rest the reduced model's.
 #include <pointhaptics/mechanics/model_patch.hpp>
@@ -32,16 +35,24 @@ class ContactPatch final : public ReducedCoupling {
   /// neighbour rings (at least 1).
   ContactPatch(const Model& model, const Eigen::MatrixXd& U, int rings, int threads);
 
-  /// For this step: the tools' forces and springs at its start (3 x n and 9 x n over the model; the springs pull
-  /// toward `start`). Chooses A, kept from the last step while the points the tools act on stay inside it with a
-  /// ring to spare. False when the tools act on no point (then there is no patch, and u = U q).
-  /// `q`: the reduced coordinates at the step's start (the correction it starts from is start - U q).
-  bool begin_step(const Model& model, const Eigen::VectorXd& q, const Points& tool_forces, const Blocks& springs,
-                  const Points& start);
+  /// What a step gives the patch.
+  struct Step {
+    const Points* tool_forces = nullptr;  ///< t, 3 x n over the model, at the step's start
+    const Blocks* springs = nullptr;      ///< S, 9 x n, pulling toward the start's u
+    const State* start = nullptr;         ///< u and v at the step's start (the correction there: u - U q)
+    const Eigen::VectorXd* q = nullptr;   ///< the reduced coordinates at the step's start
+    /// backward Euler's inertia k (0: a static solve) and anchors: a = u + carry v on the points, and the reduced
+    /// model's own a_q (reduced_integrator.hpp)
+    double inertia = 0, carry = 0;
+    const Eigen::VectorXd* reduced_anchor = nullptr;
+  };
+  /// Chooses A for this step, kept from the last step while the points the tools act on stay inside it with a ring
+  /// to spare, and for release_steps after they act on none. False when there is no patch (then u = U q).
+  bool begin_step(const Model& model, const Step& step);
   bool evaluate(const Eigen::VectorXd& q, double& energy, Eigen::VectorXd& gradient) override;
   /// Made when asked for after a new patch or refresh_hessian(), else the last one (a modified Newton: the gradient
-  /// is exact, and so is the answer; a Hessian that lags costs iterations, and the solver refreshes it when a step
-  /// takes more than a few). Its condensation's solves are warm-started from the last one's and cut at
+  /// is exact, and so is the answer; a Hessian that lags costs iterations, and the solver refreshes it for the next
+  /// step when one takes more than a few, and within a step after lagged_iterations). Its condensation's solves are warm-started from the last one's and cut at
   /// condensation_iterations CG iterations.
   void add_hessian(Eigen::MatrixXd& hessian) override;
   void refresh_hessian() { hessian_valid_ = false; }
@@ -49,8 +60,12 @@ class ContactPatch final : public ReducedCoupling {
   long long hessians() const { return hessians_; }
   static constexpr double condensation_tolerance = 1e-6;
   static constexpr int condensation_iterations = 5;
-  /// u += w of the last evaluation, on A.
-  void add_correction(Points& u) const;
+  static constexpr int release_steps = 200;
+  /// Newton iterations within one step on one Hessian before it is made again
+  static constexpr int lagged_iterations = 3;
+  /// The step's end on A: u = u* of the last evaluation, and v = (u* - u_start) / dt (the rest of the state is the
+  /// reduced model's, written before).
+  void write_state(Points& u, Points& velocity, double dt) const;
 
   bool active() const { return active_; }
   /// the patch's free points (A) and all its points (A and the held rings)
@@ -76,6 +91,7 @@ class ContactPatch final : public ReducedCoupling {
   const Eigen::MatrixXd& U_;
   int rings_, threads_;
   bool active_ = false;
+  int steps_untouched_ = 0, uses_this_step_ = 0;
   ModelPatch patch_;
   std::unique_ptr<Workspace> ws_;
   NewtonSolver newton_;
@@ -83,8 +99,9 @@ class ContactPatch final : public ReducedCoupling {
   Eigen::MatrixXd U_patch_;                       ///< 3 n_patch x r: the patch's rows of U
   std::vector<char> inside_;                      ///< per model point: within A less its outer ring (A kept while the
                                                   ///< tools act only there)
-  std::vector<index_t> patch_of_;                 ///< per model point: its patch index, or -1
   Points tool_, load_, start_, rest_, star_, w_;  ///< patch: t, f + t, the springs' anchor, U_P q, u*, u* - U_P q
+  Points anchor_, reduced_anchor_;                ///< patch: a, and U_P a_q
+  double inertia_ = 0;
   Points forces_at_rest_, scratch_, product_;
   Blocks springs_;
   std::vector<Mat3> gradients_;

@@ -95,8 +95,8 @@ ReducedSolveReport ReducedIntegrator::step(ReducedState& state, double dt, doubl
                                            bool accept_at_budget, ReducedCoupling* coupling) {
   // q' minimises W - f.q' + (1/dt^2 + c/dt) |q' - a|^2 / 2 with a = q + dt v / (1 + c dt): the two quadratic terms
   // |q' - q - dt v|^2 / (2 dt^2) + c |q' - q|^2 / (2 dt) differ from it by a constant
-  const double inertia = 1 / (dt * dt) + damping_ / dt;
-  anchor_ = state.q + (dt / (1 + damping_ * dt)) * state.v;
+  const double inertia = this->inertia(dt);
+  anchor_ = state.q + carry(dt) * state.v;
   iterate_ = state.q + dt * state.v;  // warm start
   const ReducedSolveReport report =
       minimise(iterate_, external_, inertia, anchor_, tolerance, max_iterations, accept_at_budget, coupling);

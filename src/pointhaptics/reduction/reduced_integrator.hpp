@@ -38,6 +38,10 @@ class ReducedIntegrator {
   /// `external`: U^T f of the dead loads (gravity, tractions); `damping`: mass-proportional, 1/s.
   ReducedIntegrator(const SvkPolynomial& forces, Eigen::VectorXd external, double damping);
   const Eigen::VectorXd& external() const { return external_; }
+  /// A backward Euler step of dt minimises inertia(dt) |q' - a|^2 / 2 + W(q') - f . q' with the anchor
+  /// a = q + carry(dt) v (of any displacement and velocity: the contact patch's points take the same).
+  double inertia(double dt) const { return 1 / (dt * dt) + damping_ / dt; }
+  double carry(double dt) const { return dt / (1 + damping_ * dt); }
   /// One backward Euler step of dt. Newton stops at a residual below `tolerance` times the load's size (or the
   /// inertia's, whichever is larger) or after `max_iterations`; a step that does not converge leaves `state` as
   /// it was, unless `accept_at_budget` (real time, as the full implicit solver's iteration budget): then the

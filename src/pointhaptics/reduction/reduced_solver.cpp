@@ -114,7 +114,18 @@ StepReport ReducedSolver::step(const Model& model, State& state, Workspace& ws, 
     if (forces->add_beyond_energy(model, state, tool_forces_)) forces->add_stiffness(model, state, springs_);
     if (!patch_)
       patch_ = std::make_unique<ContactPatch>(model, basis_.U, spec_.reduction.contact_rings, ws.n_threads());
-    if (patch_->begin_step(model, reduced_.q, tool_forces_, springs_, state.u)) coupling = patch_.get();
+    ContactPatch::Step step;
+    step.tool_forces = &tool_forces_;
+    step.springs = &springs_;
+    step.start = &state;
+    step.q = &reduced_.q;
+    if (spec_.kind != SolverKind::STATIC) {
+      step.inertia = integrator_->inertia(spec_.dt);
+      step.carry = integrator_->carry(spec_.dt);
+    }
+    reduced_anchor_ = reduced_.q + step.carry * reduced_.v;
+    step.reduced_anchor = &reduced_anchor_;
+    if (patch_->begin_step(model, step)) coupling = patch_.get();
   }
   const double tolerance = spec_.tolerance > 0 ? spec_.tolerance : spec_.kind == SolverKind::STATIC ? 1e-8 : 1e-6;
   ReducedSolveReport solved;
@@ -158,8 +169,8 @@ StepReport ReducedSolver::step(const Model& model, State& state, Workspace& ws, 
     u.segment(begin, rows).noalias() = basis_.U.middleRows(begin, rows) * reduced_.q;
     v.segment(begin, rows).noalias() = basis_.U.middleRows(begin, rows) * reduced_.v;
   });
-  // and the contact patch's correction, quasi-static (it carries no velocity of its own)
-  if (coupling) coupling->add_correction(state.u);
+  // and the contact patch's points in full
+  if (coupling) coupling->write_state(state.u, state.velocity, spec_.kind == SolverKind::STATIC ? 0.0 : spec_.dt);
   return report;
 }
 

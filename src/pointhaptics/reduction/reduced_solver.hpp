@@ -64,6 +64,7 @@ class ReducedSolver final : public Solver {
   double first_frequency_hz_ = 0;
   std::unique_ptr<ContactPatch> patch_;
   Points tool_forces_;
+  Eigen::VectorXd reduced_anchor_;
   ContactPatch::Blocks springs_;
   int steps_since_count_ = exact_count_every;
   index_t last_count_ = 0;
