@@ -55,6 +55,7 @@ ModelPatch model_patch(const Model& model, const std::vector<index_t>& free, int
       }
     part_end.push_back(static_cast<index_t>(patch.full_of.size()));
   }
+  patch.ring_end.assign(part_end.begin() + 1, part_end.end());
   const index_t n = static_cast<index_t>(patch.full_of.size());
   Model& m = patch.model;
   m.n_points = n;

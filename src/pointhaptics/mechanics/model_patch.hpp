@@ -13,6 +13,8 @@ struct ModelPatch {
                                  ///< outer one passive, Model::n_passive)
   std::vector<index_t> full_of;  ///< patch index -> the model's
   index_t n_free = 0;            ///< the first n_free points: the free ones
+  /// per held ring, the end of its points (ring k is [ring_end[k-1], ring_end[k]), ring 0 starting at n_free)
+  std::vector<index_t> ring_end;
 };
 
 /// The points `free` (each once; the model's held ones stay held) and, held, `held_rings` rings of neighbours

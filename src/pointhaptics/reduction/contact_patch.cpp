@@ -21,7 +21,7 @@ ContactPatch::ContactPatch(const Model& model, const Eigen::MatrixXd& U, int rin
   // the patch's own solves: tight, so that the reduced Newton's line search sees its energy without noise; its
   // tangent factorised (a few hundred points: a small factor, and the condensation's r solves then take a few
   // CG iterations each)
-  settings_.tolerance = 1e-9;
+  settings_.tolerance = 1e-7;
   settings_.max_iterations = 50;
   settings_.preconditioner = Preconditioner::CHOLESKY;
   settings_.refactorisation = Refactorisation::IN_PLACE;
@@ -40,7 +40,13 @@ void ContactPatch::build(const Model& model, const std::vector<index_t>& touched
   // a patch of a few thousand points is faster on one thread than shared (measured: a third of a 225-point
   // patch's step went to handing chunks between two)
   ws_ = std::make_unique<Workspace>(patch_.model, n < 4096 ? 1 : threads_);
-  newton_ = NewtonSolver(patch_.model);
+  // the free points' own solves need only the stencils that reach them: the same patch with every ring beyond the
+  // first passive (their gradients, which the first ring's hourglass pairs read, are still made whole), a third of
+  // the stencils here
+  inner_ = patch_.model;
+  inner_.n_passive = n - patch_.ring_end.front();
+  inner_ws_ = std::make_unique<Workspace>(inner_, n < 4096 ? 1 : threads_);
+  newton_ = NewtonSolver(inner_);
   for (Points* p : {&tool_, &load_, &start_, &rest_, &star_, &w_, &anchor_, &reduced_anchor_, &forces_at_rest_,
                     &scratch_, &product_})
     *p = Points::Zero(3, n);
@@ -113,7 +119,7 @@ bool ContactPatch::evaluate(const Eigen::VectorXd& q, double& energy, Eigen::Vec
   forces_at_rest_ = ws_->f_int;
   // the correction minimised out at this q, the rings held at U_R q (w is zero there), from the last one
   star_ = rest_ + w_;
-  const NewtonStats stats = newton_.solve(patch, problem(), star_, *ws_, settings_);
+  const NewtonStats stats = newton_.solve(inner_, problem(), star_, *inner_ws_, settings_);
   inner_iterations_ += stats.iterations;
   if (!stats.converged) {
     failure_ = stats.failure;
@@ -167,7 +173,7 @@ void ContactPatch::add_hessian(Eigen::MatrixXd& hessian) {
     // plus the full model's there, condensed onto the held rings: z_k = H d_k with d_k = U_R e_k (zero on A),
     // y_k = H_AA^-1 z_k on A, and d_l . z_k - z_l . y_k
     const NewtonProblem problem = this->problem();
-    newton_.linearise(patch, problem, star_, *ws_);
+    newton_.linearise(inner_, problem, star_, *inner_ws_);
     star_tangent_.linearise(patch, star_, TangentMode::PROJECTED, ws_.get());
     Eigen::MatrixXd z_free(free_rows, r), y_free(free_rows, r);
     for (Eigen::Index k = 0; k < r; ++k) {
@@ -177,8 +183,8 @@ void ContactPatch::add_hessian(Eigen::MatrixXd& hessian) {
       hessian_.col(k).noalias() += U_patch_.bottomRows(U_patch_.rows() - free_rows).transpose() *
                                    flat(scratch_).tail(U_patch_.rows() - free_rows);
       Points& y = condensed_start_[static_cast<std::size_t>(k)];
-      const int iterations =
-          newton_.solve_linearised(patch, problem, scratch_, y, condensation_tolerance, condensation_iterations, *ws_);
+      const int iterations = newton_.solve_linearised(inner_, problem, scratch_, y, condensation_tolerance,
+                                                      condensation_iterations, *inner_ws_);
       condensation_cg_ += std::abs(iterations);
       // held points of the model within A carry no correction: zero rows of z and y
       for (index_t i = 0; i < patch_.n_free; ++i)

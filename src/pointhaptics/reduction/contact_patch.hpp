@@ -94,6 +94,8 @@ class ContactPatch final : public ReducedCoupling {
   int steps_untouched_ = 0, uses_this_step_ = 0;
   ModelPatch patch_;
   std::unique_ptr<Workspace> ws_;
+  Model inner_;  ///< the patch for the free points' own solves: its rings beyond the first passive
+  std::unique_ptr<Workspace> inner_ws_;
   NewtonSolver newton_;
   NewtonSettings settings_;
   Eigen::MatrixXd U_patch_;                       ///< 3 n_patch x r: the patch's rows of U
