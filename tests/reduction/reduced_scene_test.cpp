@@ -113,6 +113,33 @@ TEST(ReducedScene, TheGradientBoundHoldsAtEveryPointSoNoInvertedPointIsMissed) {
   }
 }
 
+TEST(ReducedScene, TheStateIsWrittenWhenReadAndReadsTheSameAsWrittenAtEveryStep) {
+  // a step leaves u = U q and v = U q' unwritten (writing them cost several reduced steps); state() writes them
+  Scene scene = parse_scene(reduced("implicit"));
+  ModelSimulation lazy(build_scene_model(scene), scene.solver, 2);
+  ModelSimulation eager(build_scene_model(scene), scene.solver, 2);
+  for (int k = 0; k < 50; ++k) {
+    lazy.step();
+    EXPECT_TRUE(lazy.solver_impl().unpublished());
+    eager.step();
+    (void)eager.state();  // read at every step: written at every step
+  }
+  const Points held_before = lazy.state().u;  // (read: written now)
+  EXPECT_FALSE(lazy.solver_impl().unpublished());
+  EXPECT_EQ(held_before, eager.state().u);
+  EXPECT_EQ(lazy.state().velocity, eager.state().velocity);
+  EXPECT_GT(held_before.cwiseAbs().maxCoeff(), 1e-5) << "it moved";
+  // Simulation::run() writes it at its end, step() at every step: a reference held across them reads it whole
+  Simulation sim(build_scene_model(scene), scene.solver, 2);
+  const State& held = sim.state();
+  sim.run(0.05);
+  EXPECT_EQ(held.u, eager.state().u);
+  sim.step();
+  EXPECT_NE(held.u, eager.state().u);
+  eager.step();
+  EXPECT_EQ(held.u, eager.state().u);
+}
+
 TEST(ReducedScene, WhatIsNotReducedYetIsANamedError) {
   const auto error = [](const std::string& text) {
     try {

@@ -89,7 +89,23 @@ index_t ReducedSolver::count_inverted(const Model& model, const State& state, Wo
   }
   if (++steps_since_count_ < exact_count_every) return last_count_;
   steps_since_count_ = 0;
-  return last_count_ = pointhaptics::count_inverted(model, state.u, ws);
+  if (!unpublished_) return last_count_ = pointhaptics::count_inverted(model, state.u, ws);
+  inversion_u_.resize(3, model.n_points);
+  Eigen::Map<Eigen::VectorXd>(inversion_u_.data(), inversion_u_.size()).noalias() = basis_.U * reduced_.q;
+  return last_count_ = pointhaptics::count_inverted(model, inversion_u_, ws);
+}
+
+void ReducedSolver::publish(State& state, Workspace& ws) {
+  if (!unpublished_) return;
+  // u = U q and v = U q' on the step's threads, each its rows of U (both products cost several reduced steps)
+  Eigen::Map<Eigen::VectorXd> u(state.u.data(), state.u.size()), v(state.velocity.data(), state.velocity.size());
+  ws.for_each_chunk([&](int chunk) {
+    const Eigen::Index begin = 3 * static_cast<Eigen::Index>(ws.chunk_begin(chunk));
+    const Eigen::Index rows = 3 * static_cast<Eigen::Index>(ws.chunk_end(chunk)) - begin;
+    u.segment(begin, rows).noalias() = basis_.U.middleRows(begin, rows) * reduced_.q;
+    v.segment(begin, rows).noalias() = basis_.U.middleRows(begin, rows) * reduced_.v;
+  });
+  unpublished_ = false;
 }
 
 StepReport ReducedSolver::step(const Model& model, State& state, Workspace& ws, DynamicForces* forces) {
@@ -160,17 +176,19 @@ StepReport ReducedSolver::step(const Model& model, State& state, Workspace& ws, 
                           coupling ? coupling->failure() : "");
     return report;
   }
+  // the state's finite check, on the coordinates (the state may not be written yet)
+  if (!reduced_.q.allFinite() || !reduced_.v.allFinite()) {
+    report.status = StepStatus::FAILED;
+    report.failure = "reduced step: the coordinates are not finite";
+    return report;
+  }
   if (spec_.kind != SolverKind::STATIC) state.time += spec_.dt;
-  // u = U q and v = U q' on the step's threads, each its rows of U (both products are most of a step's time)
-  Eigen::Map<Eigen::VectorXd> u(state.u.data(), state.u.size()), v(state.velocity.data(), state.velocity.size());
-  ws.for_each_chunk([&](int chunk) {
-    const Eigen::Index begin = 3 * static_cast<Eigen::Index>(ws.chunk_begin(chunk));
-    const Eigen::Index rows = 3 * static_cast<Eigen::Index>(ws.chunk_end(chunk)) - begin;
-    u.segment(begin, rows).noalias() = basis_.U.middleRows(begin, rows) * reduced_.q;
-    v.segment(begin, rows).noalias() = basis_.U.middleRows(begin, rows) * reduced_.v;
-  });
-  // and the contact patch's points in full
-  if (coupling) coupling->write_state(state.u, state.velocity, spec_.kind == SolverKind::STATIC ? 0.0 : spec_.dt);
+  unpublished_ = true;
+  if (forces) {
+    // tools read the state at every step: written now, with the contact patch's points in full
+    publish(state, ws);
+    if (coupling) coupling->write_state(state.u, state.velocity, spec_.kind == SolverKind::STATIC ? 0.0 : spec_.dt);
+  }
   return report;
 }
 

@@ -46,6 +46,11 @@ class ReducedSolver final : public Solver {
   static constexpr int refresh_after_iterations = 2;
   /// max_p c_p above, per unit of q (SvkPolynomial::gradient_bound)
   double gradient_bound() const { return polynomial_->gradient_bound(); }
+  /// Without tools a step writes nothing into the state: u = U q and v = U q' are written when something reads
+  /// them (ModelSimulation::state(): outputs, the summary, Python), so a run that reads the state every k steps
+  /// pays for it every k steps. With tools (a probe reads the surface at every step) the step writes them.
+  bool unpublished() const override { return unpublished_; }
+  void publish(State& state, Workspace& ws) override;
   /// the reduced model's lowest natural frequency about rest, Hz
   double first_frequency_hz() const { return first_frequency_hz_; }
 
@@ -66,6 +71,8 @@ class ReducedSolver final : public Solver {
   Points tool_forces_;
   Eigen::VectorXd reduced_anchor_;
   ContactPatch::Blocks springs_;
+  bool unpublished_ = false;
+  Points inversion_u_;  ///< U q for the exact inversion count (the state may not hold it yet)
   int steps_since_count_ = exact_count_every;
   index_t last_count_ = 0;
 };

@@ -84,6 +84,12 @@ class Solver {
   /// default those of the gradients its force evaluations left in `ws` (mechanics/inversion.hpp); a solver that
   /// leaves none there answers from `state` itself.
   virtual index_t count_inverted(const Model& model, const State& state, Workspace& ws);
+  /// A solver whose step leaves the state's displacement and velocity to be written when something reads them (a
+  /// reduced model's u = U q and v = U q': two products with the 3n x r basis, several times its step) says so
+  /// here, and publish() writes them; the simulation calls it before anything reads the state
+  /// (ModelSimulation::state()). Others write the state in the step: false, and nothing to do.
+  virtual bool unpublished() const { return false; }
+  virtual void publish(State& /*state*/, Workspace& /*ws*/) {}
 };
 
 /// The solver a spec asks for, for `model`. `stable_dt`: explicit only, the stable step if already known

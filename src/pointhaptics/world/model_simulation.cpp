@@ -122,9 +122,15 @@ double ModelSimulation::stable_dt() const {
   return stable_dt_;
 }
 
+void ModelSimulation::publish_state() const {
+  if (solver_impl_ && solver_impl_->unpublished())
+    solver_impl_->publish(const_cast<State&>(state_), const_cast<Workspace&>(ws_));
+}
+
 void ModelSimulation::set_state(const State& state) {
   if (state.u.cols() != model_.n_points || state.velocity.cols() != model_.n_points)
     throw Error("simulation: the state is for another model");
+  publish_state();     // (a write left for later would overwrite the one given)
   state_.u = state.u;  // copied into the state's buffers: views of them stay valid
   state_.velocity = state.velocity;
   state_.time = state.time;
@@ -251,6 +257,8 @@ const StepReport& ModelSimulation::step() {
     throw Error(
         fmt::format("simulation: no step after a failed one (t = {:.6g} s: {})", state_.time, diagnostics_.failure));
   const StageClock clock;
+  // tools read the state (attached after steps that left it unwritten: written now)
+  if (!hands_.empty() || held_tool_ || !posed_bodies_.empty() || body_contact_) publish_state();
   // inputs: the tools take their place for this step
   timed_stage(diagnostics_.tools_seconds, [&] { place_tools(); });
   // the solver: internal, external, contact and tool forces, time integration or equilibrium, held points
@@ -429,7 +437,8 @@ bool ModelSimulation::place_hand(ProbeAttachment& hand, const StepInputs& inputs
 }
 
 void ModelSimulation::check_finite(StepReport& report) const {
-  if (report.status == StepStatus::FAILED || state_.u.allFinite()) return;
+  // (a solver that left the state unwritten checked its own coordinates)
+  if (report.status == StepStatus::FAILED || solver_impl_->unpublished() || state_.u.allFinite()) return;
   report.status = StepStatus::FAILED;
   report.failure = fmt::format("the state is not finite at t = {:.6g} s", state_.time);
 }

@@ -145,7 +145,12 @@ class ModelSimulation {
   const StepReport& step();
 
   const Model& model() const { return model_; }
-  const State& state() const { return state_; }
+  /// The object's state, made whole first when the solver left it to be written (Solver::publish(): a reduced
+  /// model writes u = U q when something reads it).
+  const State& state() const {
+    publish_state();
+    return state_;
+  }
   /// Between steps, cut the object where `sweep` crosses it at the current positions (mechanics/cut.hpp).
   /// When pairs were severed, the solver is rebuilt on the cut model, and the explicit stable step shortens to
   /// what cut_lanczos_steps Lanczos steps started on the cut's points find, if that is shorter (a one-sided or
@@ -257,6 +262,9 @@ class ModelSimulation {
   Model model_;
   SolverSpec solver_;
   State state_;
+  /// Solver::publish() into state_ and ws_ when the solver left the state unwritten: logically const (the state is
+  /// the object's whatever the solver keeps), so state() can give it whole.
+  void publish_state() const;
   Workspace ws_;
   int n_threads_ = 0;
   mutable double stable_dt_ = 0;          ///< 0: not computed yet (static and implicit kinds, until stable_dt())

@@ -31,6 +31,12 @@ Simulation& Simulation::operator=(Simulation&&) noexcept = default;
 // ---- the step pipeline: the active set here, the rest in ModelSimulation::step() -----------------------
 
 const StepReport& Simulation::step() {
+  const StepReport& report = step_unwritten();
+  core().state();  // written whole (a reduced model's): the caller may hold it (Python's arrays are views of it)
+  return report;
+}
+
+const StepReport& Simulation::step_unwritten() {
   interrupted_step_.clear();
   try {
     return run_step_stages();
@@ -142,8 +148,14 @@ long long Simulation::steps_in(double duration) const {
 
 void Simulation::run(double duration, const std::function<bool(long long, long long)>& after_step) {
   const long long n_steps = steps_in(duration);
+  // the state written whole at the end (a reduced model writes it only when read: after_step reads it through
+  // state(), which writes it then), however the run ends
+  struct WrittenAtTheEnd {
+    Simulation& sim;
+    ~WrittenAtTheEnd() { sim.core().state(); }
+  } written{*this};
   for (long long k = 1; k <= n_steps; ++k) {
-    if (step().status == StepStatus::FAILED) return;
+    if (step_unwritten().status == StepStatus::FAILED) return;
     if (after_step && !after_step(k, n_steps)) return;
   }
 }

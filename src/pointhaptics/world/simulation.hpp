@@ -187,6 +187,8 @@ class Simulation {
   void apply_scripted_cuts();
   /// step()'s stages; step() notes a stop inside them
   const StepReport& run_step_stages();
+  /// step() without writing a reduced model's state whole at its end (run() writes it when read, and at its end)
+  const StepReport& step_unwritten();
   /// What the last step was stopped in (a stop request inside it), else empty: the state is then not a step's
   /// result, and summary() never reports it as converged
   std::string interrupted_step_;
