@@ -68,13 +68,6 @@ std::vector<index_t> visible_shell(const Csr& neighbours) {
 }
 
 std::unique_ptr<Prepared> prepare(const Scene& scene_in, ProbeSource source, int threads) {
-  // the viewer's probe touches the object, and a reduced model takes no contact yet (issue 49): named here, not a
-  // first step that fails
-  if (scene_in.solver.reduction.modes > 0)
-    throw Error(
-        fmt::format("{}: view: a reduced model ([reduction]) cannot be touched by the viewer's probe yet; run it with "
-                    "`pointhaptics run {} --vtk DIR` (ParaView) or from Python",
-                    scene_in.path, scene_in.path));
   auto p = std::make_unique<Prepared>();
   p->scene = scene_in;
   Scene& scene = p->scene;
