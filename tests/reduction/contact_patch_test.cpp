@@ -29,16 +29,7 @@ namespace {
 constexpr double spacing = 0.01;
 
 // a 12 x 4 x 4 cantilever of St. Venant-Kirchhoff points, held at x = 0
-Model cantilever() {
-  MaterialParams m;
-  m.model = MaterialModel::SVK;
-  m.young = 1e5;
-  m.poisson = 0.3;
-  m.density = 1000;
-  Model model = build_model(test::jittered_box(12, 4, 4, spacing, 0.1), m, KernelParams{});
-  for (index_t i = 0; i < model.n_points; ++i) model.fixed[static_cast<std::size_t>(i)] = model.X(0, i) < 0.5 * spacing;
-  return model;
-}
+Model cantilever() { return test::jittered_cantilever(spacing); }
 
 // the top points near x = 8 spacings: where a tool presses
 std::vector<index_t> pressed_points(const Model& model) {

@@ -21,16 +21,7 @@ namespace {
 constexpr double spacing = 0.01;
 
 // a 12 x 4 x 4 cantilever of St. Venant-Kirchhoff points, held at x = 0
-Model cantilever(MaterialModel material = MaterialModel::SVK) {
-  MaterialParams m;
-  m.model = material;
-  m.young = 1e5;
-  m.poisson = 0.3;
-  m.density = 1000;
-  Model model = build_model(test::jittered_box(12, 4, 4, spacing, 0.1), m, KernelParams{});
-  for (index_t i = 0; i < model.n_points; ++i) model.fixed[static_cast<std::size_t>(i)] = model.X(0, i) < 0.5 * spacing;
-  return model;
-}
+Model cantilever(MaterialModel material = MaterialModel::SVK) { return test::jittered_cantilever(spacing, material); }
 
 Points tip_load(const Model& model, double force) {
   Points f = Points::Zero(3, model.n_points);

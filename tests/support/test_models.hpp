@@ -17,6 +17,19 @@ inline PointCloud jittered_box(int nx, int ny, int nz, double spacing, double ji
   return cloud;
 }
 
+/// A 12 x 4 x 4 cantilever of points at `spacing` (jittered by a tenth of it), E = 1e5 Pa, nu = 0.3, held at x = 0:
+/// the reduced model's tests' object.
+inline Model jittered_cantilever(double spacing, MaterialModel material = MaterialModel::SVK) {
+  MaterialParams m;
+  m.model = material;
+  m.young = 1e5;
+  m.poisson = 0.3;
+  m.density = 1000;
+  Model model = build_model(jittered_box(12, 4, 4, spacing, 0.1), m, KernelParams{});
+  for (index_t i = 0; i < model.n_points; ++i) model.fixed[static_cast<std::size_t>(i)] = model.X(0, i) < 0.5 * spacing;
+  return model;
+}
+
 /// Gaussian random field with standard deviation `scale` per component.
 inline Points random_field(index_t n, double scale, unsigned seed = 2) {
   std::mt19937 rng(seed);
