@@ -175,6 +175,52 @@ TEST(ContactPatch, StaysWhileItsCorrectionMovesOnAfterTheToolLeavesThenGoes) {
   EXPECT_EQ(c.patch->rebuilds(), 2);
 }
 
+// a tool's forces and springs on the top points near x = 8 spacings, as a probe gives them (DynamicForces)
+class PushOnTop final : public DynamicForces {
+ public:
+  explicit PushOnTop(std::vector<index_t> points) : points_(std::move(points)) {}
+  void add(const Model&, const State&, Points& f) override {
+    for (const index_t i : points_) f(1, i) -= 0.005;
+  }
+  bool add_stiffness(const Model&, const State&, Eigen::Matrix<double, 9, Eigen::Dynamic>& springs) override {
+    for (const index_t i : points_) springs(4, i) += 50;  // (y, y)
+    return true;
+  }
+
+ private:
+  std::vector<index_t> points_;
+};
+
+TEST(ContactPatch, AReducedStepWithAToolWritesThePatchInFullAndItsVelocity) {
+  // the solver's side of the coupling, a few steps (quick under the sanitizers, where a probe's press is not)
+  const Model model = cantilever();
+  SolverSpec spec;
+  spec.kind = SolverKind::IMPLICIT;
+  spec.dt = 1e-3;
+  spec.reduction.modes = 10;
+  spec.reduction.contact_rings = 2;
+  Workspace ws(model, 2);
+  ReducedSolver solver(model, spec, ws);
+  State state = State::at_rest(model);
+  PushOnTop push(pressed_points(model));
+  Points before = state.u;
+  for (int k = 0; k < 20; ++k) {
+    before = state.u;
+    const StepReport report = solver.step(model, state, ws, &push);
+    ASSERT_NE(report.status, StepStatus::FAILED) << report.failure;
+    EXPECT_FALSE(solver.unpublished()) << "a tool reads the state: written at every step";
+  }
+  ASSERT_NE(solver.contact_patch(), nullptr);
+  EXPECT_GT(solver.contact_patch()->free_points(), 0);
+  EXPECT_TRUE(state.u.allFinite());
+  for (const index_t i : pressed_points(model)) {
+    EXPECT_LT(state.u(1, i), 0.0) << "pushed down at " << i;
+    // the patch's points carry their own velocity: the step's motion
+    EXPECT_LT((state.velocity.col(i) - (state.u.col(i) - before.col(i)) / spec.dt).norm(),
+              1e-9 * (1 + state.velocity.col(i).norm()));
+  }
+}
+
 struct Press {
   Vec3 felt;  // the force the device rendered at the end, N
   double tip = 0, probe_y = 0, seconds = 0;
