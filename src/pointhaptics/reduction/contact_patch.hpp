@@ -99,6 +99,7 @@ class ContactPatch final : public ReducedCoupling {
   NewtonSolver newton_;
   NewtonSettings settings_;
   Eigen::MatrixXd U_patch_;                       ///< 3 n_patch x r: the patch's rows of U
+  std::vector<index_t> touched_;                  ///< the points the tools act on this step
   std::vector<char> inside_;                      ///< per model point: within A less its outer ring (A kept while the
                                                   ///< tools act only there)
   Points tool_, load_, start_, rest_, star_, w_;  ///< patch: t, f + t, the springs' anchor, U_P q, u*, u* - U_P q
