@@ -140,6 +140,21 @@ TEST(ReducedScene, TheStateIsWrittenWhenReadAndReadsTheSameAsWrittenAtEveryStep)
   EXPECT_EQ(held.u, eager.state().u);
 }
 
+TEST(ReducedScene, AStateSetFromOutsideIsWhereTheNextStepsContinueFrom) {
+  // it was overwritten by the solver's own coordinates at the next step
+  Scene scene = parse_scene(reduced("implicit"));
+  Simulation first(build_scene_model(scene), scene.solver, 2), second(build_scene_model(scene), scene.solver, 2);
+  first.run(0.05);
+  second.set_state(first.state());
+  first.run(0.02);
+  second.run(0.02);
+  const double size = first.state().u.cwiseAbs().maxCoeff();
+  EXPECT_GT(size, 1e-5);
+  EXPECT_LT((second.state().u - first.state().u).cwiseAbs().maxCoeff(), 1e-9 * size);
+  EXPECT_LT((second.state().velocity - first.state().velocity).cwiseAbs().maxCoeff(),
+            1e-9 * first.state().velocity.cwiseAbs().maxCoeff());
+}
+
 TEST(ReducedScene, WhatIsNotReducedYetIsANamedError) {
   const auto error = [](const std::string& text) {
     try {

@@ -95,6 +95,14 @@ index_t ReducedSolver::count_inverted(const Model& model, const State& state, Wo
   return last_count_ = pointhaptics::count_inverted(model, inversion_u_, ws);
 }
 
+void ReducedSolver::take_state(const Model& model, const State& state) {
+  Points weighted = state.u * model.mass.asDiagonal();
+  reduced_.q = basis_.U.transpose() * Eigen::Map<const Eigen::VectorXd>(weighted.data(), weighted.size());
+  weighted = state.velocity * model.mass.asDiagonal();
+  reduced_.v = basis_.U.transpose() * Eigen::Map<const Eigen::VectorXd>(weighted.data(), weighted.size());
+  unpublished_ = false;  // the state holds what was given
+}
+
 void ReducedSolver::publish(State& state, Workspace& ws) {
   if (!unpublished_) return;
   // u = U q and v = U q' on the step's threads, each its rows of U (both products cost several reduced steps)

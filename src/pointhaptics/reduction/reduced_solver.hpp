@@ -51,6 +51,11 @@ class ReducedSolver final : public Solver {
   /// pays for it every k steps. With tools (a probe reads the surface at every step) the step writes them.
   bool unpublished() const override { return unpublished_; }
   void publish(State& state, Workspace& ws) override;
+  /// A state given from outside (ModelSimulation::set_state()): q and q' become its projection on the basis,
+  /// U^T M u and U^T M v (U is mass-orthonormal), so the next step continues from it; the state keeps what was
+  /// given (outside the basis' span, the part the basis does not hold is lost at the next step, except under a
+  /// probe's contact patch, which takes it as its correction).
+  void take_state(const Model& model, const State& state);
   /// the reduced model's lowest natural frequency about rest, Hz
   double first_frequency_hz() const { return first_frequency_hz_; }
 

@@ -138,6 +138,8 @@ void ModelSimulation::set_state(const State& state) {
   if (state.viscous.rows() == state_.viscous.rows() && state.viscous.cols() == state_.viscous.cols())
     state_.viscous = state.viscous;
   else state_.viscous.setZero();
+  // a reduced model steps its own coordinates: they take the given state (its projection on the basis)
+  if (auto* reduced = dynamic_cast<ReducedSolver*>(solver_impl_.get())) reduced->take_state(model_, state_);
 }
 
 CutReport ModelSimulation::cut(std::span<const BladeSweep> sweeps) {
