@@ -116,6 +116,31 @@ void ReducedSolver::publish(State& state, Workspace& ws) {
   unpublished_ = false;
 }
 
+ContactPatch* ReducedSolver::begin_contact(const Model& model, const State& state, DynamicForces& forces, int threads) {
+  // the tools' forces at the step's start and their springs (a probe's, linearly implicit as in the full implicit
+  // solver), on a patch of points in full resolution around where they act
+  if (tool_forces_.cols() != model.n_points) {
+    tool_forces_ = Points::Zero(3, model.n_points);
+    springs_ = ContactPatch::Blocks::Zero(9, model.n_points);
+  }
+  tool_forces_.setZero();
+  springs_.setZero();
+  if (forces.add_beyond_energy(model, state, tool_forces_)) forces.add_stiffness(model, state, springs_);
+  if (!patch_) patch_ = std::make_unique<ContactPatch>(model, basis_.U, spec_.reduction.contact_rings, threads);
+  ContactPatch::Step step;
+  step.tool_forces = &tool_forces_;
+  step.springs = &springs_;
+  step.start = &state;
+  step.q = &reduced_.q;
+  if (spec_.kind != SolverKind::STATIC) {
+    step.inertia = integrator_->inertia(spec_.dt);
+    step.carry = integrator_->carry(spec_.dt);
+  }
+  reduced_anchor_ = reduced_.q + step.carry * reduced_.v;
+  step.reduced_anchor = &reduced_anchor_;
+  return patch_->begin_step(model, step) ? patch_.get() : nullptr;
+}
+
 StepReport ReducedSolver::step(const Model& model, State& state, Workspace& ws, DynamicForces* forces) {
   StepReport report;
   ContactPatch* coupling = nullptr;
@@ -127,29 +152,7 @@ StepReport ReducedSolver::step(const Model& model, State& state, Workspace& ws, 
           "probe is)";
       return report;
     }
-    // the tools' forces at the step's start and their springs (a probe's, linearly implicit as in the full
-    // implicit solver), on a patch of points in full resolution around where they act
-    if (tool_forces_.cols() != model.n_points) {
-      tool_forces_ = Points::Zero(3, model.n_points);
-      springs_ = ContactPatch::Blocks::Zero(9, model.n_points);
-    }
-    tool_forces_.setZero();
-    springs_.setZero();
-    if (forces->add_beyond_energy(model, state, tool_forces_)) forces->add_stiffness(model, state, springs_);
-    if (!patch_)
-      patch_ = std::make_unique<ContactPatch>(model, basis_.U, spec_.reduction.contact_rings, ws.n_threads());
-    ContactPatch::Step step;
-    step.tool_forces = &tool_forces_;
-    step.springs = &springs_;
-    step.start = &state;
-    step.q = &reduced_.q;
-    if (spec_.kind != SolverKind::STATIC) {
-      step.inertia = integrator_->inertia(spec_.dt);
-      step.carry = integrator_->carry(spec_.dt);
-    }
-    reduced_anchor_ = reduced_.q + step.carry * reduced_.v;
-    step.reduced_anchor = &reduced_anchor_;
-    if (patch_->begin_step(model, step)) coupling = patch_.get();
+    coupling = begin_contact(model, state, *forces, ws.n_threads());
   }
   const double tolerance = spec_.tolerance > 0 ? spec_.tolerance : spec_.kind == SolverKind::STATIC ? 1e-8 : 1e-6;
   ReducedSolveReport solved;

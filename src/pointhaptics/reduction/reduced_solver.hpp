@@ -63,6 +63,9 @@ class ReducedSolver final : public Solver {
   /// The basis (basis_): read from the cache when `spec_.reduction.cache` names one and a good file is there,
   /// else made (on the points, or on a coarser sampling and carried) and kept there; sets the cache_* members.
   void make_or_read_basis(const Model& model, Workspace& ws);
+  /// This step's contact patch for the tools' forces and springs at `state` (nullptr when they act on no point);
+  /// `threads`: the step's (the patch's, when it is large).
+  ContactPatch* begin_contact(const Model& model, const State& state, DynamicForces& forces, int threads);
   SolverSpec spec_;
   ModalBasis basis_;
   std::unique_ptr<SvkPolynomial> polynomial_;
