@@ -112,7 +112,6 @@ NewtonProblem ContactPatch::problem() {
 
 bool ContactPatch::evaluate(const Eigen::VectorXd& q, double& energy, Eigen::VectorXd& gradient) {
   const Model& patch = patch_.model;
-  q_ = q;
   failure_ = "";
   // the patch's stencils as the reduced model has them (U_P q): their energy and forces, taken out again
   basis_product(q, rest_);
@@ -177,7 +176,8 @@ void ContactPatch::add_hessian(Eigen::MatrixXd& hessian) {
     const NewtonProblem problem = this->problem();
     newton_.linearise(inner_, problem, star_, *inner_ws_);
     star_tangent_.linearise(patch, star_, TangentMode::PROJECTED, ws_.get());
-    Eigen::MatrixXd z_free(free_rows, r), y_free(free_rows, r);
+    z_free_.resize(free_rows, r);  // (allocates only when the patch changes)
+    y_free_.resize(free_rows, r);
     for (Eigen::Index k = 0; k < r; ++k) {
       flat(product_) = U_patch_.col(k);
       product_.leftCols(patch_.n_free).setZero();
@@ -185,19 +185,17 @@ void ContactPatch::add_hessian(Eigen::MatrixXd& hessian) {
       hessian_.col(k).noalias() += U_patch_.bottomRows(U_patch_.rows() - free_rows).transpose() *
                                    flat(scratch_).tail(U_patch_.rows() - free_rows);
       Points& y = condensed_start_[static_cast<std::size_t>(k)];
-      const int iterations = newton_.solve_linearised(inner_, problem, scratch_, y, condensation_tolerance,
-                                                      condensation_iterations, *inner_ws_);
-      condensation_cg_ += std::abs(iterations);
+      newton_.solve_linearised(inner_, problem, scratch_, y, condensation_tolerance, condensation_iterations,
+                               *inner_ws_);
       // held points of the model within A carry no correction: zero rows of z and y
       for (index_t i = 0; i < patch_.n_free; ++i)
         if (patch.fixed[static_cast<std::size_t>(i)]) scratch_.col(i).setZero(), y.col(i).setZero();
-      z_free.col(k) = flat(scratch_).head(free_rows);
-      y_free.col(k) = flat(y).head(free_rows);
+      z_free_.col(k) = flat(scratch_).head(free_rows);
+      y_free_.col(k) = flat(y).head(free_rows);
     }
-    hessian_.noalias() -= z_free.transpose() * y_free;
+    hessian_.noalias() -= z_free_.transpose() * y_free_;
     hessian_ = 0.5 * (hessian_ + hessian_.transpose()).eval();
     hessian_valid_ = true;
-    ++hessians_;
   }
   hessian += hessian_;
 }

@@ -56,8 +56,6 @@ class ContactPatch final : public ReducedCoupling {
   /// condensation_iterations CG iterations.
   void add_hessian(Eigen::MatrixXd& hessian) override;
   void refresh_hessian() { hessian_valid_ = false; }
-  /// Hessians made since construction
-  long long hessians() const { return hessians_; }
   static constexpr double condensation_tolerance = 1e-6;
   static constexpr int condensation_iterations = 5;
   static constexpr int release_steps = 200;
@@ -75,9 +73,8 @@ class ContactPatch final : public ReducedCoupling {
   index_t largest_free_points() const { return largest_free_points_; }
   /// patches made (A chosen anew) since construction
   long long rebuilds() const { return rebuilds_; }
-  /// Newton iterations of the patch's solves, and CG iterations of the condensation, since construction
+  /// Newton iterations of the patch's solves since construction
   long long inner_iterations() const { return inner_iterations_; }
-  long long condensation_cg_iterations() const { return condensation_cg_; }
   /// why the last evaluation failed (empty when it did not)
   const char* failure() const { return failure_; }
 
@@ -109,12 +106,12 @@ class ContactPatch final : public ReducedCoupling {
   Blocks springs_;
   std::vector<Mat3> gradients_;
   Tangent rest_tangent_, star_tangent_;
-  Eigen::VectorXd q_;        ///< the q last evaluated
-  Eigen::MatrixXd hessian_;  ///< its Hessian, once made (hessian_valid_)
+  Eigen::MatrixXd hessian_;          ///< its Hessian, once made (hessian_valid_)
+  Eigen::MatrixXd z_free_, y_free_;  ///< the condensation's H_AR U_R and H_AA^-1 H_AR U_R (scratch)
   bool hessian_valid_ = false;
   std::vector<Points> condensed_start_;  ///< H_AA^-1 H_AR U_R e_k of the last Hessian: warm starts
   index_t largest_free_points_ = 0;
-  long long hessians_ = 0, rebuilds_ = 0, inner_iterations_ = 0, condensation_cg_ = 0;
+  long long rebuilds_ = 0, inner_iterations_ = 0;
   const char* failure_ = "";
 };
 

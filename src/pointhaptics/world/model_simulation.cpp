@@ -260,7 +260,7 @@ const StepReport& ModelSimulation::step() {
         fmt::format("simulation: no step after a failed one (t = {:.6g} s: {})", state_.time, diagnostics_.failure));
   const StageClock clock;
   // tools read the state (attached after steps that left it unwritten: written now)
-  if (!hands_.empty() || held_tool_ || !posed_bodies_.empty() || body_contact_) publish_state();
+  if (has_tools()) publish_state();
   // inputs: the tools take their place for this step
   timed_stage(diagnostics_.tools_seconds, [&] { place_tools(); });
   // the solver: internal, external, contact and tool forces, time integration or equilibrium, held points
@@ -332,7 +332,7 @@ void ModelSimulation::update_sleep() {
 
 DynamicForces* ModelSimulation::forces_this_step() {
   // (through the set even for one member: it times the contact stage, which the solvers interleave with the rest)
-  if (hands_.empty() && !held_tool_ && posed_bodies_.empty() && !body_contact_) return nullptr;
+  if (!has_tools()) return nullptr;
   forces_.clear();
   for (ProbeAttachment& hand : hands_) forces_.add_member(&hand.tool);
   if (held_tool_) forces_.add_member(held_tool_.get());

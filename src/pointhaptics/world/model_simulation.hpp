@@ -265,6 +265,8 @@ class ModelSimulation {
   /// Solver::publish() into state_ and ws_ when the solver left the state unwritten: logically const (the state is
   /// the object's whatever the solver keeps), so state() can give it whole.
   void publish_state() const;
+  /// Whether anything acts on the object beside its loads: hands, a held tool, posed bodies, contact between bodies.
+  bool has_tools() const { return !hands_.empty() || held_tool_ || !posed_bodies_.empty() || body_contact_; }
   Workspace ws_;
   int n_threads_ = 0;
   mutable double stable_dt_ = 0;          ///< 0: not computed yet (static and implicit kinds, until stable_dt())
