@@ -109,9 +109,9 @@ void print_summary(ph::Simulation& sim, const ph::RunSummary& s, double setup_s)
     if (!r.cache_note.empty()) fmt::print("                {}\n", r.cache_note);
     if (r.contact_patches > 0)
       fmt::print(
-          "                contact patch: up to {} points in full around the tools, chosen {} times, {} Newton "
-          "iterations of its own\n",
-          r.contact_points, r.contact_patches, r.contact_iterations);
+          "                contact patch: up to {} points in full around the tools, chosen {} times, {} "
+          "Hessians made\n",
+          r.contact_points, r.contact_patches, r.contact_hessians);
   }
   fmt::print("displacement    max {:.4g} m at point {} ({:.4g}, {:.4g}, {:.4g})\n", max_u, worst, m.X(0, worst),
              m.X(1, worst), m.X(2, worst));

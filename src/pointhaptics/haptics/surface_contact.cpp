@@ -98,6 +98,9 @@ SurfaceContact::SurfaceContact(const Model& model, const TriangleMesh& surface, 
     candidate_skin_ = shape.kind == ToolKind::PLANE ? model.spacing : 0.5 * tool_reach(shape);
     candidates_.reserve(static_cast<std::size_t>(m));
     near_triangles_.reserve(triangles_.size());
+    candidate_points_.reserve(static_cast<std::size_t>(model.n_points));
+    candidate_u_.resize(3, model.n_points);
+    point_marked_.assign(static_cast<std::size_t>(model.n_points), 0);
   }
 }
 
@@ -172,6 +175,16 @@ void SurfaceContact::evaluate_near(const Points& u) {
   const double moved =
       (pose_.position - candidate_position_).norm() + max_weight_l1_ * std::max(0.0, largest - candidate_largest_);
   if (!(moved <= candidate_skin_)) select_candidates(largest);
+  // the candidates' vertices stand when the points their maps read have not moved since they were carried (a step
+  // evaluates the surface at one u three or four times: where the tool is placed, its forces, its springs and the
+  // step's end, which is the next one's start)
+  const bool known = u.cols() == static_cast<Eigen::Index>(point_marked_.size());
+  if (known && candidate_u_current_) {
+    bool same = true;
+    for (std::size_t k = 0; k < candidate_points_.size() && same; ++k)
+      same = u.col(candidate_points_[k]) == candidate_u_.col(static_cast<Eigen::Index>(k));
+    if (same) return;
+  }
   for (const index_t v : candidates_) {
     if (v >= n_surface_) continue;
     Vec3 y = Y_.col(v);
@@ -185,6 +198,10 @@ void SurfaceContact::evaluate_near(const Points& u) {
     y_.col(v) =
         s.weight[0] * y_.col(s.vertex[0]) + s.weight[1] * y_.col(s.vertex[1]) + s.weight[2] * y_.col(s.vertex[2]);
   }
+  if (!known) return;
+  for (std::size_t k = 0; k < candidate_points_.size(); ++k)
+    candidate_u_.col(static_cast<Eigen::Index>(k)) = u.col(candidate_points_[k]);
+  candidate_u_current_ = true;
 }
 
 void SurfaceContact::select_candidates(double largest) {
@@ -219,6 +236,19 @@ void SurfaceContact::select_candidates(double largest) {
       near_triangles_.push_back(t);
   candidate_position_ = pose_.position;
   candidate_largest_ = largest;
+  // the points the candidates' maps read, once each
+  for (const index_t p : candidate_points_) point_marked_[static_cast<std::size_t>(p)] = 0;
+  candidate_points_.clear();
+  for (const index_t v : candidates_) {
+    if (v >= n_surface_) continue;
+    for (index_t e = map_.points.begin(v); e < map_.points.end(v); ++e) {
+      const index_t p = map_.points.index[static_cast<std::size_t>(e)];
+      if (static_cast<std::size_t>(p) >= point_marked_.size() || point_marked_[static_cast<std::size_t>(p)]) continue;
+      point_marked_[static_cast<std::size_t>(p)] = 1;
+      candidate_points_.push_back(p);
+    }
+  }
+  candidate_u_current_ = false;
 }
 
 void SurfaceContact::set_vertex_ids(const std::vector<index_t>& ids) {

@@ -291,6 +291,12 @@ class SurfaceContact final : public EnergyTerm {
   double candidate_largest_ = 0, candidate_skin_ = 0, max_weight_l1_ = 0;
   std::vector<double> weight_l1_;  ///< per vertex and sample, sum |w| of its map's row (samples: their parents')
   std::vector<char> carried_;      ///< evaluate()'s scratch: which vertices and samples it carries
+  /// the points the candidates' maps read (each once; point_marked_ flags them), and their u when the candidates
+  /// were last carried (candidate_u_current_): the vertices stand while those have not moved
+  std::vector<index_t> candidate_points_;
+  std::vector<char> point_marked_;
+  Points candidate_u_;
+  bool candidate_u_current_ = false;
   int sample_levels_ = 0;
   SurfaceMap map_;
   ToolShape shape_;

@@ -169,7 +169,7 @@ std::string result_json(const Model& model, const State& state, const RunSummary
                         {"cache_note", r.cache_note},
                         {"contact_points", r.contact_points},
                         {"contact_patches", r.contact_patches},
-                        {"contact_iterations", r.contact_iterations}};
+                        {"contact_hessians", r.contact_hessians}};
   }
   // without levels of detail every point is simulated
   const LodSummary& l = s.lod;

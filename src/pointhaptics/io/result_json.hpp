@@ -96,8 +96,8 @@ struct ReductionSummary {
   bool from_cache = false;  ///< the basis was read from cache_file (the set-up's factor, modes and derivatives skipped)
   std::string cache_note;   ///< what went wrong with the cache file, when something did
   /// a tool's contact region in full resolution (reduction/contact_patch.hpp): the most points it had free, the
-  /// times it was chosen anew, and its own Newton iterations
-  long long contact_points = 0, contact_patches = 0, contact_iterations = 0;
+  /// times it was chosen anew, and the Hessians made for it (each a Cholesky factor of its tangent)
+  long long contact_points = 0, contact_patches = 0, contact_hessians = 0;
 };
 
 struct RunSummary {

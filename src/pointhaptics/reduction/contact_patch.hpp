@@ -11,13 +11,15 @@
 /// forces and springs at the step's start, as the full implicit solver takes a probe's), and backward Euler's
 /// inertia of u itself, k/2 |U q + P w - a|_M^2 = k/2 |q - a_q|^2 + k/2 |u_A - a_A|_M^2 - k/2 |U_A (q - a_q)|_M^2
 /// (U is mass-orthonormal): the coupled system is the full model's step restricted to the subspace {U q + P w},
-/// and keeps its stability (a first version without the patch's mass diverged under a hand in real time). For each
-/// q the patch's correction is minimised out (Newton on the patch with its inertia, its rings held at U q), so the
-/// reduced Newton sees
-///   Phi(q) = Pi(q, w*(q)),   dPhi/dq = dPi/dq at w*,
-///   d2Phi/dq2 = K_W(q) - U_P^T K_P(U_P q) U_P - k U_A^T M_A U_A + U_R^T (H_RR - H_RA H_AA^-1 H_AR) U_R,
-/// the last term the patch's tangent with the springs (H, its positive semi-definite part) condensed onto its held
-/// rings R: the object's stiffness where the tool presses is the full model's, the rest the reduced model's.
+/// and keeps its stability (a first version without the patch's mass diverged under a hand in real time).
+/// The patch's points on A, v = U_A q + w, are unknowns of the reduced Newton beside q (ReducedCoupling: one Newton
+/// on both, v eliminated in each iteration's linear system):
+///   H_qq = K_W(q) - U_P^T K_P(U_P q) U_P - k U_A^T M_A U_A + U_R^T H_RR U_R,   H_qv = U_R^T H_RA,   H_vv = H_AA,
+/// H the patch's tangent with the springs and the inertia at u (its positive semi-definite part), so that the
+/// condensed Hessian H_qq - U_R^T H_RA H_AA^-1 H_AR U_R is the reduced model's stiffness with the full model's where
+/// the tool presses. It lags from step to step (a modified Newton: the gradient is exact, and so is the answer).
+/// (A first version minimised v out at every q with a Newton solve of its own: the same answers at 3.6 ms a step
+/// on the 10k-point stiff beam, most of it those solves.)
 #include <pointhaptics/mechanics/model_patch.hpp>
 #include <pointhaptics/mechanics/tangent.hpp>
 #include <pointhaptics/reduction/reduced_integrator.hpp>
@@ -49,20 +51,25 @@ class ContactPatch final : public ReducedCoupling {
   /// Chooses A for this step, kept from the last step while the points the tools act on stay inside it with a ring
   /// to spare, and for release_steps after they act on none. False when there is no patch (then u = U q).
   bool begin_step(const Model& model, const Step& step);
+  /// ReducedCoupling: the energy at q and the patch's points as they are now (the rings at U_R q)
   bool evaluate(const Eigen::VectorXd& q, double& energy, Eigen::VectorXd& gradient) override;
-  /// Made when asked for after a new patch or refresh_hessian(), else the last one (a modified Newton: the gradient
-  /// is exact, and so is the answer; a Hessian that lags costs iterations, and the solver refreshes it for the next
-  /// step when one takes more than a few, and within a step after lagged_iterations). Its condensation's solves are warm-started from the last one's and cut at
-  /// condensation_iterations CG iterations.
+  double residual() const override;
+  /// Made when asked for after a new patch or refresh_hessian(), else the last one. A Hessian that lags costs
+  /// iterations: the solver refreshes it for the next step when one takes more than a few, and within a step after
+  /// lagged_iterations. Making it costs the rest tangent's and the patch tangent's r products, the patch tangent's
+  /// Cholesky factor on A and r solves with it.
   void add_hessian(Eigen::MatrixXd& hessian) override;
+  void condense(Eigen::VectorXd& gradient) override;
+  double begin_move(const Eigen::VectorXd& dq) override;
+  void move(double alpha) override;
   void refresh_hessian() { hessian_valid_ = false; }
   static constexpr double condensation_tolerance = 1e-6;
-  static constexpr int condensation_iterations = 5;
+  static constexpr int condensation_iterations = 10;
   static constexpr int release_steps = 200;
   /// Newton iterations within one step on one Hessian before it is made again
   static constexpr int lagged_iterations = 3;
-  /// The step's end on A: u = u* of the last evaluation, and v = (u* - u_start) / dt (the rest of the state is the
-  /// reduced model's, written before).
+  /// The step's end on A: u = v, and the velocity (v - u_start) / dt (the rest of the state is the reduced model's,
+  /// written before).
   void write_state(Points& u, Points& velocity, double dt) const;
 
   bool active() const { return active_; }
@@ -73,8 +80,8 @@ class ContactPatch final : public ReducedCoupling {
   index_t largest_free_points() const { return largest_free_points_; }
   /// patches made (A chosen anew) since construction
   long long rebuilds() const { return rebuilds_; }
-  /// Newton iterations of the patch's solves since construction
-  long long inner_iterations() const { return inner_iterations_; }
+  /// Hessians made since construction (each a Cholesky factor of the patch's tangent on A)
+  long long hessians() const { return hessians_; }
   /// why the last evaluation failed (empty when it did not)
   const char* failure() const { return failure_; }
 
@@ -82,7 +89,9 @@ class ContactPatch final : public ReducedCoupling {
   void build(const Model& model, const std::vector<index_t>& touched);
   /// the patch's rows of U times x, as the patch's 3 x n points
   void basis_product(const Eigen::VectorXd& x, Points& out) const;
-  /// the patch's own problem: the loads and the tools' springs, no inertia (w is quasi-static)
+  /// the part of the patch's energy that moves with A (strain_energy_near), at u
+  double energy_near(const Points& u);
+  /// the patch's own problem on A: the loads, the tools' springs and the inertia
   NewtonProblem problem();
 
   const Eigen::MatrixXd& U_;
@@ -91,27 +100,28 @@ class ContactPatch final : public ReducedCoupling {
   int steps_untouched_ = 0, uses_this_step_ = 0;
   ModelPatch patch_;
   std::unique_ptr<Workspace> ws_;
-  Model inner_;  ///< the patch for the free points' own solves: its rings beyond the first passive
+  Model inner_;  ///< the patch for its tangent on A (H_AA): its rings beyond the first passive
   std::unique_ptr<Workspace> inner_ws_;
-  NewtonSolver newton_;
-  NewtonSettings settings_;
+  NewtonSolver newton_;                           ///< the tangent on A and its factor (H_AA)
   Eigen::MatrixXd U_patch_;                       ///< 3 n_patch x r: the patch's rows of U
   std::vector<index_t> touched_;                  ///< the points the tools act on this step
   std::vector<char> inside_;                      ///< per model point: within A less its outer ring (A kept while the
                                                   ///< tools act only there)
-  Points tool_, load_, start_, rest_, star_, w_;  ///< patch: t, f + t, the springs' anchor, U_P q, u*, u* - U_P q
+  Points tool_, load_, start_, rest_, star_;      ///< patch: t, f + t, the springs' anchor, U_P q, u (v on A)
   Points anchor_, reduced_anchor_;                ///< patch: a, and U_P a_q
+  Points residual_, solved_, move_start_, move_;  ///< on A: g_v, H_AA^-1 g_v, v where the move began, dv
   double inertia_ = 0;
+  double reach_ = 1;  ///< |U_A|_2, the reduced gradient's most per unit of force on A (residual())
   Points forces_at_rest_, scratch_, product_;
   Blocks springs_;
   std::vector<Mat3> gradients_;
   Tangent rest_tangent_, star_tangent_;
   Eigen::MatrixXd hessian_;          ///< its Hessian, once made (hessian_valid_)
-  Eigen::MatrixXd z_free_, y_free_;  ///< the condensation's H_AR U_R and H_AA^-1 H_AR U_R (scratch)
+  Eigen::MatrixXd z_free_, y_free_;  ///< H_AR U_R and H_AA^-1 H_AR U_R on A's rows (H_vq and H_vv^-1 H_vq)
   bool hessian_valid_ = false;
-  std::vector<Points> condensed_start_;  ///< H_AA^-1 H_AR U_R e_k of the last Hessian: warm starts
+  std::vector<Points> condensed_start_;  ///< H_AA^-1 H_AR U_R e_k of the last Hessian: the next one's warm starts
   index_t largest_free_points_ = 0;
-  long long rebuilds_ = 0, inner_iterations_ = 0;
+  long long rebuilds_ = 0, hessians_ = 0;
   const char* failure_ = "";
 };
 

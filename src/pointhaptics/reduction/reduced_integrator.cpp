@@ -10,6 +10,7 @@ ReducedIntegrator::ReducedIntegrator(const SvkPolynomial& forces, Eigen::VectorX
     : forces_(forces), external_(std::move(external)), damping_(damping), llt_(forces.size()) {
   const int r = forces.size();
   gradient_.resize(r);
+  condensed_.resize(r);
   direction_.resize(r);
   trial_.resize(r);
   anchor_.resize(r);
@@ -42,6 +43,7 @@ ReducedSolveReport ReducedIntegrator::minimise(Eigen::VectorXd& x, const Eigen::
       if (!coupling->evaluate(x, coupled, coupling_gradient_)) {
         if (!checking || (alpha *= 0.5) < 1e-9) return report;
         x = start_ + alpha * direction_;
+        coupling->move(alpha);
         continue;
       }
       energy += coupled;
@@ -53,11 +55,12 @@ ReducedSolveReport ReducedIntegrator::minimise(Eigen::VectorXd& x, const Eigen::
     if (checking && value > before + 1e-4 * alpha * slope) {
       if ((alpha *= 0.5) < 1e-9) return report;
       x = start_ + alpha * direction_;
+      if (coupling) coupling->move(alpha);
       continue;
     }
     gradient_ -= force;
     gradient_.noalias() += inertia * (x - anchor);
-    report.residual = gradient_.norm();
+    report.residual = coupling ? std::hypot(gradient_.norm(), coupling->residual()) : gradient_.norm();
     if (report.residual <= tolerance * scale) {
       report.converged = true;
       return report;
@@ -74,15 +77,21 @@ ReducedSolveReport ReducedIntegrator::minimise(Eigen::VectorXd& x, const Eigen::
       if (coupling) coupling->add_hessian(hessian_);
       llt_.compute(hessian_);
     }
-    direction_ = llt_.solve(gradient_);
+    // with a coupling, its unknowns eliminated (ReducedCoupling): the condensed gradient, and the slope of the
+    // step in both
+    condensed_ = gradient_;
+    if (coupling) coupling->condense(condensed_);
+    direction_ = llt_.solve(condensed_);
     direction_ *= -1;
     before = value;
     slope = gradient_.dot(direction_);
+    if (coupling) slope += coupling->begin_move(direction_);
     alpha = 1;
     // near the answer the objective's change falls below its round-off: then Newton's step is not checked
     checking = -slope > 1e-11 * std::abs(value);
     start_ = x;
     x += direction_;
+    if (coupling) coupling->move(1);
     if (stop_at_budget && report.iterations == max_iterations) {
       report.at_budget = true;
       return report;

@@ -13,16 +13,32 @@ struct ReducedState {
   Eigen::VectorXd q, v;  ///< coordinates and their rates
 };
 
-/// A part of the energy beyond the polynomial and the loads, as a function of q: the region a tool touches in full
-/// resolution (contact_patch.hpp), whose points' own correction is minimised out at each q.
+/// A part of the energy beyond the polynomial and the loads with unknowns of its own, minimised together with q
+/// (one Newton on both): the region a tool touches in full resolution, whose points are its unknowns
+/// (contact_patch.hpp). Newton's system in (q, its unknowns v) is solved with v eliminated:
+///   [H_qq H_qv; H_vq H_vv] [dq; dv] = -[g_q; g_v],
+///   (H_qq - H_qv H_vv^-1 H_vq) dq = -(g_q - H_qv H_vv^-1 g_v),   dv = -H_vv^-1 (g_v + H_vq dq).
+/// Each Newton iteration calls evaluate(), add_hessian(), condense() and begin_move() in this order; a line search
+/// then calls move() with the share of the step it tries, before evaluate() there.
 class ReducedCoupling {
  public:
   virtual ~ReducedCoupling() = default;
-  /// Its energy at q, J, with its gradient added into `gradient`; false when it cannot be evaluated there (its
-  /// own solve failed): the step then fails or backtracks.
+  /// Its energy at q and its own unknowns' current values, with its gradient in q (at fixed v) added into
+  /// `gradient`; false when it is not finite there (the step backtracks, or fails).
   virtual bool evaluate(const Eigen::VectorXd& q, double& energy, Eigen::VectorXd& gradient) = 0;
-  /// Its Hessian (or a positive semi-definite approximation of it) at the q last evaluated, added into `hessian`.
+  /// |g_v| of the last evaluation, in the units of the reduced gradient (U is mass-orthonormal: each point's
+  /// force divided by the square root of its mass), for Newton's convergence test
+  virtual double residual() const = 0;
+  /// H_qq's part and the Schur complement -H_qv H_vv^-1 H_vq (or positive semi-definite approximations of them) at
+  /// the last evaluation, added into `hessian`
   virtual void add_hessian(Eigen::MatrixXd& hessian) = 0;
+  /// gradient -= H_qv H_vv^-1 g_v: the right-hand side of the condensed system
+  virtual void condense(Eigen::VectorXd& gradient) = 0;
+  /// Its unknowns' step for the reduced one dq, dv = -H_vv^-1 (g_v + H_vq dq), from where they are now; returns
+  /// g_v . dv (its share of the step's slope)
+  virtual double begin_move(const Eigen::VectorXd& dq) = 0;
+  /// its unknowns at the step's start plus alpha times its step
+  virtual void move(double alpha) = 0;
 };
 
 struct ReducedSolveReport {
@@ -61,7 +77,8 @@ class ReducedIntegrator {
   Eigen::VectorXd external_;
   double damping_;
   // scratch
-  Eigen::VectorXd gradient_, direction_, trial_, anchor_, scaled_force_, start_, iterate_, coupling_gradient_;
+  Eigen::VectorXd gradient_, condensed_, direction_, trial_, anchor_, scaled_force_, start_, iterate_,
+      coupling_gradient_;
   Eigen::MatrixXd hessian_;
   Eigen::LLT<Eigen::MatrixXd> llt_;
 };

@@ -208,6 +208,16 @@ void NewtonSolver::linearise(const Model& model, const NewtonProblem& problem, c
   preconditioner_mode_ = TangentMode::PROJECTED;
 }
 
+bool NewtonSolver::linearise_factorised(const Model& model, const NewtonProblem& problem, const Points& u,
+                                        Workspace& ws) {
+  linearise(model, problem, u, ws);
+  kind_ = Preconditioner::CHOLESKY;
+  use_cholesky_ = factorise(model, problem, ws);
+  factor_stale_ = false;
+  refactorise_ = !use_cholesky_;
+  return use_cholesky_;
+}
+
 int NewtonSolver::solve_linearised(const Model& model, const NewtonProblem& problem, const Points& b, Points& x,
                                    double tolerance, int max_iterations, Workspace& ws) {
   SolverScratch& s = ws.solver_scratch();

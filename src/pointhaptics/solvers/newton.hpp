@@ -110,6 +110,11 @@ class NewtonSolver {
   /// curvature: x is then the last iterate before it).
   int solve_linearised(const Model& model, const NewtonProblem& problem, const Points& b, Points& x, double tolerance,
                        int max_iterations, Workspace& ws);
+  /// linearise(), and the tangent's Cholesky factor made (over the free points, with the problem's inertia and
+  /// springs) as solve_linearised()'s preconditioner, which then converges in a few CG iterations (the factor is of
+  /// the assembled tangent, whose hourglass part is a bound); false when it cannot be made (a tangent that is not
+  /// finite).
+  bool linearise_factorised(const Model& model, const NewtonProblem& problem, const Points& u, Workspace& ws);
   /// The Cholesky factor's size and timings (zero unless the CHOLESKY preconditioner ran).
   const CholeskyStats& cholesky_stats() const { return cholesky_.stats(); }
   /// The Cholesky factor itself (its background work can be watched or, in tests, held back).

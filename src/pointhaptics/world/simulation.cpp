@@ -583,7 +583,7 @@ RunSummary Simulation::summary() {
     if (const ContactPatch* patch = reduced->contact_patch()) {
       r.contact_points = patch->largest_free_points();
       r.contact_patches = patch->rebuilds();
-      r.contact_iterations = patch->inner_iterations();
+      r.contact_hessians = patch->hessians();
     }
   }
   s.converged = state.u.allFinite() && !d.failed && interrupted_step_.empty();
