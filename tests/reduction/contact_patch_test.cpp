@@ -247,6 +247,34 @@ TEST(ContactPatch, AReducedStepWithAToolWritesThePatchInFullAndItsVelocity) {
   }
 }
 
+TEST(ContactPatch, OneNewtonIterationAStepCarriesThePatchAlongAndStaysWithConvergedSteps) {
+  // real time's iteration budget: the step's one Newton iteration moves the patch's points with q (ReducedCoupling::
+  // move), so a step that stops there is close to a converged one
+  const Model model = cantilever();
+  const auto run = [&](int budget) {
+    SolverSpec spec;
+    spec.kind = SolverKind::IMPLICIT;
+    spec.dt = 1e-3;
+    spec.iteration_budget = budget;
+    spec.reduction.modes = 10;
+    spec.reduction.contact_rings = 2;
+    Workspace ws(model, 2);
+    ReducedSolver solver(model, spec, ws);
+    State state = State::at_rest(model);
+    PushOnTop push(pressed_points(model));
+    for (int k = 0; k < 20; ++k) EXPECT_NE(solver.step(model, state, ws, &push).status, StepStatus::FAILED);
+    return state.u;
+  };
+  const Points converged = run(0), one = run(1);
+  double largest = 0, apart = 0;
+  for (const index_t i : pressed_points(model)) {
+    largest = std::max(largest, converged.col(i).norm());
+    apart = std::max(apart, (one.col(i) - converged.col(i)).norm());
+  }
+  EXPECT_GT(largest, 0.0);
+  EXPECT_LT(apart, 0.01 * largest) << "pressed points: " << largest << " m, one iteration a step off by " << apart;
+}
+
 struct Press {
   Vec3 felt;  // the force the device rendered at the end, N
   double tip = 0, probe_y = 0, seconds = 0;
