@@ -21,6 +21,7 @@ ContactPatch::ContactPatch(const Model& model, const Eigen::MatrixXd& U, int rin
   if (rings < 1) throw Error("reduction.contact_rings: at least 1 (the points a tool acts on and a ring around them)");
   if (U.rows() != 3 * model.n_points) throw Error("contact patch: the basis is not the model's");
   inside_.assign(static_cast<std::size_t>(model.n_points), 0);
+  velocity_slot_.assign(static_cast<std::size_t>(model.n_points), -1);
 }
 
 void ContactPatch::build(const Model& model, const std::vector<index_t>& touched) {
@@ -72,6 +73,7 @@ bool ContactPatch::begin_step(const Model& model, const Step& step) {
   if (!active_) {
     patch_ = ModelPatch{};
     std::fill(inside_.begin(), inside_.end(), 0);
+    forget_velocities();
     return false;
   }
   const bool rebuilt = patch_.full_of.empty() || std::any_of(touched.begin(), touched.end(), [&](index_t i) {
@@ -83,8 +85,16 @@ bool ContactPatch::begin_step(const Model& model, const Step& step) {
     const index_t i = patch_.full_of[static_cast<std::size_t>(k)];
     tool_.col(k) = tool_forces.col(i);
     start_.col(k) = step.start->u.col(i);
-    anchor_.col(k) = step.start->u.col(i) + step.carry * step.start->velocity.col(i);
     springs_.col(k) = springs.col(i);
+  }
+  // A's anchors: a = u + carry v, v as the last step left it where it solved the point in full, else the reduced
+  // model's (the state's v is written only when read)
+  for (index_t k = 0; k < patch_.n_free; ++k) {
+    const index_t slot = velocity_slot_[static_cast<std::size_t>(patch_.full_of[static_cast<std::size_t>(k)])];
+    const Vec3 velocity = slot >= 0               ? Vec3(velocity_.col(slot))
+                          : step.reduced_velocity ? Vec3(U_patch_.middleRows(3 * k, 3) * *step.reduced_velocity)
+                                                  : Vec3::Zero();
+    anchor_.col(k) = start_.col(k) + step.carry * velocity;
   }
   inertia_ = step.inertia;
   basis_product(*step.reduced_anchor, reduced_anchor_);
@@ -237,13 +247,29 @@ void ContactPatch::move(double alpha) {
   star_.leftCols(n_free) = move_start_.leftCols(n_free) + alpha * move_.leftCols(n_free);
 }
 
-void ContactPatch::write_state(Points& u, Points& velocity, double dt) const {
+void ContactPatch::finish_step(Points& u, Points& velocity, double dt) {
+  forget_velocities();
   if (!active_) return;
-  for (index_t k = 0; k < patch_.n_free; ++k) {
+  const index_t n_free = patch_.n_free;
+  velocity_.resize(3, n_free);  // (allocates only when the patch changes)
+  for (index_t k = 0; k < n_free; ++k) {
     const index_t i = patch_.full_of[static_cast<std::size_t>(k)];
+    finished_free_.push_back(i);
+    velocity_slot_[static_cast<std::size_t>(i)] = k;
+    velocity_.col(k) = dt > 0 ? Vec3((star_.col(k) - start_.col(k)) / dt) : Vec3::Zero();
     u.col(i) = star_.col(k);
-    if (dt > 0) velocity.col(i) = (star_.col(k) - start_.col(k)) / dt;
   }
+  write_velocities(velocity);
+}
+
+void ContactPatch::write_velocities(Points& velocity) const {
+  for (std::size_t k = 0; k < finished_free_.size(); ++k)
+    velocity.col(finished_free_[k]) = velocity_.col(static_cast<Eigen::Index>(k));
+}
+
+void ContactPatch::forget_velocities() {
+  for (const index_t i : finished_free_) velocity_slot_[static_cast<std::size_t>(i)] = -1;
+  finished_free_.clear();
 }
 
 }  // namespace pointhaptics

@@ -47,6 +47,9 @@ class ContactPatch final : public ReducedCoupling {
     /// model's own a_q (reduced_integrator.hpp)
     double inertia = 0, carry = 0;
     const Eigen::VectorXd* reduced_anchor = nullptr;
+    /// q', for the velocity of points the last step did not solve in full (the state's may not be written:
+    /// ReducedSolver::publish()); none: at rest
+    const Eigen::VectorXd* reduced_velocity = nullptr;
   };
   /// Chooses A for this step, kept from the last step while the points the tools act on stay inside it with a ring
   /// to spare, and for release_steps after they act on none. False when there is no patch (then u = U q).
@@ -68,9 +71,14 @@ class ContactPatch final : public ReducedCoupling {
   static constexpr int release_steps = 200;
   /// Newton iterations within one step on one Hessian before it is made again
   static constexpr int lagged_iterations = 3;
-  /// The step's end on A: u = v, and the velocity (v - u_start) / dt (the rest of the state is the reduced model's,
-  /// written before).
-  void write_state(Points& u, Points& velocity, double dt) const;
+  /// The step's end on A, written into the state (the rest of it is the reduced model's, written before): u = v,
+  /// and the velocity (v - u_start) / dt, which the patch also keeps for the next step and for write_velocities().
+  void finish_step(Points& u, Points& velocity, double dt);
+  /// A's velocities of the last step finished, written again (after the reduced model's v = U q' was written over
+  /// them); nothing once the patch is released
+  void write_velocities(Points& velocity) const;
+  /// The kept velocities dropped (a state set from outside: the next step takes the state's)
+  void forget_velocities();
 
   bool active() const { return active_; }
   /// the patch's free points (A) and all its points (A and the held rings)
@@ -102,9 +110,12 @@ class ContactPatch final : public ReducedCoupling {
   std::unique_ptr<Workspace> ws_;
   Model inner_;  ///< the patch for its tangent on A (H_AA): its rings beyond the first passive
   std::unique_ptr<Workspace> inner_ws_;
-  NewtonSolver newton_;                           ///< the tangent on A and its factor (H_AA)
-  Eigen::MatrixXd U_patch_;                       ///< 3 n_patch x r: the patch's rows of U
-  std::vector<index_t> touched_;                  ///< the points the tools act on this step
+  NewtonSolver newton_;           ///< the tangent on A and its factor (H_AA)
+  Eigen::MatrixXd U_patch_;       ///< 3 n_patch x r: the patch's rows of U
+  std::vector<index_t> touched_;  ///< the points the tools act on this step
+  /// the last finished step's A (model points) and their velocities; per model point its column there, or -1
+  std::vector<index_t> finished_free_, velocity_slot_;
+  Points velocity_;
   std::vector<char> inside_;                      ///< per model point: within A less its outer ring (A kept while the
                                                   ///< tools act only there)
   Points tool_, load_, start_, rest_, star_;      ///< patch: t, f + t, the springs' anchor, U_P q, u (v on A)

@@ -89,7 +89,7 @@ index_t ReducedSolver::count_inverted(const Model& model, const State& state, Wo
   }
   if (++steps_since_count_ < exact_count_every) return last_count_;
   steps_since_count_ = 0;
-  if (!unpublished_) return last_count_ = pointhaptics::count_inverted(model, state.u, ws);
+  if (!positions_unpublished_) return last_count_ = pointhaptics::count_inverted(model, state.u, ws);
   inversion_u_.resize(3, model.n_points);
   Eigen::Map<Eigen::VectorXd>(inversion_u_.data(), inversion_u_.size()).noalias() = basis_.U * reduced_.q;
   return last_count_ = pointhaptics::count_inverted(model, inversion_u_, ws);
@@ -100,20 +100,28 @@ void ReducedSolver::take_state(const Model& model, const State& state) {
   reduced_.q = basis_.U.transpose() * Eigen::Map<const Eigen::VectorXd>(weighted.data(), weighted.size());
   weighted = state.velocity * model.mass.asDiagonal();
   reduced_.v = basis_.U.transpose() * Eigen::Map<const Eigen::VectorXd>(weighted.data(), weighted.size());
-  unpublished_ = false;  // the state holds what was given
+  positions_unpublished_ = velocities_unpublished_ = false;  // the state holds what was given
+  patch_in_state_ = false;
+  if (patch_) patch_->forget_velocities();
 }
 
 void ReducedSolver::publish(State& state, Workspace& ws) {
-  if (!unpublished_) return;
-  // u = U q and v = U q' on the step's threads, each its rows of U (both products cost several reduced steps)
+  write(state, ws, positions_unpublished_, velocities_unpublished_);
+  positions_unpublished_ = velocities_unpublished_ = false;
+}
+
+void ReducedSolver::write(State& state, Workspace& ws, bool positions, bool velocities) {
+  if (!positions && !velocities) return;
+  // on the step's threads, each its rows of U (each product costs several reduced steps)
   Eigen::Map<Eigen::VectorXd> u(state.u.data(), state.u.size()), v(state.velocity.data(), state.velocity.size());
   ws.for_each_chunk([&](int chunk) {
     const Eigen::Index begin = 3 * static_cast<Eigen::Index>(ws.chunk_begin(chunk));
     const Eigen::Index rows = 3 * static_cast<Eigen::Index>(ws.chunk_end(chunk)) - begin;
-    u.segment(begin, rows).noalias() = basis_.U.middleRows(begin, rows) * reduced_.q;
-    v.segment(begin, rows).noalias() = basis_.U.middleRows(begin, rows) * reduced_.v;
+    if (positions) u.segment(begin, rows).noalias() = basis_.U.middleRows(begin, rows) * reduced_.q;
+    if (velocities) v.segment(begin, rows).noalias() = basis_.U.middleRows(begin, rows) * reduced_.v;
   });
-  unpublished_ = false;
+  // the contact patch's points move as it solved them
+  if (velocities && patch_in_state_) patch_->write_velocities(state.velocity);
 }
 
 ContactPatch* ReducedSolver::begin_contact(const Model& model, const State& state, DynamicForces& forces, int threads) {
@@ -138,6 +146,7 @@ ContactPatch* ReducedSolver::begin_contact(const Model& model, const State& stat
   }
   reduced_anchor_ = reduced_.q + step.carry * reduced_.v;
   step.reduced_anchor = &reduced_anchor_;
+  step.reduced_velocity = &reduced_.v;
   return patch_->begin_step(model, step) ? patch_.get() : nullptr;
 }
 
@@ -194,11 +203,14 @@ StepReport ReducedSolver::step(const Model& model, State& state, Workspace& ws, 
     return report;
   }
   if (spec_.kind != SolverKind::STATIC) state.time += spec_.dt;
-  unpublished_ = true;
+  positions_unpublished_ = velocities_unpublished_ = true;
+  patch_in_state_ = coupling != nullptr;
   if (forces) {
-    // tools read the state at every step: written now, with the contact patch's points in full
-    publish(state, ws);
-    if (coupling) coupling->write_state(state.u, state.velocity, spec_.kind == SolverKind::STATIC ? 0.0 : spec_.dt);
+    // tools read the displacement at every step (not the velocity): written now, with the contact patch's points
+    // in full (their velocities too, which the next step reads; the rest of v when something reads it)
+    write(state, ws, true, false);
+    positions_unpublished_ = false;
+    if (coupling) coupling->finish_step(state.u, state.velocity, spec_.kind == SolverKind::STATIC ? 0.0 : spec_.dt);
   }
   return report;
 }

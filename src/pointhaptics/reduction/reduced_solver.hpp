@@ -48,8 +48,10 @@ class ReducedSolver final : public Solver {
   double gradient_bound() const { return polynomial_->gradient_bound(); }
   /// Without tools a step writes nothing into the state: u = U q and v = U q' are written when something reads
   /// them (ModelSimulation::state(): outputs, the summary, Python), so a run that reads the state every k steps
-  /// pays for it every k steps. With tools (a probe reads the surface at every step) the step writes them.
-  bool unpublished() const override { return unpublished_; }
+  /// pays for it every k steps. With tools (a probe reads the surface at every step) the step writes u, and v where
+  /// the contact patch solved the points in full; the rest of v waits to be read.
+  bool unpublished() const override { return positions_unpublished_ || velocities_unpublished_; }
+  bool displacement_unpublished() const override { return positions_unpublished_; }
   void publish(State& state, Workspace& ws) override;
   /// A state given from outside (ModelSimulation::set_state()): q and q' become its projection on the basis,
   /// U^T M u and U^T M v (U is mass-orthonormal), so the next step continues from it; the state keeps what was
@@ -63,6 +65,8 @@ class ReducedSolver final : public Solver {
   /// The basis (basis_): read from the cache when `spec_.reduction.cache` names one and a good file is there,
   /// else made (on the points, or on a coarser sampling and carried) and kept there; sets the cache_* members.
   void make_or_read_basis(const Model& model, Workspace& ws);
+  /// u = U q and v = U q' into the state, each when asked for (and the contact patch's velocities over v's)
+  void write(State& state, Workspace& ws, bool positions, bool velocities);
   /// This step's contact patch for the tools' forces and springs at `state` (nullptr when they act on no point);
   /// `threads`: the step's (the patch's, when it is large).
   ContactPatch* begin_contact(const Model& model, const State& state, DynamicForces& forces, int threads);
@@ -79,8 +83,9 @@ class ReducedSolver final : public Solver {
   Points tool_forces_;
   Eigen::VectorXd reduced_anchor_;
   ContactPatch::Blocks springs_;
-  bool unpublished_ = false;
-  Points inversion_u_;  ///< U q for the exact inversion count (the state may not hold it yet)
+  bool positions_unpublished_ = false, velocities_unpublished_ = false;
+  bool patch_in_state_ = false;  ///< the last step solved a contact patch, whose points' velocities are its own
+  Points inversion_u_;           ///< U q for the exact inversion count (the state may not hold it yet)
   int steps_since_count_ = exact_count_every;
   index_t last_count_ = 0;
 };

@@ -89,6 +89,8 @@ class Solver {
   /// here, and publish() writes them; the simulation calls it before anything reads the state
   /// (ModelSimulation::state()). Others write the state in the step: false, and nothing to do.
   virtual bool unpublished() const { return false; }
+  /// the displacement unwritten (tools read it at every step; a solver may write it and leave the velocity)
+  virtual bool displacement_unpublished() const { return unpublished(); }
   virtual void publish(State& /*state*/, Workspace& /*ws*/) {}
 };
 

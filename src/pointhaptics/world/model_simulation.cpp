@@ -259,8 +259,8 @@ const StepReport& ModelSimulation::step() {
     throw Error(
         fmt::format("simulation: no step after a failed one (t = {:.6g} s: {})", state_.time, diagnostics_.failure));
   const StageClock clock;
-  // tools read the state (attached after steps that left it unwritten: written now)
-  if (has_tools()) publish_state();
+  // tools read the displacement (attached after steps that left it unwritten: written now)
+  if (has_tools() && solver_impl_ && solver_impl_->displacement_unpublished()) publish_state();
   // inputs: the tools take their place for this step
   timed_stage(diagnostics_.tools_seconds, [&] { place_tools(); });
   // the solver: internal, external, contact and tool forces, time integration or equilibrium, held points
@@ -440,7 +440,7 @@ bool ModelSimulation::place_hand(ProbeAttachment& hand, const StepInputs& inputs
 
 void ModelSimulation::check_finite(StepReport& report) const {
   // (a solver that left the state unwritten checked its own coordinates)
-  if (report.status == StepStatus::FAILED || solver_impl_->unpublished() || state_.u.allFinite()) return;
+  if (report.status == StepStatus::FAILED || solver_impl_->displacement_unpublished() || state_.u.allFinite()) return;
   report.status = StepStatus::FAILED;
   report.failure = fmt::format("the state is not finite at t = {:.6g} s", state_.time);
 }
