@@ -212,14 +212,22 @@ class PushOnTop final : public DynamicForces {
   std::vector<index_t> points_;
 };
 
-TEST(ContactPatch, AReducedStepWithAToolWritesThePatchInFullAndItsVelocity) {
-  // the solver's side of the coupling, a few steps (quick under the sanitizers, where a probe's press is not)
-  const Model model = cantilever();
+// implicit steps of 1 ms of a reduced model of 10 vectors, the patch two rings wide; `budget`: Newton iterations a
+// step (0: converged)
+SolverSpec pushed_spec(int budget) {
   SolverSpec spec;
   spec.kind = SolverKind::IMPLICIT;
   spec.dt = 1e-3;
+  spec.iteration_budget = budget;
   spec.reduction.modes = 10;
   spec.reduction.contact_rings = 2;
+  return spec;
+}
+
+TEST(ContactPatch, AReducedStepWithAToolWritesThePatchInFullAndItsVelocity) {
+  // the solver's side of the coupling, a few steps (quick under the sanitizers, where a probe's press is not)
+  const Model model = cantilever();
+  const SolverSpec spec = pushed_spec(0);
   Workspace ws(model, 2);
   ReducedSolver solver(model, spec, ws);
   State state = State::at_rest(model);
@@ -258,14 +266,8 @@ TEST(ContactPatch, OneNewtonIterationAStepCarriesThePatchAlongAndStaysWithConver
   // move), so a step that stops there is close to a converged one
   const Model model = cantilever();
   const auto run = [&](int budget) {
-    SolverSpec spec;
-    spec.kind = SolverKind::IMPLICIT;
-    spec.dt = 1e-3;
-    spec.iteration_budget = budget;
-    spec.reduction.modes = 10;
-    spec.reduction.contact_rings = 2;
     Workspace ws(model, 2);
-    ReducedSolver solver(model, spec, ws);
+    ReducedSolver solver(model, pushed_spec(budget), ws);
     State state = State::at_rest(model);
     PushOnTop push(pressed_points(model));
     for (int k = 0; k < 20; ++k) EXPECT_NE(solver.step(model, state, ws, &push).status, StepStatus::FAILED);
