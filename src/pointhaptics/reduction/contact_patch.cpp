@@ -50,7 +50,7 @@ void ContactPatch::build(const Model& model, const std::vector<index_t>& touched
   condensed_start_.assign(static_cast<std::size_t>(r), Points::Zero(3, n));
   // |U_A^T g| <= |U_A|_2 |g|: the most a force on A's points moves the reduced gradient (its residual is measured
   // so: weighted by each point's mass instead, a stiff patch's forces on points of a few grams were held to a
-  // hundred times the reduced model's tolerance, at 11 Newton iterations a step)
+  // hundred times the reduced model's tolerance)
   const Eigen::MatrixXd gram = U_patch_.topRows(3 * patch_.n_free).transpose() * U_patch_.topRows(3 * patch_.n_free);
   reach_ =
       std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(gram, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff());
@@ -129,7 +129,10 @@ bool ContactPatch::evaluate(const Eigen::VectorXd& q, double& energy, Eigen::Vec
   const Model& patch = patch_.model;
   const index_t n = patch.n_points, n_free = patch_.n_free;
   failure_ = "";
-  // the patch's stencils as the reduced model has them (U_P q): their energy and forces, taken out again
+  // the patch's stencils as the reduced model has them (U_P q): their energy and forces, taken out again. The
+  // energy of what moves with A alone (the rest cancels); the forces of the whole patch (with its outer rings
+  // passive, a passive point's pairs are charged through the neighbour's gradient only: the rings' forces would
+  // not be the energy's gradient)
   basis_product(q, rest_);
   const double rest_energy = energy_near(rest_);
   compute_internal_forces(patch, rest_, *ws_);
