@@ -64,7 +64,7 @@ bool ContactPatch::begin_step(const Model& model, const Step& step) {
   std::vector<index_t>& touched = touched_;  // (kept: a step allocates only to grow it)
   touched.clear();
   for (index_t i = 0; i < model.n_points; ++i)
-    if (tool_forces.col(i).squaredNorm() > 0 || springs.col(i).squaredNorm() > 0) touched.push_back(i);
+    if (tool_forces.col(i).squaredNorm() != 0 || springs.col(i).squaredNorm() != 0) touched.push_back(i);  // NaN too
   // a patch the tools have left stays for release_steps: its correction, which has mass, moves on as the full
   // model's points would (dropped at once, the indentation sprang back into a probe that came back to it, and a
   // stiff cantilever under a sliding probe diverged)

@@ -84,6 +84,8 @@ class ContactPatch final : public ReducedCoupling {
   /// the patch's free points (A) and all its points (A and the held rings)
   index_t free_points() const { return active_ ? patch_.n_free : 0; }
   index_t patch_points() const { return active_ ? patch_.model.n_points : 0; }
+  /// the points the tools' forces or springs acted on at the last begin_step() (every other point's are zero)
+  const std::vector<index_t>& touched() const { return touched_; }
   /// the most free points a patch had
   index_t largest_free_points() const { return largest_free_points_; }
   /// patches made (A chosen anew) since construction

@@ -131,8 +131,12 @@ ContactPatch* ReducedSolver::begin_contact(const Model& model, const State& stat
     tool_forces_ = Points::Zero(3, model.n_points);
     springs_ = ContactPatch::Blocks::Zero(9, model.n_points);
   }
-  tool_forces_.setZero();
-  springs_.setZero();
+  // (nonzero only where the last step's tools acted, which the patch found: a pass over every point less)
+  if (patch_)
+    for (const index_t i : patch_->touched()) {
+      tool_forces_.col(i).setZero();
+      springs_.col(i).setZero();
+    }
   if (forces.add_beyond_energy(model, state, tool_forces_)) forces.add_stiffness(model, state, springs_);
   if (!patch_) patch_ = std::make_unique<ContactPatch>(model, basis_.U, spec_.reduction.contact_rings, threads);
   ContactPatch::Step step;
