@@ -261,6 +261,28 @@ TEST(ContactPatch, AReducedStepWithAToolWritesThePatchInFullAndItsVelocity) {
   }
 }
 
+// a tool whose force is not a number on one point
+class NotANumber final : public DynamicForces {
+ public:
+  explicit NotANumber(index_t point) : point_(point) {}
+  void add(const Model&, const State&, Points& f) override { f(1, point_) = NAN; }
+
+ private:
+  index_t point_;
+};
+
+TEST(ContactPatch, AToolsForceThatIsNotANumberFailsTheStepByName) {
+  const Model model = cantilever();
+  Workspace ws(model, 1);
+  ReducedSolver solver(model, pushed_spec(0), ws);
+  State state = State::at_rest(model);
+  NotANumber tool(pressed_points(model).front());
+  const StepReport report = solver.step(model, state, ws, &tool);
+  EXPECT_EQ(report.status, StepStatus::FAILED);
+  EXPECT_NE(report.failure.find("not finite"), std::string::npos) << report.failure;
+  EXPECT_TRUE(state.u.allFinite());
+}
+
 TEST(ContactPatch, OneNewtonIterationAStepCarriesThePatchAlongAndStaysWithConvergedSteps) {
   // real time's iteration budget: the step's one Newton iteration moves the patch's points with q (ReducedCoupling::
   // move), so a step that stops there is close to a converged one
