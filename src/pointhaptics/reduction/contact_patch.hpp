@@ -60,7 +60,8 @@ class ContactPatch final : public ReducedCoupling {
   /// Made when asked for after a new patch or refresh_hessian(), else the last one. A Hessian that lags costs
   /// iterations: the solver refreshes it for the next step when one takes more than a few, and within a step after
   /// lagged_iterations. Making it costs the rest tangent's and the patch tangent's r products, the patch tangent's
-  /// Cholesky factor on A and r solves with it.
+  /// Cholesky factor on A and r CG solves preconditioned with it (condensation_tolerance, at most
+  /// condensation_iterations each, warm-started from the last Hessian's).
   void add_hessian(Eigen::MatrixXd& hessian) override;
   void condense(Eigen::VectorXd& gradient) override;
   double begin_move(const Eigen::VectorXd& dq) override;
@@ -77,7 +78,8 @@ class ContactPatch final : public ReducedCoupling {
   /// A's velocities of the last step finished, written again (after the reduced model's v = U q' was written over
   /// them); nothing once the patch is released
   void write_velocities(Points& velocity) const;
-  /// The kept velocities dropped (a state set from outside: the next step takes the state's)
+  /// The kept velocities dropped (a state set from outside: the next step's anchors take the reduced model's,
+  /// U q', the state's projection)
   void forget_velocities();
 
   bool active() const { return active_; }
