@@ -83,15 +83,13 @@ struct Coupled {
   Points tool;
   State start;
   ContactPatch::Blocks springs;
-  Eigen::VectorXd q0 = Eigen::VectorXd::Zero(10), reduced_anchor = Eigen::VectorXd::Zero(10),
-                  reduced_velocity = Eigen::VectorXd::Zero(10);
+  Eigen::VectorXd reduced_anchor = Eigen::VectorXd::Zero(10), reduced_velocity = Eigen::VectorXd::Zero(10);
   std::unique_ptr<ContactPatch> patch;
   ContactPatch::Step step() const {
     ContactPatch::Step s;
     s.tool_forces = &tool;
     s.springs = &springs;
     s.start = &start;
-    s.q = &q0;
     s.inertia = 1e4;  // a step of 10 ms: the inertia terms weigh with the rest
     s.carry = 1e-2;
     s.reduced_anchor = &reduced_anchor;

@@ -232,14 +232,15 @@ void ContactPatch::condense(Eigen::VectorXd& gradient) {
   // s = H_AA^-1 g_v (the factor of the Hessian in use), and g_q - H_qv s = g_q - Z^T s
   const Eigen::Index free_rows = 3 * patch_.n_free;
   solved_.setZero();
-  newton_.solve_linearised(inner_, problem(), residual_, solved_, 1e-3, 20, *inner_ws_);
+  newton_.solve_linearised(inner_, problem(), residual_, solved_, direction_tolerance, direction_iterations,
+                           *inner_ws_);
   gradient.noalias() -= z_free_.transpose() * flat(solved_).head(free_rows);
 }
 
 double ContactPatch::begin_move(const Eigen::VectorXd& dq) {
   // dv = -H_AA^-1 (g_v + H_AR U_R dq) = -(s + Y dq); zero at held points (s and Y are)
   const Eigen::Index free_rows = 3 * patch_.n_free;
-  move_start_ = star_;
+  move_start_.leftCols(patch_.n_free) = star_.leftCols(patch_.n_free);
   flat(move_).head(free_rows).noalias() = -y_free_ * dq;
   flat(move_).head(free_rows) -= flat(solved_).head(free_rows);
   return flat(residual_).head(free_rows).dot(flat(move_).head(free_rows));

@@ -41,8 +41,7 @@ class ContactPatch final : public ReducedCoupling {
   struct Step {
     const Points* tool_forces = nullptr;  ///< t, 3 x n over the model, at the step's start
     const Blocks* springs = nullptr;      ///< S, 9 x n, pulling toward the start's u
-    const State* start = nullptr;         ///< u and v at the step's start (the correction there: u - U q)
-    const Eigen::VectorXd* q = nullptr;   ///< the reduced coordinates at the step's start
+    const State* start = nullptr;         ///< u at the step's start (A's points start from it)
     /// backward Euler's inertia k (0: a static solve) and anchors: a = u + carry v on the points, and the reduced
     /// model's own a_q (reduced_integrator.hpp)
     double inertia = 0, carry = 0;
@@ -69,6 +68,9 @@ class ContactPatch final : public ReducedCoupling {
   void refresh_hessian() { hessian_valid_ = false; }
   static constexpr double condensation_tolerance = 1e-6;
   static constexpr int condensation_iterations = 10;
+  /// condense()'s solve of H_AA s = g_v, a Newton direction's: relative tolerance and CG iterations at most
+  static constexpr double direction_tolerance = 1e-3;
+  static constexpr int direction_iterations = 20;
   static constexpr int release_steps = 200;
   /// Newton iterations within one step on one Hessian before it is made again
   static constexpr int lagged_iterations = 3;

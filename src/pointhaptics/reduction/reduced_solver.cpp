@@ -143,7 +143,6 @@ ContactPatch* ReducedSolver::begin_contact(const Model& model, const State& stat
   step.tool_forces = &tool_forces_;
   step.springs = &springs_;
   step.start = &state;
-  step.q = &reduced_.q;
   if (spec_.kind != SolverKind::STATIC) {
     step.inertia = integrator_->inertia(spec_.dt);
     step.carry = integrator_->carry(spec_.dt);
